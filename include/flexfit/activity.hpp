@@ -1,0 +1,45 @@
+// Activity metrics (SPEC 4, thesis 4.1.4 and Table 4.2).
+//
+// A spring is active when | |x_i - x_j| - L_ij | > threshold. Per step the tracker counts the
+// active springs; over a run it keeps the maximum active at one time, the number of distinct
+// springs ever active, and the restoration time: from the release of the load to the first
+// step after it at which no spring is active.
+#pragma once
+
+#include "flexfit/part_state.hpp"
+
+#include <optional>
+#include <vector>
+
+namespace flexfit {
+
+std::size_t countActiveSprings(const PartModel& model, std::span<const Vec3> positions, double threshold);
+
+class ActivityTracker {
+public:
+    ActivityTracker(const PartModel& model, double threshold);
+
+    // Counts the active springs of `state` and folds them into the run totals; returns the count.
+    std::size_t observe(const PartModel& model, const PartState& state);
+    // The load is released at `time`: the restoration clock starts.
+    void markRelease(double time);
+
+    double threshold() const { return threshold_; }
+    std::size_t activeNow() const { return activeNow_; }
+    std::size_t maxActive() const { return maxActive_; }
+    std::size_t totalDistinct() const { return totalDistinct_; }
+    // Seconds from the release to the first observation with zero active springs; nullopt
+    // while not yet restored (or not released).
+    std::optional<double> restorationTime() const { return restorationTime_; }
+
+private:
+    double threshold_;
+    std::vector<unsigned char> everActive_;  // (E)
+    std::size_t activeNow_ = 0;
+    std::size_t maxActive_ = 0;
+    std::size_t totalDistinct_ = 0;
+    std::optional<double> releaseTime_;
+    std::optional<double> restorationTime_;
+};
+
+}  // namespace flexfit

@@ -1,0 +1,53 @@
+// Triangle meshes: the input of every part, with validation and vertex welding.
+//
+// A TriMesh is plain data. validateMesh() is the single gate every reader and generator
+// passes through: it rejects what would give a broken mass-spring model (empty mesh, index out
+// of range, NaN/Inf coordinates, degenerate or duplicate faces) and counts what is merely
+// unusual (open boundaries, non-manifold edges) as warnings.
+#pragma once
+
+#include "flexfit/core.hpp"
+
+#include <string>
+#include <vector>
+
+namespace flexfit {
+
+struct TriMesh {
+    std::string name;
+    std::vector<Vec3> vertices;  // (V)
+    std::vector<Face> faces;     // (F) 0-based vertex indices, counter-clockwise seen from outside
+};
+
+// What validation found that is legal but worth knowing.
+struct MeshDiagnostics {
+    std::size_t edgeCount = 0;          // unique undirected edges (= springs)
+    std::size_t boundaryEdges = 0;      // edges used by exactly one face (open surface)
+    std::size_t nonManifoldEdges = 0;   // edges used by three or more faces
+    std::size_t unreferencedVertices = 0;
+    std::vector<std::string> warnings;  // human-readable, one per class found
+
+    bool closed() const { return boundaryEdges == 0 && nonManifoldEdges == 0; }
+};
+
+// Where each face and vertex came from in a text file, for error messages (0 = unknown).
+struct MeshSourceLines {
+    std::vector<std::size_t> vertexLine;  // (V) or empty
+    std::vector<std::size_t> faceLine;    // (F) or empty
+};
+
+// Throws InputError naming `source` (and the line, when `lines` knows it) for the first
+// problem found. Faces are degenerate when two indices repeat or their area is below
+// 1e-12 x (bounding-box diagonal)^2; duplicates are faces over the same three vertices.
+MeshDiagnostics validateMesh(const TriMesh& mesh, const std::string& source,
+                             const MeshSourceLines& lines = {});
+
+// Merges vertices closer than `tolerance` (0: bit-identical positions only), keeping the first
+// of each cluster in input order, so the result is deterministic. Faces that collapse are
+// removed; the count is returned. Used for formats that split vertices per face (STL).
+std::size_t weldVertices(TriMesh& mesh, double tolerance);
+
+// Axis-aligned bounds of the vertices.
+Eigen::AlignedBox3d boundingBox(const TriMesh& mesh);
+
+}  // namespace flexfit

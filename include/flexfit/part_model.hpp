@@ -1,0 +1,69 @@
+// The immutable part model: everything about a part that does not change while it simulates.
+//
+// Mesh, topology (CSR neighbourhoods), springs with rest lengths, stiffness and damping, and
+// masses. Held through std::shared_ptr<const PartModel>, so several parts can share one model
+// and no step can modify it. The mutable side is PartState (part_state.hpp).
+//
+// Springs are the unique mesh edges (Topology order). Arrays are struct-of-arrays: the step
+// streams over springA/springB/restLength/stiffness/damping without touching cold data.
+#pragma once
+
+#include "flexfit/mesh.hpp"
+#include "flexfit/topology.hpp"
+
+#include <memory>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+namespace flexfit {
+
+// Spring constants: stiffness k (kg/s^2) and damping b (kg/s).
+struct Material {
+    double stiffness = 0.1;
+    double damping = 0.01;
+
+    // Thesis Table 4.1.
+    static constexpr Material rigid() { return {1.0, 0.1}; }
+    static constexpr Material elastic() { return {0.1, 0.01}; }
+    static constexpr Material superelastic() { return {0.01, 0.001}; }
+};
+
+// "rigid" | "elastic" | "superelastic"; nullopt for anything else.
+std::optional<Material> materialPreset(std::string_view name);
+
+struct PartModelSettings {
+    Material material = Material::elastic();  // for every spring unless springMaterials is set
+    double vertexMass = 1.0;                  // kg, for every vertex unless vertexMasses is set
+    std::vector<double> vertexMasses;         // (V) optional per-vertex masses
+    std::vector<Material> springMaterials;    // (E) optional per-spring constants, Topology order
+};
+
+struct PartModel {
+    std::string name;
+    TriMesh mesh;  // rest shape in the part frame
+    Topology topology;
+
+    // Masses (V).
+    std::vector<Vec3> restPositions;   // (V) part frame; same as mesh.vertices
+    std::vector<double> mass;          // (V) kg, > 0
+    std::vector<double> inverseMass;   // (V) 1/kg
+
+    // Springs (E): one per unique edge.
+    std::vector<Index> springA;        // (E) first mass
+    std::vector<Index> springB;        // (E) second mass
+    std::vector<double> restLength;    // (E) initial Euclidean distance
+    std::vector<double> stiffness;     // (E) k
+    std::vector<double> damping;       // (E) b
+
+    std::size_t massCount() const { return mass.size(); }
+    std::size_t springCount() const { return springA.size(); }
+    std::size_t faceCount() const { return mesh.faces.size(); }
+};
+
+// Builds a model from a validated mesh. Throws InputError (source "part model settings") for
+// non-positive or non-finite masses and constants, or per-vertex / per-spring arrays of the
+// wrong size.
+std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings = {});
+
+}  // namespace flexfit

@@ -1,0 +1,27 @@
+// The mutable state of a simulated part: positions, velocities and accumulated forces of its
+// masses, in the part frame. Struct-of-arrays, sized by the model's mass count.
+#pragma once
+
+#include "flexfit/part_model.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace flexfit {
+
+struct PartState {
+    std::vector<Vec3> positions;   // (V) part frame
+    std::vector<Vec3> velocities;  // (V)
+    std::vector<Vec3> forces;      // (V) accumulated during a step; scratch between steps
+    double time = 0.0;             // s
+    std::uint64_t stepCount = 0;
+
+    // All masses at their rest positions, at rest.
+    static PartState atRest(const PartModel& model);
+};
+
+// 64-bit FNV-1a hash of time, positions and velocities, bit for bit: equal hashes mean the
+// same state (determinism tests).
+std::uint64_t stateHash(const PartState& state);
+
+}  // namespace flexfit

@@ -1,0 +1,91 @@
+// Mass-spring-damper dynamics of a whole part (the thesis's full MSD model, SPEC 2-3).
+//
+// Equation of motion (thesis eq. 2.1): m_i a_i = -gamma v_i + sum_j g_ij + f_i with
+//   g_ij = -k (|x_i - x_j| - L_ij) u_ij - b ((v_i - v_j) . u_ij) u_ij,  u_ij = (x_i - x_j)/|.|
+// f_i: gravity m_i g, point loads, and anchor springs when they restore the shape.
+//
+// Integrators (h = time step):
+//   semi-implicit (symplectic) Euler: v += h a(x, v); x += h v      -- the default
+//   explicit Euler:                   x += h v;      v += h a(x, v) -- the thesis's, to compare
+// Stability (per vibration mode of angular frequency w with modal damping c = 2 zeta w):
+//   symplectic Euler is stable iff h^2 w^2 + 2 c h < 4  (undamped: h < 2/w);
+//   explicit Euler is stable iff h < c / w^2, so it always blows up without damping; with
+//   stiffness-proportional damping (b/k per spring) that is h < b/k for the fast modes.
+// analyzeStability() evaluates both with a Gershgorin upper bound on w (warn: may blow up) and a
+// Rayleigh-quotient lower bound (reject: certain to blow up). Known limit: neither integrator
+// is unconditionally stable; stiff materials need h below the bound it reports.
+//
+// Shape restoration (SPEC 3):
+//   AnchorSprings: a zero-rest-length spring (k_a, b_a) ties each mass to its rest position.
+//   Constraint:    after integration each mass moves a fraction c of the way back to its rest
+//                  position (position-based, like PBD); its velocity takes the correction /h,
+//                  so the correction removes energy instead of leaving a drift. With no other
+//                  force the offset decays by sqrt(1 - c) per step (|eigenvalue| of the update).
+//                  The fraction is per step, so the decay rate depends on h.
+#pragma once
+
+#include "flexfit/part_state.hpp"
+
+#include <span>
+#include <string>
+
+namespace flexfit {
+
+enum class Integrator { SemiImplicitEuler, ExplicitEuler };
+enum class RestorationMethod { None, AnchorSprings, Constraint };
+
+struct RestorationSettings {
+    RestorationMethod method = RestorationMethod::Constraint;
+    double anchorStiffness = 1.0;     // k_a, kg/s^2
+    double anchorDamping = 0.1;       // b_a, kg/s
+    double constraintFraction = 0.05; // c in (0, 1]: share of the separation removed per step
+};
+
+struct SimulationSettings {
+    double timeStep = 1e-3;  // s
+    Integrator integrator = Integrator::SemiImplicitEuler;
+    Vec3 gravity = Vec3::Zero();  // m/s^2
+    double globalDamping = 0.0;   // gamma, kg/s
+    RestorationSettings restoration;
+};
+
+// Throws InputError (source "simulation settings") for non-finite or out-of-range values.
+void validateSettings(const SimulationSettings& settings);
+
+// An external force on one mass for the current step.
+struct PointLoad {
+    Index mass = 0;
+    Vec3 force = Vec3::Zero();
+};
+
+// Work done by a step, for tests that assert counts rather than times.
+struct StepCounters {
+    std::size_t springsEvaluated = 0;
+    std::size_t massesIntegrated = 0;
+};
+
+// Advances every mass of the part by one time step. Loads must name masses < massCount.
+void stepFullModel(const PartModel& model, const SimulationSettings& settings,
+                   std::span<const PointLoad> loads, PartState& state,
+                   StepCounters* counters = nullptr);
+
+// Total kinetic + spring + anchor potential energy (no gravity), and linear momentum.
+double totalEnergy(const PartModel& model, const SimulationSettings& settings, const PartState& state);
+Vec3 linearMomentum(const PartModel& model, const PartState& state);
+
+struct StabilityReport {
+    double omegaUpper = 0.0;     // Gershgorin bound: no mode is faster (rad/s)
+    double omegaLower = 0.0;     // Rayleigh bound: some mode is at least this fast (rad/s)
+    double safeTimeStep = 0.0;   // below this every mode is stable (may be conservative)
+    double unstableTimeStep = 0.0;  // above this some mode certainly diverges
+    bool certainlyUnstable = false;  // timeStep > unstableTimeStep
+    bool possiblyUnstable = false;   // timeStep > safeTimeStep
+    std::string message;             // empty when stable
+};
+
+StabilityReport analyzeStability(const PartModel& model, const SimulationSettings& settings);
+
+const char* toString(Integrator integrator);
+const char* toString(RestorationMethod method);
+
+}  // namespace flexfit

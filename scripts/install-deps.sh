@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the Debian packages Flexfit needs to build, test and run its demo.
+# Idempotent and quiet: when every package is present it prints nothing and exits 0.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config     # toolchain
+  libeigen3-dev                        # linear algebra
+  libassimp-dev                        # mesh import (OBJ, STL, PLY, OFF, glTF)
+  libcli11-dev                         # command line
+  libspdlog-dev libfmt-dev             # logging and formatting
+  libgtest-dev libgmock-dev            # tests
+  libbenchmark-dev                     # benchmarks
+  python3-matplotlib                   # plots of experiment results (/usr/bin/python3)
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$p")
+done
+[[ ${#missing[@]} -eq 0 ]] && exit 0
+
+echo "install-deps: installing ${missing[*]}"
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"

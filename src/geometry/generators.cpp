@@ -1,0 +1,161 @@
+#include "flexfit/generators.hpp"
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <stdexcept>
+
+namespace flexfit {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+void require(bool ok, const char* what) {
+    if (!ok) throw InputError("generator", 0, what);
+}
+
+// Quad (a, b, c, d) counter-clockwise from outside -> two triangles.
+void addQuad(std::vector<Face>& faces, Index a, Index b, Index c, Index d) {
+    faces.push_back({a, b, c});
+    faces.push_back({a, c, d});
+}
+
+// Sphere-topology grid: a pole at +y, (rings-1) latitude rows of `segments`, a pole at -y.
+// `point(theta, phi)` gives the vertex for polar angle theta in (0, pi) and azimuth phi.
+template <class PointFn>
+TriMesh makePolarGrid(int segments, int rings, PointFn point) {
+    TriMesh mesh;
+    mesh.vertices.push_back(point(0.0, 0.0));
+    for (int r = 1; r < rings; ++r)
+        for (int s = 0; s < segments; ++s)
+            mesh.vertices.push_back(point(kPi * r / rings, 2.0 * kPi * s / segments));
+    mesh.vertices.push_back(point(kPi, 0.0));
+    const Index south = Index(mesh.vertices.size() - 1);
+    auto at = [&](int r, int s) { return Index(1 + (r - 1) * segments + (s % segments)); };
+    for (int s = 0; s < segments; ++s) mesh.faces.push_back({0, at(1, s), at(1, s + 1)});
+    for (int r = 1; r + 1 < rings; ++r)
+        for (int s = 0; s < segments; ++s) addQuad(mesh.faces, at(r, s), at(r + 1, s), at(r + 1, s + 1), at(r, s + 1));
+    for (int s = 0; s < segments; ++s) mesh.faces.push_back({south, at(rings - 1, s + 1), at(rings - 1, s)});
+    return mesh;
+}
+
+Vec3 unitDirection(double theta, double phi) {
+    return {std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi)};
+}
+
+// The classic implicit heart with y up; negative inside.
+double heartField(const Vec3& p) {
+    const double x = p.x(), y = p.y(), z = p.z();
+    const double a = x * x + 2.25 * z * z + y * y - 1.0;
+    return a * a * a - x * x * y * y * y - 0.1125 * z * z * y * y * y;
+}
+
+// Distance along `dir` from the origin to the first crossing of the heart surface.
+double heartRadius(const Vec3& dir) {
+    double inside = 0.0, outside = 0.05;
+    while (heartField(outside * dir) < 0.0) {
+        inside = outside;
+        outside += 0.05;
+    }
+    for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (inside + outside);
+        (heartField(mid * dir) < 0.0 ? inside : outside) = mid;
+    }
+    return 0.5 * (inside + outside);
+}
+
+}  // namespace
+
+TriMesh makeTorus(double majorRadius, double minorRadius, int segmentsU, int segmentsV) {
+    require(minorRadius > 0 && majorRadius > minorRadius, "torus needs major radius > minor radius > 0");
+    require(segmentsU >= 3 && segmentsV >= 3, "torus needs at least 3 x 3 segments");
+    TriMesh mesh;
+    mesh.name = "torus";
+    for (int u = 0; u < segmentsU; ++u) {
+        const double phi = 2.0 * kPi * u / segmentsU;
+        for (int v = 0; v < segmentsV; ++v) {
+            const double theta = 2.0 * kPi * v / segmentsV;
+            const double ring = majorRadius + minorRadius * std::cos(theta);
+            mesh.vertices.emplace_back(ring * std::cos(phi), minorRadius * std::sin(theta), -ring * std::sin(phi));
+        }
+    }
+    auto at = [&](int u, int v) { return Index((u % segmentsU) * segmentsV + (v % segmentsV)); };
+    for (int u = 0; u < segmentsU; ++u)
+        for (int v = 0; v < segmentsV; ++v) addQuad(mesh.faces, at(u, v), at(u + 1, v), at(u + 1, v + 1), at(u, v + 1));
+    return mesh;
+}
+
+TriMesh makeUvSphere(double radius, int segments, int rings) {
+    require(radius > 0, "sphere needs radius > 0");
+    require(segments >= 3 && rings >= 2, "sphere needs segments >= 3 and rings >= 2");
+    TriMesh mesh = makePolarGrid(segments, rings, [&](double t, double p) { return Vec3(radius * unitDirection(t, p)); });
+    mesh.name = "sphere";
+    return mesh;
+}
+
+TriMesh makeIcoSphere(double radius, int subdivisions) {
+    require(radius > 0, "icosphere needs radius > 0");
+    require(subdivisions >= 0 && subdivisions <= 8, "icosphere needs 0 <= subdivisions <= 8");
+    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+    TriMesh mesh;
+    mesh.name = "icosphere";
+    mesh.vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                     {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    mesh.faces = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                  {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                  {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+    for (Vec3& v : mesh.vertices) v.normalize();
+    for (int s = 0; s < subdivisions; ++s) {
+        std::map<std::pair<Index, Index>, Index> midpoints;
+        auto midpoint = [&](Index a, Index b) {
+            const auto key = std::minmax(a, b);
+            auto [it, inserted] = midpoints.try_emplace({key.first, key.second}, Index(mesh.vertices.size()));
+            if (inserted) mesh.vertices.push_back((mesh.vertices[a] + mesh.vertices[b]).normalized());
+            return it->second;
+        };
+        std::vector<Face> faces;
+        for (const Face& f : mesh.faces) {
+            const Index ab = midpoint(f[0], f[1]), bc = midpoint(f[1], f[2]), ca = midpoint(f[2], f[0]);
+            faces.insert(faces.end(), {{f[0], ab, ca}, {f[1], bc, ab}, {f[2], ca, bc}, {ab, bc, ca}});
+        }
+        mesh.faces = std::move(faces);
+    }
+    for (Vec3& v : mesh.vertices) v *= radius;
+    return mesh;
+}
+
+TriMesh makeHeart(double size, int segments, int rings) {
+    require(size > 0, "heart needs size > 0");
+    require(segments >= 3 && rings >= 2, "heart needs segments >= 3 and rings >= 2");
+    // The implicit heart spans y in about [-1, 1.1]; centre it and scale its height to `size`.
+    TriMesh unit = makePolarGrid(segments, rings, [](double t, double p) {
+        const Vec3 dir = unitDirection(t, p);
+        return Vec3(heartRadius(dir) * dir);
+    });
+    const Eigen::AlignedBox3d box = boundingBox(unit);
+    const double scale = size / box.sizes().y();
+    const Vec3 centre = box.center();
+    for (Vec3& v : unit.vertices) v = (v - centre) * scale;
+    unit.name = "heart";
+    return unit;
+}
+
+TriMesh makeTorus1() {
+    TriMesh mesh = makeTorus(10.0, 2.5, 24, 24);
+    mesh.name = "torus1";
+    return mesh;
+}
+
+TriMesh makeTorus2() {
+    TriMesh mesh = makeTorus(10.0, 2.5, 54, 29);
+    mesh.name = "torus2";
+    return mesh;
+}
+
+TriMesh makeContainerMouth() {
+    TriMesh mesh = makeTorus(10.0, 2.5, 64, 24);
+    mesh.name = "container_mouth";
+    return mesh;
+}
+
+}  // namespace flexfit

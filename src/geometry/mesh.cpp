@@ -1,0 +1,182 @@
+#include "flexfit/mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace flexfit {
+namespace {
+
+std::size_t lineOf(const std::vector<std::size_t>& lines, std::size_t i) {
+    return i < lines.size() ? lines[i] : 0;
+}
+
+std::string faceText(std::size_t f, const Face& face) {
+    return "face " + std::to_string(f) + " (" + std::to_string(face[0]) + " " + std::to_string(face[1]) +
+           " " + std::to_string(face[2]) + ")";
+}
+
+void checkVertices(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+        if (!mesh.vertices[v].allFinite())
+            throw InputError(source, lineOf(lines.vertexLine, v),
+                             "vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+    }
+}
+
+void checkFaceIndices(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
+    const std::size_t n = mesh.vertices.size();
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        const Face& face = mesh.faces[f];
+        for (Index idx : face)
+            if (idx >= n)
+                throw InputError(source, lineOf(lines.faceLine, f),
+                                 faceText(f, face) + ": index " + std::to_string(idx) +
+                                     " out of range (the mesh has " + std::to_string(n) + " vertices)");
+        if (face[0] == face[1] || face[1] == face[2] || face[0] == face[2])
+            throw InputError(source, lineOf(lines.faceLine, f), faceText(f, face) + " is degenerate: repeated vertex");
+    }
+}
+
+void checkFaceAreas(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
+    const double diagonal = boundingBox(mesh).diagonal().norm();
+    const double minDoubleArea = 2e-12 * diagonal * diagonal;
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        const Face& face = mesh.faces[f];
+        const Vec3& a = mesh.vertices[face[0]];
+        const double doubleArea = (mesh.vertices[face[1]] - a).cross(mesh.vertices[face[2]] - a).norm();
+        if (!(doubleArea > minDoubleArea))
+            throw InputError(source, lineOf(lines.faceLine, f), faceText(f, face) + " is degenerate: zero area");
+    }
+}
+
+void checkDuplicateFaces(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
+    std::vector<std::pair<Face, std::size_t>> sorted;
+    sorted.reserve(mesh.faces.size());
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        Face key = mesh.faces[f];
+        std::sort(key.begin(), key.end());
+        sorted.emplace_back(key, f);
+    }
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 1; i < sorted.size(); ++i) {
+        if (sorted[i].first != sorted[i - 1].first) continue;
+        const std::size_t first = sorted[i - 1].second, second = sorted[i].second;
+        std::string where = "face " + std::to_string(first);
+        if (lineOf(lines.faceLine, first) > 0) where += " (line " + std::to_string(lines.faceLine[first]) + ")";
+        throw InputError(source, lineOf(lines.faceLine, second),
+                         faceText(second, mesh.faces[second]) + " duplicates " + where);
+    }
+}
+
+void countEdges(const TriMesh& mesh, MeshDiagnostics& diagnostics) {
+    std::vector<std::uint64_t> keys;
+    keys.reserve(mesh.faces.size() * 3);
+    for (const Face& face : mesh.faces)
+        for (int e = 0; e < 3; ++e) {
+            const Index a = std::min(face[e], face[(e + 1) % 3]), b = std::max(face[e], face[(e + 1) % 3]);
+            keys.push_back((std::uint64_t(a) << 32) | b);
+        }
+    std::sort(keys.begin(), keys.end());
+    for (std::size_t i = 0; i < keys.size();) {
+        std::size_t j = i;
+        while (j < keys.size() && keys[j] == keys[i]) ++j;
+        ++diagnostics.edgeCount;
+        if (j - i == 1) ++diagnostics.boundaryEdges;
+        if (j - i >= 3) ++diagnostics.nonManifoldEdges;
+        i = j;
+    }
+}
+
+}  // namespace
+
+Eigen::AlignedBox3d boundingBox(const TriMesh& mesh) {
+    Eigen::AlignedBox3d box;
+    for (const Vec3& v : mesh.vertices) box.extend(v);
+    return box;
+}
+
+MeshDiagnostics validateMesh(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
+    if (mesh.vertices.empty()) throw InputError(source, 0, "empty mesh: no vertices");
+    if (mesh.faces.empty()) throw InputError(source, 0, "empty mesh: no faces");
+    checkVertices(mesh, source, lines);
+    checkFaceIndices(mesh, source, lines);
+    checkFaceAreas(mesh, source, lines);
+    checkDuplicateFaces(mesh, source, lines);
+
+    MeshDiagnostics diagnostics;
+    countEdges(mesh, diagnostics);
+    std::vector<unsigned char> used(mesh.vertices.size(), 0);
+    for (const Face& face : mesh.faces)
+        for (Index v : face) used[v] = 1;
+    diagnostics.unreferencedVertices = std::size_t(std::count(used.begin(), used.end(), 0));
+
+    if (diagnostics.boundaryEdges > 0)
+        diagnostics.warnings.push_back(std::to_string(diagnostics.boundaryEdges) +
+                                       " boundary edges: the surface is open");
+    if (diagnostics.nonManifoldEdges > 0)
+        diagnostics.warnings.push_back(std::to_string(diagnostics.nonManifoldEdges) +
+                                       " non-manifold edges (shared by three or more faces)");
+    if (diagnostics.unreferencedVertices > 0)
+        diagnostics.warnings.push_back(std::to_string(diagnostics.unreferencedVertices) +
+                                       " vertices used by no face: they become free masses with no spring");
+    return diagnostics;
+}
+
+std::size_t weldVertices(TriMesh& mesh, double tolerance) {
+    // Hash grid with cells of the tolerance's size; each vertex is compared with the
+    // representatives in the 27 surrounding cells. Exact mode hashes the coordinates' bits.
+    const double cell = tolerance > 0 ? tolerance : 1.0;
+    struct CellHash {
+        std::size_t operator()(const std::array<std::int64_t, 3>& c) const {
+            return std::size_t(c[0] * 73856093) ^ std::size_t(c[1] * 19349663) ^ std::size_t(c[2] * 83492791);
+        }
+    };
+    std::unordered_map<std::array<std::int64_t, 3>, std::vector<Index>, CellHash> grid;
+    std::vector<Index> remap(mesh.vertices.size());
+    std::vector<Vec3> kept;
+    kept.reserve(mesh.vertices.size());
+    auto cellOf = [&](const Vec3& p) {
+        // Clamped so that huge or non-finite coordinates never overflow the integer cast.
+        auto axis = [&](double x) {
+            const double c = std::floor(x / cell);
+            return std::int64_t(std::isfinite(c) ? std::clamp(c, -1e15, 1e15) : 0.0);
+        };
+        return std::array<std::int64_t, 3>{axis(p.x()), axis(p.y()), axis(p.z())};
+    };
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+        const Vec3& p = mesh.vertices[v];
+        const auto c = cellOf(p);
+        Index match = Index(-1);
+        for (int dx = -1; dx <= 1 && match == Index(-1); ++dx)
+            for (int dy = -1; dy <= 1 && match == Index(-1); ++dy)
+                for (int dz = -1; dz <= 1 && match == Index(-1); ++dz) {
+                    auto it = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
+                    if (it == grid.end()) continue;
+                    for (Index k : it->second) {
+                        const bool same = tolerance > 0 ? (kept[k] - p).norm() <= tolerance : kept[k] == p;
+                        if (same) { match = k; break; }
+                    }
+                }
+        if (match == Index(-1)) {
+            match = Index(kept.size());
+            kept.push_back(p);
+            grid[c].push_back(match);
+        }
+        remap[v] = match;
+    }
+    std::vector<Face> faces;
+    faces.reserve(mesh.faces.size());
+    for (const Face& face : mesh.faces) {
+        const Face f{remap[face[0]], remap[face[1]], remap[face[2]]};
+        if (f[0] != f[1] && f[1] != f[2] && f[0] != f[2]) faces.push_back(f);
+    }
+    const std::size_t collapsed = mesh.faces.size() - faces.size();
+    mesh.vertices = std::move(kept);
+    mesh.faces = std::move(faces);
+    return collapsed;
+}
+
+}  // namespace flexfit

@@ -1,0 +1,102 @@
+// Mesh import through assimp (OBJ, STL, PLY, OFF, glTF/GLB, and the rest assimp reads).
+//
+// The scene graph is flattened: every mesh instance is transformed by its node's world matrix
+// and appended. Polygons are triangulated by assimp; point and line primitives cannot be and
+// are rejected. Vertices are welded (exactly, or within the tolerance) because most formats
+// split them per face corner.
+#include "flexfit/mesh_io.hpp"
+#include "io_internal.hpp"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+
+namespace flexfit {
+namespace {
+
+Eigen::Matrix4d toEigen(const aiMatrix4x4& m) {
+    Eigen::Matrix4d out;
+    out << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
+    return out;
+}
+
+void appendMesh(const aiMesh& source, const Eigen::Matrix4d& transform, const std::string& file, TriMesh& out) {
+    const Index base = Index(out.vertices.size());
+    for (unsigned v = 0; v < source.mNumVertices; ++v) {
+        const aiVector3D& p = source.mVertices[v];
+        out.vertices.push_back((transform * Eigen::Vector4d(p.x, p.y, p.z, 1.0)).head<3>());
+    }
+    for (unsigned f = 0; f < source.mNumFaces; ++f) {
+        const aiFace& face = source.mFaces[f];
+        if (face.mNumIndices != 3)
+            throw InputError(file, 0, "mesh '" + std::string(source.mName.C_Str()) + "' face " + std::to_string(f) + " has " +
+                                          std::to_string(face.mNumIndices) +
+                                          " vertices: points and lines cannot be triangulated");
+        out.faces.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
+    }
+}
+
+void appendNode(const aiScene& scene, const aiNode& node, const Eigen::Matrix4d& parent, const std::string& file, TriMesh& out) {
+    const Eigen::Matrix4d world = parent * toEigen(node.mTransformation);
+    for (unsigned i = 0; i < node.mNumMeshes; ++i) appendMesh(*scene.mMeshes[node.mMeshes[i]], world, file, out);
+    for (unsigned i = 0; i < node.mNumChildren; ++i) appendNode(scene, *node.mChildren[i], world, file, out);
+}
+
+bool isNonFiniteToken(std::string token) {
+    std::transform(token.begin(), token.end(), token.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (!token.empty() && (token[0] == '-' || token[0] == '+')) token.erase(0, 1);
+    return token.rfind("nan", 0) == 0 || token.rfind("inf", 0) == 0 || token.rfind("1.#", 0) == 0;
+}
+
+// First line of a text file holding a NaN/Inf token; 0 when none (binary files, or none found).
+std::size_t lineOfNonFiniteToken(const std::filesystem::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    std::string line, token;
+    for (std::size_t number = 1; std::getline(file, line); ++number) {
+        std::size_t i = 0;
+        while (i < line.size()) {
+            while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+            const std::size_t start = i;
+            while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+            if (i > start && isNonFiniteToken(line.substr(start, i - start))) return number;
+        }
+    }
+    return 0;
+}
+
+}  // namespace
+
+MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadOptions& options) {
+    const std::string file = path.string();
+    if (!std::filesystem::exists(path)) throw InputError(file, 0, "cannot open the file for reading: it does not exist");
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
+    if (scene == nullptr) throw InputError(file, 0, std::string("cannot import: ") + importer.GetErrorString());
+    if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 || scene->mRootNode == nullptr)
+        throw InputError(file, 0, "cannot import: the file holds no complete scene");
+
+    TriMesh mesh;
+    mesh.name = path.stem().string();
+    appendNode(*scene, *scene->mRootNode, Eigen::Matrix4d::Identity(), file, mesh);
+    if (mesh.faces.empty()) throw InputError(file, 0, "empty mesh: no triangles");
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+        if (!mesh.vertices[v].allFinite())
+            throw InputError(file, lineOfNonFiniteToken(path), "a vertex has a NaN or infinite coordinate");
+
+    MeshReadResult result;
+    const std::size_t before = mesh.vertices.size();
+    result.collapsedFaces = weldVertices(mesh, options.weldTolerance);
+    result.weldedVertices = before - mesh.vertices.size();
+    result.diagnostics = validateMesh(mesh, file);
+    if (result.collapsedFaces > 0)
+        result.diagnostics.warnings.push_back(std::to_string(result.collapsedFaces) +
+                                              " faces collapsed by welding and were removed");
+    result.mesh = std::move(mesh);
+    return result;
+}
+
+}  // namespace flexfit

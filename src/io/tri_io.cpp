@@ -1,0 +1,220 @@
+// The `.tri` reader and writer (format in mesh_io.hpp).
+#include "flexfit/mesh_io.hpp"
+
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+namespace flexfit {
+namespace {
+
+struct Line {
+    std::size_t number = 0;
+    std::vector<std::string_view> tokens;
+};
+
+bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+std::vector<std::string_view> tokenize(std::string_view line) {
+    std::vector<std::string_view> tokens;
+    std::size_t i = 0;
+    while (i < line.size()) {
+        while (i < line.size() && isSpace(line[i])) ++i;
+        const std::size_t start = i;
+        while (i < line.size() && !isSpace(line[i])) ++i;
+        if (i > start) tokens.push_back(line.substr(start, i - start));
+    }
+    return tokens;
+}
+
+// Walks the text line by line, skipping blank lines, remembering line numbers.
+class LineCursor {
+public:
+    explicit LineCursor(std::string_view text) : text_(text) {}
+
+    // The raw first line (the model's name), without its end of line.
+    std::string_view firstLine() {
+        const std::size_t end = text_.find('\n');
+        std::string_view line = text_.substr(0, end);
+        pos_ = end == std::string_view::npos ? text_.size() : end + 1;
+        lineNumber_ = 1;
+        return line;
+    }
+
+    // Next non-blank line; false at the end of the text.
+    bool next(Line& out) {
+        while (pos_ < text_.size()) {
+            const std::size_t end = std::min(text_.find('\n', pos_), text_.size());
+            std::string_view raw = text_.substr(pos_, end - pos_);
+            pos_ = end + 1;
+            ++lineNumber_;
+            out.number = lineNumber_;
+            out.tokens = tokenize(raw);
+            if (!out.tokens.empty()) return true;
+        }
+        return false;
+    }
+
+    std::size_t lineNumber() const { return lineNumber_; }
+
+private:
+    std::string_view text_;
+    std::size_t pos_ = 0;
+    std::size_t lineNumber_ = 0;
+};
+
+std::string quoted(std::string_view token) {
+    constexpr std::size_t kMax = 40;
+    std::string text(token.substr(0, kMax));
+    for (char& c : text)
+        if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+    return "'" + text + (token.size() > kMax ? "...'" : "'");
+}
+
+std::uint64_t parseCount(std::string_view token, const std::string& source, std::size_t line, const char* what) {
+    std::uint64_t value = 0;
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+    if (ec != std::errc() || end != token.data() + token.size())
+        throw InputError(source, line, std::string(what) + " " + quoted(token) + " is not a non-negative integer");
+    return value;
+}
+
+double parseCoordinate(std::string_view token, const std::string& source, std::size_t line) {
+    double value = 0.0;
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+    if (ec == std::errc::result_out_of_range)
+        throw InputError(source, line, "coordinate " + quoted(token) + " is out of the range of a double");
+    if (ec != std::errc() || end != token.data() + token.size())
+        throw InputError(source, line, "coordinate " + quoted(token) + " is not a number");
+    return value;
+}
+
+void readCounts(LineCursor& cursor, const std::string& source, std::uint64_t& vertexCount, std::uint64_t& faceCount) {
+    Line line;
+    if (!cursor.next(line)) throw InputError(source, cursor.lineNumber(), "unexpected end of file: expected the vertex and face counts");
+    if (line.tokens.size() == 2) {
+        vertexCount = parseCount(line.tokens[0], source, line.number, "vertex count");
+        faceCount = parseCount(line.tokens[1], source, line.number, "face count");
+        return;
+    }
+    if (line.tokens.size() != 1)
+        throw InputError(source, line.number, "expected the vertex and face counts, found " + std::to_string(line.tokens.size()) + " values");
+    vertexCount = parseCount(line.tokens[0], source, line.number, "vertex count");
+    if (!cursor.next(line)) throw InputError(source, cursor.lineNumber(), "unexpected end of file: expected the face count");
+    if (line.tokens.size() != 1)
+        throw InputError(source, line.number, "expected the face count, found " + std::to_string(line.tokens.size()) + " values");
+    faceCount = parseCount(line.tokens[0], source, line.number, "face count");
+}
+
+void readVertices(LineCursor& cursor, const std::string& source, std::uint64_t count, TriMesh& mesh, MeshSourceLines& lines) {
+    Line line;
+    for (std::uint64_t v = 0; v < count; ++v) {
+        if (!cursor.next(line))
+            throw InputError(source, cursor.lineNumber(), "unexpected end of file: the header announces " + std::to_string(count) +
+                                                               " vertices, found " + std::to_string(v));
+        if (line.tokens.size() != 3)
+            throw InputError(source, line.number, "vertex " + std::to_string(v) + " needs 3 coordinates, found " +
+                                                      std::to_string(line.tokens.size()) +
+                                                      " values (do the header's counts match the file?)");
+        mesh.vertices.emplace_back(parseCoordinate(line.tokens[0], source, line.number),
+                                   parseCoordinate(line.tokens[1], source, line.number),
+                                   parseCoordinate(line.tokens[2], source, line.number));
+        lines.vertexLine.push_back(line.number);
+    }
+}
+
+void readFaces(LineCursor& cursor, const std::string& source, std::uint64_t count, TriMesh& mesh, MeshSourceLines& lines) {
+    Line line;
+    for (std::uint64_t f = 0; f < count; ++f) {
+        if (!cursor.next(line))
+            throw InputError(source, cursor.lineNumber(), "unexpected end of file: the header announces " + std::to_string(count) +
+                                                               " faces, found " + std::to_string(f));
+        if (line.tokens.size() > 3)
+            throw InputError(source, line.number, "face " + std::to_string(f) + " has " + std::to_string(line.tokens.size()) +
+                                                      " indices: .tri faces are triangles");
+        if (line.tokens.size() < 3)
+            throw InputError(source, line.number, "face " + std::to_string(f) + " needs 3 vertex indices, found " +
+                                                      std::to_string(line.tokens.size()));
+        Face face{};
+        for (int k = 0; k < 3; ++k) {
+            const std::uint64_t index = parseCount(line.tokens[k], source, line.number, "vertex index");
+            if (index >= mesh.vertices.size())
+                throw InputError(source, line.number, "face " + std::to_string(f) + ": index " + std::to_string(index) +
+                                                          " out of range (the mesh has " + std::to_string(mesh.vertices.size()) + " vertices)");
+            face[k] = Index(index);
+        }
+        mesh.faces.push_back(face);
+        lines.faceLine.push_back(line.number);
+    }
+}
+
+std::string trimmed(std::string_view s) {
+    std::size_t b = 0, e = s.size();
+    while (b < e && (isSpace(s[b]) || s[b] == '\n')) ++b;
+    while (e > b && (isSpace(s[e - 1]) || s[e - 1] == '\n')) --e;
+    return std::string(s.substr(b, e - b));
+}
+
+}  // namespace
+
+MeshReadResult parseTri(std::string_view text, const std::string& source) {
+    if (text.find_first_not_of(" \t\r\n\v\f") == std::string_view::npos) throw InputError(source, 0, "empty file");
+    LineCursor cursor(text);
+    TriMesh mesh;
+    mesh.name = trimmed(cursor.firstLine());
+    std::uint64_t vertexCount = 0, faceCount = 0;
+    readCounts(cursor, source, vertexCount, faceCount);
+    if (vertexCount == 0) throw InputError(source, cursor.lineNumber(), "empty mesh: the vertex count is 0");
+    if (faceCount == 0) throw InputError(source, cursor.lineNumber(), "empty mesh: the face count is 0");
+    if (vertexCount > std::numeric_limits<Index>::max())
+        throw InputError(source, cursor.lineNumber(), "vertex count " + std::to_string(vertexCount) + " exceeds the supported maximum");
+    // Never trust the counts for allocation: a line holds at least 6 characters per record.
+    mesh.vertices.reserve(std::min<std::uint64_t>(vertexCount, text.size() / 6 + 1));
+    mesh.faces.reserve(std::min<std::uint64_t>(faceCount, text.size() / 6 + 1));
+    MeshSourceLines lines;
+    readVertices(cursor, source, vertexCount, mesh, lines);
+    readFaces(cursor, source, faceCount, mesh, lines);
+    Line extra;
+    if (cursor.next(extra))
+        throw InputError(source, extra.number, "unexpected data after the last face: the header's counts (" +
+                                                   std::to_string(vertexCount) + " vertices, " + std::to_string(faceCount) +
+                                                   " faces) do not match the file");
+    MeshReadResult result;
+    result.diagnostics = validateMesh(mesh, source, lines);
+    result.mesh = std::move(mesh);
+    return result;
+}
+
+MeshReadResult readTri(const std::filesystem::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) throw InputError(path.string(), 0, "cannot open the file for reading");
+    std::ostringstream buffer;
+    buffer << file.rdbuf();
+    return parseTri(buffer.str(), path.string());
+}
+
+std::string formatTri(const TriMesh& mesh) {
+    std::string name = mesh.name.empty() ? "unnamed" : mesh.name;
+    for (char& c : name)
+        if (c == '\n' || c == '\r') c = ' ';
+    std::string out = name + "\n" + std::to_string(mesh.vertices.size()) + " " + std::to_string(mesh.faces.size()) + "\n";
+    char buffer[128];
+    for (const Vec3& v : mesh.vertices) {
+        std::snprintf(buffer, sizeof buffer, "%.17g %.17g %.17g\n", v.x(), v.y(), v.z());
+        out += buffer;
+    }
+    for (const Face& f : mesh.faces) out += std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) + "\n";
+    return out;
+}
+
+void writeTri(const TriMesh& mesh, const std::filesystem::path& path) {
+    std::ofstream file(path, std::ios::binary);
+    if (!file) throw InputError(path.string(), 0, "cannot open the file for writing");
+    file << formatTri(mesh);
+    if (!file) throw InputError(path.string(), 0, "write failed");
+}
+
+}  // namespace flexfit
