@@ -50,11 +50,13 @@ struct PartModel {
     std::vector<double> inverseMass;   // (V) 1/kg
 
     // Springs (E): one per unique edge.
-    std::vector<Index> springA;        // (E) first mass
+    std::vector<Index> springA;        // (E) first mass (springA < springB; sorted by springA)
     std::vector<Index> springB;        // (E) second mass
     std::vector<double> restLength;    // (E) initial Euclidean distance
     std::vector<double> stiffness;     // (E) k
     std::vector<double> damping;       // (E) b
+    // (V+1) springs whose first mass is a: [springAdr[a], springAdr[a+1]).
+    std::vector<Index> springAdr;
 
     std::size_t massCount() const { return mass.size(); }
     std::size_t springCount() const { return springA.size(); }

@@ -12,7 +12,9 @@ namespace flexfit {
 struct PartState {
     std::vector<Vec3> positions;   // (V) part frame
     std::vector<Vec3> velocities;  // (V)
-    std::vector<Vec3> forces;      // (V) accumulated during a step; scratch between steps
+    // (V) external forces pending for the next step: add to them (or pass PointLoads) before a
+    // step; the step consumes them and leaves them zero.
+    std::vector<Vec3> forces;
     double time = 0.0;             // s
     std::uint64_t stepCount = 0;
 

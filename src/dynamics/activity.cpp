@@ -38,6 +38,7 @@ std::size_t ActivityTracker::observe(const PartModel& model, const PartState& st
 void ActivityTracker::markRelease(double time) {
     releaseTime_ = time;
     restorationTime_.reset();
+    if (activeNow_ == 0) restorationTime_ = 0.0;  // nothing was deformed at the release
 }
 
 }  // namespace flexfit

@@ -7,80 +7,79 @@
 namespace flexfit {
 namespace {
 
-// f_i = m_i g - gamma v_i [- k_a (x_i - rest_i) - b_a v_i]
-void initialiseForces(const PartModel& model, const SimulationSettings& s, PartState& state) {
-    const std::size_t n = model.massCount();
-    const Vec3* x = state.positions.data();
-    const Vec3* v = state.velocities.data();
-    const Vec3* rest = model.restPositions.data();
-    const double* m = model.mass.data();
-    Vec3* f = state.forces.data();
+// Per-step constants of the mass update, resolved once from the settings.
+struct MassUpdate {
+    double h, invH;
+    Vec3 gravity;
+    double drag;             // gamma (+ b_a with anchor springs)
+    double anchorStiffness;  // k_a, 0 unless anchor springs
+    double constraint;       // restoration constraint fraction, 0 unless the constraint method
+    bool semiImplicit;
+};
+
+MassUpdate resolveMassUpdate(const SimulationSettings& s) {
     const bool anchors = s.restoration.method == RestorationMethod::AnchorSprings;
-    const double ka = anchors ? s.restoration.anchorStiffness : 0.0;
-    const double drag = s.globalDamping + (anchors ? s.restoration.anchorDamping : 0.0);
-    for (std::size_t i = 0; i < n; ++i) f[i] = m[i] * s.gravity - drag * v[i] - ka * (x[i] - rest[i]);
+    const bool constraint = s.restoration.method == RestorationMethod::Constraint;
+    return {s.timeStep,
+            1.0 / s.timeStep,
+            s.gravity,
+            s.globalDamping + (anchors ? s.restoration.anchorDamping : 0.0),
+            anchors ? s.restoration.anchorStiffness : 0.0,
+            constraint ? s.restoration.constraintFraction : 0.0,
+            s.integrator == Integrator::SemiImplicitEuler};
 }
 
-void applyLoads(std::span<const PointLoad> loads, PartState& state) {
-    for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
-}
-
-// g_ij = -(k (|d| - L) + b (v_i - v_j).u) u, added to i and subtracted from j.
-void accumulateSpringForces(const PartModel& model, PartState& state) {
-    const std::size_t springs = model.springCount();
-    const Index* a = model.springA.data();
-    const Index* b = model.springB.data();
-    const double* rest = model.restLength.data();
+// The whole step is one pass over the masses in index order. Springs are sorted by their first
+// (smaller) mass a, so visiting mass a evaluates springs (a, b > a): g goes to a in a register
+// and to f[b] in memory. When the pass reaches a mass, every spring touching it has been
+// evaluated (those with a smaller first mass earlier, its own now) and nothing later reads its
+// position or velocity, so it is integrated at once. One sweep over memory, no scratch arrays.
+//
+// f_a = (pending external force) + sum_j g_aj + m_a g - drag v_a - k_a (x_a - rest_a)
+// g_ab = -(k (|d| - L) + b (v_a - v_b).u) u,  d = x_a - x_b, u = d/|d|
+void sweep(const PartModel& model, const MassUpdate& p, PartState& state) {
+    const std::size_t masses = model.massCount();
+    const Index* springAdr = model.springAdr.data();
+    const Index* springB = model.springB.data();
+    const double* restLength = model.restLength.data();
     const double* k = model.stiffness.data();
     const double* c = model.damping.data();
-    const Vec3* x = state.positions.data();
-    const Vec3* v = state.velocities.data();
-    Vec3* f = state.forces.data();
-    for (std::size_t e = 0; e < springs; ++e) {
-        const Index i = a[e], j = b[e];
-        const Vec3 d = x[i] - x[j];
-        const double length = d.norm();
-        if (!(length > 0.0)) continue;  // coincident masses: no direction, no force
-        const Vec3 u = d / length;
-        const double magnitude = k[e] * (length - rest[e]) + c[e] * (v[i] - v[j]).dot(u);
-        const Vec3 g = magnitude * u;
-        f[i] -= g;
-        f[j] += g;
-    }
-}
-
-void integrate(const PartModel& model, const SimulationSettings& s, PartState& state) {
-    const std::size_t n = model.massCount();
-    const double h = s.timeStep;
+    const double* mass = model.mass.data();
     const double* invMass = model.inverseMass.data();
-    const Vec3* f = state.forces.data();
-    Vec3* x = state.positions.data();
-    Vec3* v = state.velocities.data();
-    if (s.integrator == Integrator::SemiImplicitEuler) {
-        for (std::size_t i = 0; i < n; ++i) {
-            v[i] += (h * invMass[i]) * f[i];
-            x[i] += h * v[i];
-        }
-    } else {
-        for (std::size_t i = 0; i < n; ++i) {
-            x[i] += h * v[i];
-            v[i] += (h * invMass[i]) * f[i];
-        }
-    }
-}
-
-// Moves each mass a fraction of the way back to its rest position; the velocity takes the
-// correction so that it is not undone next step (position-based dynamics).
-void applyRestorationConstraint(const PartModel& model, const SimulationSettings& s, PartState& state) {
-    const std::size_t n = model.massCount();
-    const double c = s.restoration.constraintFraction, invH = 1.0 / s.timeStep;
     const Vec3* rest = model.restPositions.data();
-    Vec3* x = state.positions.data();
-    Vec3* v = state.velocities.data();
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec3 correction = c * (rest[i] - x[i]);
-        x[i] += correction;
-        v[i] += invH * correction;
+    Vec3* __restrict x = state.positions.data();
+    Vec3* __restrict v = state.velocities.data();
+    Vec3* __restrict f = state.forces.data();
+    for (std::size_t a = 0; a < masses; ++a) {
+        const Vec3 xa = x[a], va = v[a];
+        Vec3 fa = f[a] + mass[a] * p.gravity - p.drag * va - p.anchorStiffness * (xa - rest[a]);
+        for (Index e = springAdr[a]; e < springAdr[a + 1]; ++e) {
+            const Index b = springB[e];
+            const Vec3 d = xa - x[b];
+            const double length = d.norm();
+            const double inverse = length > 0.0 ? 1.0 / length : 0.0;  // coincident masses: no force
+            const double magnitude = k[e] * (length - restLength[e]) + c[e] * (va - v[b]).dot(d) * inverse;
+            const Vec3 g = (magnitude * inverse) * d;
+            fa -= g;
+            f[b] += g;
+        }
+        f[a] = Vec3::Zero();  // consumed: the next step starts with no pending force
+        Vec3 xNew, vNew;
+        if (p.semiImplicit) {
+            vNew = va + (p.h * invMass[a]) * fa;
+            xNew = xa + p.h * vNew;
+        } else {
+            xNew = xa + p.h * va;
+            vNew = va + (p.h * invMass[a]) * fa;
+        }
+        if (p.constraint > 0.0) {
+            // Position-based restoration: move a fraction back; the velocity takes the correction.
+            const Vec3 correction = p.constraint * (rest[a] - xNew);
+            xNew += correction;
+            vNew += p.invH * correction;
+        }
+        x[a] = xNew;
+        v[a] = vNew;
     }
 }
 
@@ -103,11 +102,8 @@ void validateSettings(const SimulationSettings& s) {
 
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
                    PartState& state, StepCounters* counters) {
-    initialiseForces(model, settings, state);
-    applyLoads(loads, state);
-    accumulateSpringForces(model, state);
-    integrate(model, settings, state);
-    if (settings.restoration.method == RestorationMethod::Constraint) applyRestorationConstraint(model, settings, state);
+    for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
+    sweep(model, resolveMassUpdate(settings), state);
     state.time += settings.timeStep;
     ++state.stepCount;
     if (counters != nullptr) {

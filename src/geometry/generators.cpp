@@ -10,6 +10,8 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
+bool positiveFinite(double x) { return std::isfinite(x) && x > 0.0; }
+
 void require(bool ok, const char* what) {
     if (!ok) throw InputError("generator", 0, what);
 }
@@ -67,7 +69,8 @@ double heartRadius(const Vec3& dir) {
 }  // namespace
 
 TriMesh makeTorus(double majorRadius, double minorRadius, int segmentsU, int segmentsV) {
-    require(minorRadius > 0 && majorRadius > minorRadius, "torus needs major radius > minor radius > 0");
+    require(positiveFinite(minorRadius) && positiveFinite(majorRadius) && majorRadius > minorRadius,
+            "torus needs finite radii with major > minor > 0");
     require(segmentsU >= 3 && segmentsV >= 3, "torus needs at least 3 x 3 segments");
     TriMesh mesh;
     mesh.name = "torus";
@@ -86,7 +89,7 @@ TriMesh makeTorus(double majorRadius, double minorRadius, int segmentsU, int seg
 }
 
 TriMesh makeUvSphere(double radius, int segments, int rings) {
-    require(radius > 0, "sphere needs radius > 0");
+    require(positiveFinite(radius), "sphere needs a finite radius > 0");
     require(segments >= 3 && rings >= 2, "sphere needs segments >= 3 and rings >= 2");
     TriMesh mesh = makePolarGrid(segments, rings, [&](double t, double p) { return Vec3(radius * unitDirection(t, p)); });
     mesh.name = "sphere";
@@ -94,7 +97,7 @@ TriMesh makeUvSphere(double radius, int segments, int rings) {
 }
 
 TriMesh makeIcoSphere(double radius, int subdivisions) {
-    require(radius > 0, "icosphere needs radius > 0");
+    require(positiveFinite(radius), "icosphere needs a finite radius > 0");
     require(subdivisions >= 0 && subdivisions <= 8, "icosphere needs 0 <= subdivisions <= 8");
     const double t = (1.0 + std::sqrt(5.0)) / 2.0;
     TriMesh mesh;
@@ -125,7 +128,7 @@ TriMesh makeIcoSphere(double radius, int subdivisions) {
 }
 
 TriMesh makeHeart(double size, int segments, int rings) {
-    require(size > 0, "heart needs size > 0");
+    require(positiveFinite(size), "heart needs a finite size > 0");
     require(segments >= 3 && rings >= 2, "heart needs segments >= 3 and rings >= 2");
     // The implicit heart spans y in about [-1, 1.1]; centre it and scale its height to `size`.
     TriMesh unit = makePolarGrid(segments, rings, [](double t, double p) {

@@ -41,13 +41,16 @@ void checkFaceIndices(const TriMesh& mesh, const std::string& source, const Mesh
 }
 
 void checkFaceAreas(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
-    const double diagonal = boundingBox(mesh).diagonal().norm();
-    const double minDoubleArea = 2e-12 * diagonal * diagonal;
+    // Edges are scaled by the bounding-box diagonal first, so the test is relative and neither
+    // underflows for tiny meshes nor overflows for huge ones.
+    const double diagonal = boundingBox(mesh).diagonal().stableNorm();  // no over/underflow
+    const double scale = diagonal > 0.0 ? 1.0 / diagonal : 1.0;
     for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
         const Face& face = mesh.faces[f];
         const Vec3& a = mesh.vertices[face[0]];
-        const double doubleArea = (mesh.vertices[face[1]] - a).cross(mesh.vertices[face[2]] - a).norm();
-        if (!(doubleArea > minDoubleArea))
+        const Vec3 ab = (mesh.vertices[face[1]] - a) * scale, ac = (mesh.vertices[face[2]] - a) * scale;
+        const double relativeDoubleArea = ab.cross(ac).norm();
+        if (!(relativeDoubleArea > 2e-12))
             throw InputError(source, lineOf(lines.faceLine, f), faceText(f, face) + " is degenerate: zero area");
     }
 }
@@ -126,12 +129,15 @@ MeshDiagnostics validateMesh(const TriMesh& mesh, const std::string& source, con
 }
 
 std::size_t weldVertices(TriMesh& mesh, double tolerance) {
-    // Hash grid with cells of the tolerance's size; each vertex is compared with the
-    // representatives in the 27 surrounding cells. Exact mode hashes the coordinates' bits.
+    // Hash grid with cells of the tolerance's size; each vertex is compared with the kept
+    // vertices in the 27 surrounding cells and joins the first one found within the tolerance.
+    // Exact mode compares coordinates with == (so 0.0 and -0.0 are the same position).
     const double cell = tolerance > 0 ? tolerance : 1.0;
     struct CellHash {
         std::size_t operator()(const std::array<std::int64_t, 3>& c) const {
-            return std::size_t(c[0] * 73856093) ^ std::size_t(c[1] * 19349663) ^ std::size_t(c[2] * 83492791);
+            // Unsigned arithmetic: wraps instead of overflowing for far-away cells.
+            return std::size_t(std::uint64_t(c[0]) * 73856093u) ^ std::size_t(std::uint64_t(c[1]) * 19349663u) ^
+                   std::size_t(std::uint64_t(c[2]) * 83492791u);
         }
     };
     std::unordered_map<std::array<std::int64_t, 3>, std::vector<Index>, CellHash> grid;

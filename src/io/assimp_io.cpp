@@ -11,9 +11,11 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include <algorithm>
+#include <charconv>
 #include <cctype>
+#include <cmath>
 #include <fstream>
+#include <limits>
 
 namespace flexfit {
 namespace {
@@ -46,10 +48,15 @@ void appendNode(const aiScene& scene, const aiNode& node, const Eigen::Matrix4d&
     for (unsigned i = 0; i < node.mNumChildren; ++i) appendNode(scene, *node.mChildren[i], world, file, out);
 }
 
-bool isNonFiniteToken(std::string token) {
-    std::transform(token.begin(), token.end(), token.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (!token.empty() && (token[0] == '-' || token[0] == '+')) token.erase(0, 1);
-    return token.rfind("nan", 0) == 0 || token.rfind("inf", 0) == 0 || token.rfind("1.#", 0) == 0;
+// A whole token that is a number assimp cannot hold: NaN, infinity, or beyond float range
+// (assimp stores coordinates as 32-bit floats). Words that merely start with "inf" do not count.
+bool isNonFiniteToken(const std::string& token) {
+    double value = 0.0;
+    const char* begin = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
+    const auto [end, ec] = std::from_chars(begin, token.data() + token.size(), value);
+    if (end != token.data() + token.size()) return false;
+    if (ec == std::errc::result_out_of_range) return true;
+    return ec == std::errc() && !(std::abs(value) <= double(std::numeric_limits<float>::max()));
 }
 
 // First line of a text file holding a NaN/Inf token; 0 when none (binary files, or none found).

@@ -30,6 +30,9 @@ MeshReadResult readMesh(const std::filesystem::path& path, const MeshReadOptions
         result.collapsedFaces = weldVertices(result.mesh, options.weldTolerance);
         result.weldedVertices = before - result.mesh.vertices.size();
         result.diagnostics = validateMesh(result.mesh, path.string());
+        if (result.collapsedFaces > 0)
+            result.diagnostics.warnings.push_back(std::to_string(result.collapsedFaces) +
+                                                  " faces collapsed by welding and were removed");
     }
     return result;
 }

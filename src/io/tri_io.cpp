@@ -189,6 +189,10 @@ MeshReadResult parseTri(std::string_view text, const std::string& source) {
 }
 
 MeshReadResult readTri(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw InputError(path.string(), 0, std::filesystem::exists(path, ec) ? "not a regular file"
+                                                                               : "cannot open the file for reading: it does not exist");
     std::ifstream file(path, std::ios::binary);
     if (!file) throw InputError(path.string(), 0, "cannot open the file for reading");
     std::ostringstream buffer;

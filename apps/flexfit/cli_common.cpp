@@ -1,0 +1,87 @@
+#include "cli_common.hpp"
+
+#include <fmt/core.h>
+
+#include <charconv>
+#include <cstdlib>
+#include <fstream>
+
+namespace flexfit::cli {
+namespace {
+
+double parseNumber(std::string_view token, const std::string& option, const std::string& whole) {
+    double value = 0.0;
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+    if (ec != std::errc() || end != token.data() + token.size() || !std::isfinite(value))
+        throw InputError("option " + option, 0, "'" + whole + "' is not a finite number list (x,y,z)");
+    return value;
+}
+
+std::filesystem::path toolsDirectory() {
+    for (const std::filesystem::path dir : {FLEXFIT_TOOLS_DIR, FLEXFIT_INSTALLED_TOOLS_DIR})
+        if (std::filesystem::exists(dir)) return dir;
+    return FLEXFIT_TOOLS_DIR;
+}
+
+std::string shellQuote(const std::string& s) {
+    std::string out = "'";
+    for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+}  // namespace
+
+Vec3 parseVec3(const std::string& text, const std::string& option) {
+    const std::size_t c1 = text.find(','), c2 = c1 == std::string::npos ? c1 : text.find(',', c1 + 1);
+    if (c1 == std::string::npos || c2 == std::string::npos || text.find(',', c2 + 1) != std::string::npos)
+        throw InputError("option " + option, 0, "'" + text + "' is not three comma-separated numbers (x,y,z)");
+    std::string_view view(text);
+    return {parseNumber(view.substr(0, c1), option, text), parseNumber(view.substr(c1 + 1, c2 - c1 - 1), option, text),
+            parseNumber(view.substr(c2 + 1), option, text)};
+}
+
+PointLoad parseLoad(const std::string& text, const std::string& option) {
+    const std::size_t colon = text.find(':');
+    if (colon == std::string::npos) throw InputError("option " + option, 0, "'" + text + "' is not MASS:FX,FY,FZ");
+    unsigned long mass = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + colon, mass);
+    if (ec != std::errc() || end != text.data() + colon)
+        throw InputError("option " + option, 0, "'" + text + "': mass index is not a non-negative integer");
+    return {Index(mass), parseVec3(text.substr(colon + 1), option)};
+}
+
+MeshReadResult loadMesh(const std::filesystem::path& path, double weldTolerance) {
+    MeshReadResult result = readMesh(path, MeshReadOptions{weldTolerance});
+    for (const std::string& warning : result.diagnostics.warnings) fmt::print(stderr, "warning: {}: {}\n", path.string(), warning);
+    return result;
+}
+
+void writeTextFile(const std::filesystem::path& path, const std::string& text) {
+    std::ofstream file(path, std::ios::binary);
+    if (!file) throw InputError(path.string(), 0, "cannot open the file for writing");
+    file << text;
+    if (!file) throw InputError(path.string(), 0, "write failed");
+}
+
+void makeDirectory(const std::filesystem::path& dir) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec || !std::filesystem::is_directory(dir)) throw InputError(dir.string(), 0, "cannot create the directory: " + ec.message());
+}
+
+bool runPlotScript(const std::string& script, const std::vector<std::string>& args) {
+    const char* python = "/usr/bin/python3";
+    if (!std::filesystem::exists(python)) {
+        fmt::print(stderr, "warning: {} not found: plots skipped (CSV results are complete)\n", python);
+        return false;
+    }
+    std::string command = std::string(python) + " " + shellQuote((toolsDirectory() / script).string());
+    for (const std::string& a : args) command += " " + shellQuote(a);
+    if (std::system(command.c_str()) != 0) {
+        fmt::print(stderr, "warning: {} failed (is python3-matplotlib installed?): plots skipped\n", script);
+        return false;
+    }
+    return true;
+}
+
+}  // namespace flexfit::cli

@@ -1,0 +1,30 @@
+// Helpers shared by the subcommands: parsing of vector and load arguments, loading meshes with
+// their warnings printed, writing text files, and running the plot scripts.
+#pragma once
+
+#include "flexfit/flexfit.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace flexfit::cli {
+
+// "x,y,z" -> Vec3; throws InputError naming `option`.
+Vec3 parseVec3(const std::string& text, const std::string& option);
+// "MASS:FX,FY,FZ" -> PointLoad; throws InputError naming `option`.
+PointLoad parseLoad(const std::string& text, const std::string& option);
+
+// Reads any supported mesh and prints its warnings to stderr.
+MeshReadResult loadMesh(const std::filesystem::path& path, double weldTolerance = 0.0);
+
+// Writes `text` to `path`; throws InputError when it cannot.
+void writeTextFile(const std::filesystem::path& path, const std::string& text);
+// Creates the directory (and parents); throws InputError when it cannot.
+void makeDirectory(const std::filesystem::path& dir);
+
+// Runs tools/<script> with Debian's /usr/bin/python3 (matplotlib); returns false (after a
+// warning) when Python or matplotlib is missing, so the CSV results still stand.
+bool runPlotScript(const std::string& script, const std::vector<std::string>& args);
+
+}  // namespace flexfit::cli

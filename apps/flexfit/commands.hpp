@@ -1,0 +1,16 @@
+// The `flexfit` command's subcommands. Each registers its options on the CLI11 app and runs
+// through a callback; errors in user input surface as flexfit::InputError and are printed by
+// main() with the file, line and problem.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace flexfit::cli {
+
+void registerInfo(CLI::App& app);
+void registerConvert(CLI::App& app);
+void registerGen(CLI::App& app);
+void registerSimulate(CLI::App& app);
+void registerExperimentRestoration(CLI::App& experiment);
+
+}  // namespace flexfit::cli

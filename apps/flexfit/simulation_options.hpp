@@ -1,0 +1,34 @@
+// Command-line options that build a PartModel and SimulationSettings (shared by subcommands).
+#pragma once
+
+#include "flexfit/flexfit.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <memory>
+#include <string>
+
+namespace flexfit::cli {
+
+struct SimulationOptions {
+    std::string material = "elastic";
+    double stiffness = -1.0, damping = -1.0;  // < 0: the material's
+    double vertexMass = 1.0;
+    std::string restore = "constraint";
+    double anchorStiffness = -1.0, anchorDamping = -1.0;  // < 0: the material's k and b
+    double constraintFraction = 0.05;
+    std::string integrator = "semi-implicit";
+    double timeStep = 1e-3;
+    std::string gravity = "0,0,0";
+    double globalDamping = 0.0;
+    bool allowUnstable = false;
+
+    void addTo(CLI::App& cmd);
+    Material resolvedMaterial() const;
+    PartModelSettings modelSettings() const;
+    // Validated settings; prints a stability warning or throws InputError when the step is
+    // certain to diverge (unless allowUnstable).
+    SimulationSettings simulationSettings(const PartModel& model) const;
+};
+
+}  // namespace flexfit::cli

@@ -1,0 +1,11 @@
+# Runs EXE with ARGS (a ;-list) and checks: exit status 2, stderr matching REGEX, nothing on stdout.
+execute_process(COMMAND ${EXE} ${ARGS} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT status EQUAL 2)
+  message(FATAL_ERROR "expected exit status 2, got '${status}'\nstdout: ${out}\nstderr: ${err}")
+endif()
+if(NOT err MATCHES "${REGEX}")
+  message(FATAL_ERROR "stderr does not match '${REGEX}':\n${err}")
+endif()
+if(NOT out STREQUAL "")
+  message(FATAL_ERROR "expected no output on stdout, got:\n${out}")
+endif()

@@ -1,0 +1,530 @@
+// Tests readMesh through assimp (OBJ, STL, PLY, OFF, glTF 2.0) on small hand-written files, against hand-counted vertices/faces/edges after welding, the OBJ writer's round trip and the error contract.
+#include "flexfit/generators.hpp"
+#include "flexfit/mesh_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace flexfit {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A unique directory in the system temp directory, removed with its contents at scope exit.
+class TempDir {
+public:
+    TempDir() {
+        static int counter = 0;
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        path_ = fs::temp_directory_path() / ("flexfit_assimp_io_test_" + std::to_string(::getpid()) + "_" +
+                                             (info ? std::string(info->name()) : "x") + "_" + std::to_string(counter++));
+        fs::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+
+    fs::path write(const std::string& name, const std::string& content) const {
+        const fs::path file = path_ / name;
+        std::ofstream out(file, std::ios::binary);
+        out << content;
+        return file;
+    }
+    const fs::path& path() const { return path_; }
+
+private:
+    fs::path path_;
+};
+
+// Rounds each coordinate to the nearest float. Written per scalar: GCC 12 at -O2 was seen to drop
+// the rounding in `v.cast<float>().cast<double>()` inside a loop over Eigen vectors.
+Vec3 toFloatPrecision(const Vec3& v) {
+    volatile float x = float(v.x()), y = float(v.y()), z = float(v.z());
+    return Vec3(double(x), double(y), double(z));
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+double signedVolume(const TriMesh& mesh) {
+    double sum = 0.0;
+    for (const Face& f : mesh.faces) sum += mesh.vertices[f[0]].dot(mesh.vertices[f[1]].cross(mesh.vertices[f[2]]));
+    return sum / 6.0;
+}
+
+// Expects readMesh to throw InputError naming the file; returns it.
+InputError expectReadError(const fs::path& file, const MeshReadOptions& options = {}) {
+    try {
+        readMesh(file, options);
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.source(), file.string());
+        return e;
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "not an InputError: " << e.what();
+        return InputError("none", 0, "none");
+    }
+    ADD_FAILURE() << "accepted " << file;
+    return InputError("none", 0, "none");
+}
+
+// Unit cube, outward counter-clockwise quads (1-based OBJ indices).
+const std::string kCubeVertices =
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
+const std::string kObjCubeQuads = "# cube\no cube\n" + kCubeVertices +
+                                  "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+const std::string kObjCubeTriangles = "o cube\n" + kCubeVertices +
+                                      "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n"
+                                      "f 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n";
+
+// Tetrahedron (0,0,0) (1,0,0) (0,1,0) (0,0,1), outward faces (0 2 1) (0 1 3) (0 3 2) (1 2 3).
+const double kTetVertices[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+const int kTetFaces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+
+// ASCII STL of the tetrahedron: one vertex per face corner (12). `perturb` moves the second and
+// third copies of each corner by that much (along x and y).
+std::string stlTetrahedron(double perturb = 0.0, double scale = 1.0) {
+    std::string out = "solid tet\n";
+    std::map<int, int> seen;
+    char buffer[160];
+    for (const auto& face : kTetFaces) {
+        out += "  facet normal 0 0 0\n    outer loop\n";
+        for (int corner : face) {
+            const int copy = seen[corner]++;
+            double p[3] = {scale * kTetVertices[corner][0], scale * kTetVertices[corner][1], scale * kTetVertices[corner][2]};
+            if (copy == 1) p[0] += perturb;
+            if (copy == 2) p[1] += perturb;
+            std::snprintf(buffer, sizeof buffer, "      vertex %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+            out += buffer;
+        }
+        out += "    endloop\n  endfacet\n";
+    }
+    return out + "endsolid tet\n";
+}
+
+std::string base64(const std::vector<std::uint8_t>& bytes) {
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (std::size_t i = 0; i < bytes.size(); i += 3) {
+        const std::uint32_t b0 = bytes[i], b1 = i + 1 < bytes.size() ? bytes[i + 1] : 0,
+                            b2 = i + 2 < bytes.size() ? bytes[i + 2] : 0;
+        const std::uint32_t n = (b0 << 16) | (b1 << 8) | b2;
+        out += table[(n >> 18) & 63];
+        out += table[(n >> 12) & 63];
+        out += i + 1 < bytes.size() ? table[(n >> 6) & 63] : '=';
+        out += i + 2 < bytes.size() ? table[n & 63] : '=';
+    }
+    return out;
+}
+
+TEST(Base64, KnownVectors) {
+    EXPECT_EQ(base64({}), "");
+    EXPECT_EQ(base64({'f'}), "Zg==");
+    EXPECT_EQ(base64({'f', 'o'}), "Zm8=");
+    EXPECT_EQ(base64({'f', 'o', 'o'}), "Zm9v");
+    EXPECT_EQ(base64({'f', 'o', 'o', 'b', 'a', 'r'}), "Zm9vYmFy");
+}
+
+// A minimal glTF 2.0 file of the tetrahedron: float positions and unsigned short indices in one
+// buffer embedded as a base64 data: URI.
+std::string gltfTetrahedron() {
+    std::vector<std::uint8_t> bytes;
+    auto append = [&](const void* data, std::size_t size) {
+        const auto* p = static_cast<const std::uint8_t*>(data);
+        bytes.insert(bytes.end(), p, p + size);  // little-endian host, as glTF requires
+    };
+    for (const auto& v : kTetVertices)
+        for (double c : v) {
+            const float f = float(c);
+            append(&f, sizeof f);
+        }
+    for (const auto& face : kTetFaces)
+        for (int i : face) {
+            const std::uint16_t s = std::uint16_t(i);
+            append(&s, sizeof s);
+        }
+    EXPECT_EQ(bytes.size(), 72u);
+    return R"({
+  "asset": {"version": "2.0", "generator": "flexfit test"},
+  "scene": 0,
+  "scenes": [{"nodes": [0]}],
+  "nodes": [{"mesh": 0, "name": "tet"}],
+  "meshes": [{"name": "tet", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": 4}]}],
+  "buffers": [{"byteLength": 72, "uri": "data:application/octet-stream;base64,)" +
+           base64(bytes) + R"("}],
+  "bufferViews": [
+    {"buffer": 0, "byteOffset": 0, "byteLength": 48, "target": 34962},
+    {"buffer": 0, "byteOffset": 48, "byteLength": 24, "target": 34963}
+  ],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+    {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"}
+  ]
+}
+)";
+}
+
+void expectTetrahedronResult(const MeshReadResult& r) {
+    EXPECT_EQ(r.mesh.vertices.size(), 4u);
+    EXPECT_EQ(r.mesh.faces.size(), 4u);
+    EXPECT_EQ(r.diagnostics.edgeCount, 6u);
+    EXPECT_TRUE(r.diagnostics.closed());
+    EXPECT_TRUE(r.diagnostics.warnings.empty());
+    EXPECT_NEAR(signedVolume(r.mesh), 1.0 / 6.0, 1e-12);
+    // Each input corner position is present.
+    for (const auto& v : kTetVertices) {
+        bool found = false;
+        for (const Vec3& p : r.mesh.vertices) found = found || p == Vec3(v[0], v[1], v[2]);
+        EXPECT_TRUE(found) << v[0] << " " << v[1] << " " << v[2];
+    }
+}
+
+void expectCubeResult(const MeshReadResult& r) {
+    EXPECT_EQ(r.mesh.vertices.size(), 8u);
+    EXPECT_EQ(r.mesh.faces.size(), 12u);
+    EXPECT_EQ(r.diagnostics.edgeCount, 18u);
+    EXPECT_TRUE(r.diagnostics.closed());
+    EXPECT_TRUE(r.diagnostics.warnings.empty());
+    EXPECT_EQ(r.collapsedFaces, 0u);
+    EXPECT_NEAR(signedVolume(r.mesh), 1.0, 1e-12);  // outward orientation preserved
+    const Eigen::AlignedBox3d box = boundingBox(r.mesh);
+    EXPECT_EQ(box.min(), Vec3(0, 0, 0));
+    EXPECT_EQ(box.max(), Vec3(1, 1, 1));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Formats
+
+TEST(AssimpIo, ObjCubeOfQuadsIsTriangulated) {
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("cube.obj", kObjCubeQuads));
+    expectCubeResult(r);
+    EXPECT_EQ(r.mesh.name, "cube");  // the file's stem
+}
+
+TEST(AssimpIo, ObjCubeOfTriangles) {
+    TempDir dir;
+    expectCubeResult(readMesh(dir.write("cube.obj", kObjCubeTriangles)));
+}
+
+TEST(AssimpIo, AsciiStlTetrahedronIsWelded) {
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("tet.stl", stlTetrahedron()));
+    expectTetrahedronResult(r);
+    EXPECT_EQ(r.weldedVertices, 8u);  // 12 corners -> 4 vertices
+    EXPECT_EQ(r.collapsedFaces, 0u);
+}
+
+TEST(AssimpIo, BinaryStlTetrahedronIsWelded) {
+    std::string stl(80, ' ');
+    stl.replace(0, 9, "flexfit 1");  // a header that does not start with "solid"
+    auto append = [&](const void* data, std::size_t size) { stl.append(static_cast<const char*>(data), size); };
+    const std::uint32_t count = 4;
+    append(&count, sizeof count);
+    for (const auto& face : kTetFaces) {
+        const float normal[3] = {0, 0, 0};
+        append(normal, sizeof normal);
+        for (int corner : face) {
+            const float p[3] = {float(kTetVertices[corner][0]), float(kTetVertices[corner][1]), float(kTetVertices[corner][2])};
+            append(p, sizeof p);
+        }
+        const std::uint16_t attributes = 0;
+        append(&attributes, sizeof attributes);
+    }
+    ASSERT_EQ(stl.size(), 84u + 4 * 50);
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("tet_binary.stl", stl));
+    expectTetrahedronResult(r);
+    EXPECT_EQ(r.weldedVertices, 8u);
+}
+
+TEST(AssimpIo, AsciiPly) {
+    TempDir dir;
+    std::string ply =
+        "ply\nformat ascii 1.0\ncomment tetrahedron\nelement vertex 4\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        "element face 4\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const auto& v : kTetVertices) ply += std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) + "\n";
+    for (const auto& f : kTetFaces) ply += "3 " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) + "\n";
+    expectTetrahedronResult(readMesh(dir.write("tet.ply", ply)));
+}
+
+TEST(AssimpIo, AsciiPlyCubeOfQuads) {
+    TempDir dir;
+    const std::string ply =
+        "ply\nformat ascii 1.0\nelement vertex 8\nproperty double x\nproperty double y\nproperty double z\n"
+        "element face 6\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+        "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 3 7 6 2\n4 0 4 7 3\n4 1 2 6 5\n";
+    expectCubeResult(readMesh(dir.write("cube.ply", ply)));
+}
+
+TEST(AssimpIo, Off) {
+    TempDir dir;
+    const std::string off =
+        "OFF\n8 6 12\n"
+        "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+        "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 3 7 6 2\n4 0 4 7 3\n4 1 2 6 5\n";
+    expectCubeResult(readMesh(dir.write("cube.off", off)));
+}
+
+TEST(AssimpIo, OffTetrahedron) {
+    TempDir dir;
+    std::string off = "OFF\n4 4 6\n";
+    for (const auto& v : kTetVertices) off += std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) + "\n";
+    for (const auto& f : kTetFaces) off += "3 " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) + "\n";
+    expectTetrahedronResult(readMesh(dir.write("tet.off", off)));
+}
+
+TEST(AssimpIo, GltfWithEmbeddedBuffer) {
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("tet.gltf", gltfTetrahedron()));
+    expectTetrahedronResult(r);
+}
+
+TEST(AssimpIo, ExtensionIsCaseInsensitive) {
+    TempDir dir;
+    expectCubeResult(readMesh(dir.write("CUBE.OBJ", kObjCubeQuads)));
+}
+
+// ---------------------------------------------------------------------------------------------
+// OBJ round trip through writeObj
+
+// Matches every read vertex to an original one within `tolerance` (a bijection), then checks the
+// faces are the same faces in the same order with the same winding.
+void expectSameMeshUpToVertexOrder(const TriMesh& original, const TriMesh& read, double tolerance) {
+    ASSERT_EQ(read.vertices.size(), original.vertices.size());
+    ASSERT_EQ(read.faces.size(), original.faces.size());
+    // OBJ stores the faces in order; the importer may renumber vertices (one per face corner,
+    // then welded in first-use order), so map through the faces.
+    std::vector<Index> toOriginal(read.vertices.size(), Index(-1));
+    for (std::size_t f = 0; f < read.faces.size(); ++f)
+        for (int k = 0; k < 3; ++k) {
+            const Index r = read.faces[f][k], o = original.faces[f][k];
+            if (toOriginal[r] == Index(-1)) toOriginal[r] = o;
+            ASSERT_EQ(toOriginal[r], o) << "face " << f << " corner " << k;
+        }
+    std::vector<int> hits(original.vertices.size(), 0);
+    double worst = 0.0;
+    for (std::size_t v = 0; v < read.vertices.size(); ++v) {
+        ASSERT_NE(toOriginal[v], Index(-1));
+        ++hits[toOriginal[v]];
+        worst = std::max(worst, (read.vertices[v] - original.vertices[toOriginal[v]]).cwiseAbs().maxCoeff());
+    }
+    for (int h : hits) EXPECT_EQ(h, 1);
+    EXPECT_LE(worst, tolerance);
+}
+
+TEST(AssimpIo, ObjRoundTripOfFloatRepresentableMesh) {
+    // assimp is built with single-precision ai_real here, so coordinates that are exact floats
+    // survive exactly; the round trip then matches to 1e-12.
+    TriMesh mesh = makeTorus1();
+    for (Vec3& v : mesh.vertices) v = toFloatPrecision(v);
+    TempDir dir;
+    const fs::path file = dir.path() / "torus.obj";
+    writeObj(mesh, file);
+    const MeshReadResult r = readMesh(file);
+    expectSameMeshUpToVertexOrder(mesh, r.mesh, 1e-12);
+    EXPECT_TRUE(r.diagnostics.closed());
+    EXPECT_EQ(r.diagnostics.edgeCount, 1728u);
+}
+
+TEST(AssimpIo, ObjRoundTripOfDoubleMesh) {
+    // writeObj writes 17 significant digits; assimp (ai_real = float in this build) reads them
+    // into floats, so a general double mesh comes back to float precision (relative 2^-24).
+    for (const TriMesh& mesh : {makeTorus1(), makeIcoSphere(3.0, 2), makeHeart(20.0, 24, 12)}) {
+        SCOPED_TRACE(mesh.name);
+        TempDir dir;
+        const fs::path file = dir.path() / "mesh.obj";
+        writeObj(mesh, file);
+        const MeshReadResult r = readMesh(file);
+        const double extent = boundingBox(mesh).sizes().maxCoeff();
+        const double tolerance = extent * 0x1p-23;
+        expectSameMeshUpToVertexOrder(mesh, r.mesh, tolerance);
+        EXPECT_TRUE(r.diagnostics.closed());
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors
+
+TEST(AssimpIo, ObjWithOnlyLineElementsIsRejected) {
+    TempDir dir;
+    const InputError e = expectReadError(dir.write("line.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n"));
+    EXPECT_TRUE(contains(e.problem(), "cannot be triangulated")) << e.problem();
+}
+
+TEST(AssimpIo, ObjMixingTrianglesAndLinesIsRejected) {
+    TempDir dir;
+    const InputError e = expectReadError(dir.write("mixed.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nl 1 2\n"));
+    EXPECT_TRUE(contains(e.problem(), "cannot be triangulated")) << e.problem();
+}
+
+TEST(AssimpIo, ObjWithOnlyPointsIsRejected) {
+    TempDir dir;
+    const InputError e = expectReadError(dir.write("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\np 1 2 3\n"));
+    EXPECT_TRUE(contains(e.problem(), "cannot be triangulated")) << e.problem();
+}
+
+TEST(AssimpIo, ObjWithNaNCoordinateNamesTheLineOfTheVertex) {
+    TempDir dir;
+    const std::string obj = "o cube\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 nan 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                            "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+    const InputError e = expectReadError(dir.write("nan.obj", obj));
+    EXPECT_EQ(e.line(), 5u) << e.what();
+    EXPECT_TRUE(contains(e.problem(), "NaN or infinite")) << e.problem();
+}
+
+TEST(AssimpIo, StlWithNaNCoordinateNamesTheLineOfTheVertex) {
+    TempDir dir;
+    std::string stl = stlTetrahedron();
+    // Line 1 "solid tet", 2 "facet normal", 3 "outer loop", 4-6 the first facet's vertices.
+    const std::size_t at = stl.find("vertex 1 0 0");
+    ASSERT_NE(at, std::string::npos);
+    stl.replace(at, 12, "vertex 1 NaN 0");
+    const InputError e = expectReadError(dir.write("nan.stl", stl));
+    EXPECT_EQ(e.line(), 6u) << e.what();
+    EXPECT_TRUE(contains(e.problem(), "NaN or infinite")) << e.problem();
+}
+
+TEST(AssimpIo, ObjWithInfCoordinateNamesTheLineOfTheVertex) {
+    TempDir dir;
+    const InputError e = expectReadError(dir.write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 -inf 0\nf 1 2 3\n"));
+    EXPECT_EQ(e.line(), 3u) << e.what();
+}
+
+// The line reported must be that of the 'v' record, even when earlier lines hold words that
+// start with "nan"/"inf" (comments, object and material names).
+TEST(AssimpIo, ObjNaNLineIgnoresWordsInCommentsAndNames) {
+    TempDir dir;
+    const std::string obj = "# information: a triangle\no infinity_pool\nv 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n";
+    const InputError e = expectReadError(dir.write("words.obj", obj));
+    EXPECT_EQ(e.line(), 4u) << e.what();
+}
+
+TEST(AssimpIo, CoordinateBeyondSinglePrecision) {
+    // 1e39 is a finite double but a single-precision assimp (ai_real = float, as in Debian's
+    // build) reads it as infinity: the file is then rejected as holding a non-finite coordinate.
+    // A double-precision assimp reads it. Either way: no crash, no half-built mesh.
+    TempDir dir;
+    const fs::path file = dir.write("big.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n");
+    try {
+        const MeshReadResult r = readMesh(file);
+        ASSERT_EQ(r.mesh.vertices.size(), 3u);
+        EXPECT_EQ(boundingBox(r.mesh).max().x(), 1e39);
+    } catch (const InputError& e) {
+        EXPECT_TRUE(contains(e.problem(), "NaN or infinite")) << e.problem();
+    }
+}
+
+TEST(AssimpIo, NonexistentFile) {
+    const fs::path missing = fs::temp_directory_path() / "flexfit_assimp_io_test_no_such_file.obj";
+    const InputError e = expectReadError(missing);
+    EXPECT_TRUE(contains(e.problem(), "does not exist")) << e.problem();
+    expectReadError(fs::temp_directory_path() / "flexfit_assimp_io_test_no_such_file.stl");
+    expectReadError(fs::temp_directory_path() / "flexfit_assimp_io_test_no_such_file.gltf");
+}
+
+TEST(AssimpIo, GarbageFilesAreRejected) {
+    TempDir dir;
+    expectReadError(dir.write("garbage.obj", "this is not an obj file\n\x01\x02\x03"));
+    expectReadError(dir.write("empty.obj", ""));
+    expectReadError(dir.write("garbage.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [ {"));
+    expectReadError(dir.write("unknown.xyz123", "1 2 3\n"));
+}
+
+TEST(AssimpIo, TruncatedAsciiStlIsRejected) {
+#if defined(__SANITIZE_ADDRESS__)
+    // assimp 5.2.5's STL importer leaks ~2.4 kB when it throws on this input (inside
+    // libassimp, not Flexfit); LeakSanitizer would fail the whole binary.
+    GTEST_SKIP() << "assimp leaks on a truncated ASCII STL";
+#endif
+    TempDir dir;
+    expectReadError(dir.write("garbage.stl", "solid x\n  facet normal 0 0 0\n    outer loop\n      vertex 0 0\n"));
+}
+
+TEST(AssimpIo, DegenerateAndDuplicateFacesAreRejected) {
+    TempDir dir;
+    // Zero-area face.
+    EXPECT_TRUE(contains(expectReadError(dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n")).problem(),
+                         "zero area"));
+    // Duplicate faces (the same triangle twice, opposite winding).
+    EXPECT_TRUE(contains(expectReadError(dir.write("dup.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 3 2 1\n")).problem(),
+                         "duplicates"));
+}
+
+TEST(AssimpIo, NegativeOrNaNWeldToleranceIsRejected) {
+    TempDir dir;
+    const fs::path file = dir.write("tet.stl", stlTetrahedron());
+    expectReadError(file, MeshReadOptions{-1e-6});
+    expectReadError(file, MeshReadOptions{std::nan("")});
+    expectReadError(file, MeshReadOptions{INFINITY});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Weld tolerance
+
+TEST(AssimpIo, WeldTolerance) {
+    TempDir dir;
+    // Corners 0.5 apart with copies perturbed by 1e-7 (representable apart in float at this scale).
+    const fs::path file = dir.write("perturbed.stl", stlTetrahedron(1e-7, 0.5));
+
+    const MeshReadResult split = readMesh(file, MeshReadOptions{0.0});
+    EXPECT_EQ(split.mesh.vertices.size(), 12u);  // nothing identical: every corner its own vertex
+    EXPECT_EQ(split.mesh.faces.size(), 4u);
+    EXPECT_EQ(split.weldedVertices, 0u);
+    EXPECT_EQ(split.diagnostics.edgeCount, 12u);
+    EXPECT_EQ(split.diagnostics.boundaryEdges, 12u);
+    EXPECT_FALSE(split.diagnostics.closed());
+    ASSERT_FALSE(split.diagnostics.warnings.empty());
+    EXPECT_TRUE(contains(split.diagnostics.warnings[0], "12 boundary edges")) << split.diagnostics.warnings[0];
+
+    const MeshReadResult welded = readMesh(file, MeshReadOptions{1e-5});
+    EXPECT_EQ(welded.mesh.vertices.size(), 4u);
+    EXPECT_EQ(welded.weldedVertices, 8u);
+    EXPECT_EQ(welded.collapsedFaces, 0u);
+    EXPECT_EQ(welded.diagnostics.edgeCount, 6u);
+    EXPECT_TRUE(welded.diagnostics.closed());
+    EXPECT_TRUE(welded.diagnostics.warnings.empty());
+    // The first copy of each corner (unperturbed) is kept.
+    for (const auto& v : kTetVertices) {
+        bool found = false;
+        for (const Vec3& p : welded.mesh.vertices) found = found || p == 0.5 * Vec3(v[0], v[1], v[2]);
+        EXPECT_TRUE(found);
+    }
+}
+
+TEST(AssimpIo, WeldingThatCollapsesFacesIsCountedAndWarned) {
+    TempDir dir;
+    // The tetrahedron plus a sliver triangle whose two corners weld together at 1e-3.
+    std::string obj;
+    for (const auto& v : kTetVertices) obj += "v " + std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) + "\n";
+    obj += "v 0.0001 0 0\n";
+    for (const auto& f : kTetFaces) obj += "f " + std::to_string(f[0] + 1) + " " + std::to_string(f[1] + 1) + " " + std::to_string(f[2] + 1) + "\n";
+    obj += "f 1 5 3\n";
+    const fs::path file = dir.write("sliver.obj", obj);
+    const MeshReadResult unwelded = readMesh(file);
+    EXPECT_EQ(unwelded.mesh.vertices.size(), 5u);
+    EXPECT_EQ(unwelded.collapsedFaces, 0u);
+    const MeshReadResult r = readMesh(file, MeshReadOptions{1e-3});
+    EXPECT_EQ(r.mesh.vertices.size(), 4u);
+    EXPECT_EQ(r.mesh.faces.size(), 4u);
+    EXPECT_EQ(r.collapsedFaces, 1u);
+    EXPECT_TRUE(r.diagnostics.closed());
+    ASSERT_EQ(r.diagnostics.warnings.size(), 1u);
+    EXPECT_TRUE(contains(r.diagnostics.warnings[0], "1 faces collapsed")) << r.diagnostics.warnings[0];
+}
+
+}  // namespace
+}  // namespace flexfit

@@ -1,0 +1,280 @@
+// Tests the format dispatch of writeMesh/readMesh and readMesh's weld tolerance on .tri files, against meshes written and counted by hand.
+#include "flexfit/generators.hpp"
+#include "flexfit/mesh_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+
+namespace flexfit {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A unique directory in the system temp directory, removed with its contents at scope exit.
+class TempDir {
+public:
+    TempDir() {
+        static int counter = 0;
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        path_ = fs::temp_directory_path() / ("flexfit_mesh_io_test_" + std::to_string(::getpid()) + "_" +
+                                             (info ? std::string(info->name()) : "x") + "_" + std::to_string(counter++));
+        fs::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+
+    fs::path write(const std::string& name, const std::string& content) const {
+        const fs::path file = path_ / name;
+        std::ofstream out(file, std::ios::binary);
+        out << content;
+        return file;
+    }
+    const fs::path& path() const { return path_; }
+
+private:
+    fs::path path_;
+};
+
+std::string slurp(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    return buffer.str();
+}
+
+// Rounds each coordinate to the nearest float. Written per scalar: GCC 12 at -O2 was seen to drop
+// the rounding in `v.cast<float>().cast<double>()` inside a loop over Eigen vectors.
+Vec3 toFloatPrecision(const Vec3& v) {
+    volatile float x = float(v.x()), y = float(v.y()), z = float(v.z());
+    return Vec3(double(x), double(y), double(z));
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+bool bitIdentical(const TriMesh& a, const TriMesh& b) {
+    return a.vertices.size() == b.vertices.size() && a.faces == b.faces &&
+           std::memcmp(a.vertices.data(), b.vertices.data(), a.vertices.size() * sizeof(Vec3)) == 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// writeMesh dispatch
+
+TEST(MeshIo, WriteMeshTriIsFormatTri) {
+    const TriMesh mesh = makeIcoSphere(1.3, 1);
+    TempDir dir;
+    for (const char* name : {"ico.tri", "ICO2.TRI", "ico3.Tri"}) {
+        const fs::path file = dir.path() / name;
+        writeMesh(mesh, file);
+        EXPECT_EQ(slurp(file), formatTri(mesh)) << name;
+        EXPECT_TRUE(bitIdentical(readMesh(file).mesh, mesh)) << name;
+    }
+}
+
+TEST(MeshIo, WriteMeshObjIsWriteObj) {
+    const TriMesh mesh = makeTorus(3.0, 1.0, 5, 4);
+    TempDir dir;
+    const fs::path viaDispatch = dir.path() / "a.obj", direct = dir.path() / "b.obj", upper = dir.path() / "c.OBJ";
+    writeMesh(mesh, viaDispatch);
+    writeObj(mesh, direct);
+    writeMesh(mesh, upper);
+    const std::string text = slurp(viaDispatch);
+    EXPECT_EQ(text, slurp(direct));
+    EXPECT_EQ(text, slurp(upper));
+    EXPECT_EQ(text.rfind("# written by flexfit\n", 0), 0u);
+    EXPECT_TRUE(contains(text, "\no torus\n"));
+    EXPECT_TRUE(contains(text, "\nf 1 5 6\n"));  // 1-based: the first face (0 4 5)
+    const MeshReadResult r = readMesh(viaDispatch);
+    EXPECT_EQ(r.mesh.vertices.size(), 20u);
+    EXPECT_EQ(r.mesh.faces.size(), 40u);
+    EXPECT_EQ(r.diagnostics.edgeCount, 60u);
+    EXPECT_TRUE(r.diagnostics.closed());
+}
+
+TEST(MeshIo, WriteMeshRejectsOtherExtensions) {
+    const TriMesh mesh = makeIcoSphere(1.0, 0);
+    TempDir dir;
+    for (const char* name : {"out.stl", "out.ply", "out.gltf", "out", "out.tri.bak"}) {
+        const fs::path file = dir.path() / name;
+        try {
+            writeMesh(mesh, file);
+            ADD_FAILURE() << name << " accepted";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.source(), file.string());
+            EXPECT_TRUE(contains(e.problem(), "supported output formats are .tri and .obj")) << e.problem();
+        }
+        EXPECT_FALSE(fs::exists(file)) << name << ": nothing may be written";
+    }
+}
+
+TEST(MeshIo, WritersRejectUnwritablePaths) {
+    const TriMesh mesh = makeIcoSphere(1.0, 0);
+    TempDir dir;
+    const fs::path missingDir = dir.path() / "no" / "such" / "dir";
+    EXPECT_THROW(writeMesh(mesh, missingDir / "m.tri"), InputError);
+    EXPECT_THROW(writeMesh(mesh, missingDir / "m.obj"), InputError);
+    EXPECT_THROW(writeObj(mesh, dir.path()), InputError);  // a directory
+    EXPECT_THROW(writeTri(mesh, dir.path()), InputError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// readMesh of .tri
+
+// Tetrahedron whose vertex 0 is split: vertex 4 lies 1e-9 from vertex 0 and face (0 1 3) uses it.
+const std::string kSplitTet =
+    "split tet\n5 4\n"
+    "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1e-9 0 0\n"
+    "0 2 1\n4 1 3\n0 3 2\n1 2 3\n";
+
+TEST(MeshIo, ReadMeshTriDoesNotWeldByDefault) {
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("split.tri", kSplitTet));
+    EXPECT_EQ(r.mesh.name, "split tet");
+    EXPECT_EQ(r.mesh.vertices.size(), 5u);
+    EXPECT_EQ(r.weldedVertices, 0u);
+    EXPECT_EQ(r.collapsedFaces, 0u);
+    EXPECT_EQ(r.diagnostics.edgeCount, 8u);  // 6 + the split edges 4-1, 4-3
+    EXPECT_EQ(r.diagnostics.boundaryEdges, 4u);
+    EXPECT_FALSE(r.diagnostics.closed());
+    EXPECT_FALSE(r.diagnostics.warnings.empty());
+}
+
+TEST(MeshIo, ReadMeshTriWeldsWithinTolerance) {
+    TempDir dir;
+    const fs::path file = dir.write("split.tri", kSplitTet);
+    // Below the gap: still split.
+    const MeshReadResult tight = readMesh(file, MeshReadOptions{1e-10});
+    EXPECT_EQ(tight.mesh.vertices.size(), 5u);
+    EXPECT_EQ(tight.weldedVertices, 0u);
+    EXPECT_FALSE(tight.diagnostics.closed());
+    // Above the gap: welded into the closed tetrahedron, keeping vertex 0 (the first).
+    const MeshReadResult r = readMesh(file, MeshReadOptions{1e-6});
+    ASSERT_EQ(r.mesh.vertices.size(), 4u);
+    EXPECT_EQ(r.mesh.vertices[0], Vec3(0, 0, 0));
+    EXPECT_EQ(r.weldedVertices, 1u);
+    EXPECT_EQ(r.collapsedFaces, 0u);
+    EXPECT_EQ(r.mesh.faces[1], (Face{0, 1, 3}));
+    EXPECT_EQ(r.diagnostics.edgeCount, 6u);
+    EXPECT_TRUE(r.diagnostics.closed());
+    EXPECT_TRUE(r.diagnostics.warnings.empty());
+    EXPECT_EQ(r.mesh.name, "split tet");
+}
+
+TEST(MeshIo, ReadMeshTriWeldingCollapsesFaces) {
+    TempDir dir;
+    // The tetrahedron plus a sliver face (0 4 2), vertex 4 1e-4 from vertex 0.
+    const std::string text =
+        "sliver\n5 5\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1e-4 0 0\n0 2 1\n0 1 3\n0 3 2\n1 2 3\n0 4 2\n";
+    const fs::path file = dir.write("sliver.tri", text);
+    const MeshReadResult before = readMesh(file);
+    EXPECT_EQ(before.diagnostics.nonManifoldEdges, 1u);
+    const MeshReadResult r = readMesh(file, MeshReadOptions{1e-3});
+    EXPECT_EQ(r.weldedVertices, 1u);
+    EXPECT_EQ(r.collapsedFaces, 1u);
+    EXPECT_EQ(r.mesh.faces.size(), 4u);
+    EXPECT_TRUE(r.diagnostics.closed());
+}
+
+TEST(MeshIo, ReadMeshTriWeldingThatBreaksTheMeshThrows) {
+    TempDir dir;
+    // Welding at 0.6 merges vertex 3 into vertex 0 (and into no other): the two faces become duplicates.
+    const std::string text = "dup\n4 2\n0 0 0\n1 0 0\n0 1 0\n0 0 0.5\n0 1 2\n3 1 2\n";
+    const fs::path file = dir.write("dup.tri", text);
+    EXPECT_NO_THROW(readMesh(file));
+    try {
+        readMesh(file, MeshReadOptions{0.6});
+        ADD_FAILURE() << "accepted duplicate faces after welding";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.source(), file.string());
+        EXPECT_TRUE(contains(e.problem(), "duplicates")) << e.problem();
+    }
+}
+
+TEST(MeshIo, ReadMeshTriErrorsCarryTheLine) {
+    TempDir dir;
+    const fs::path file = dir.write("bad.tri", "tet\n4 4\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 2 1\n0 1 3\n0 3 9\n1 2 3\n");
+    for (double tolerance : {0.0, 1e-6}) {
+        try {
+            readMesh(file, MeshReadOptions{tolerance});
+            ADD_FAILURE() << "accepted";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.source(), file.string());
+            EXPECT_EQ(e.line(), 9u);
+            EXPECT_TRUE(contains(e.problem(), "out of range")) << e.problem();
+        }
+    }
+}
+
+TEST(MeshIo, ReadMeshRejectsBadWeldTolerance) {
+    TempDir dir;
+    const fs::path file = dir.path() / "t.tri";
+    writeTri(makeIcoSphere(1.0, 0), file);
+    for (double bad : {-1.0, -1e-300, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+        try {
+            readMesh(file, MeshReadOptions{bad});
+            ADD_FAILURE() << bad << " accepted";
+        } catch (const InputError& e) {
+            EXPECT_TRUE(contains(e.problem(), "weld tolerance")) << e.problem();
+        }
+    }
+}
+
+TEST(MeshIo, ReadMeshMissingTriFile) {
+    const fs::path missing = fs::temp_directory_path() / "flexfit_mesh_io_test_missing.tri";
+    try {
+        readMesh(missing);
+        ADD_FAILURE() << "accepted a missing file";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.source(), missing.string());
+        EXPECT_TRUE(contains(e.problem(), "cannot open")) << e.problem();
+    }
+}
+
+TEST(MeshIo, ReadMeshOfADirectoryThrows) {
+    TempDir dir;
+    for (const char* name : {"d.tri", "d.obj", "d.stl"}) {
+        const fs::path sub = dir.path() / name;
+        fs::create_directories(sub);
+        try {
+            readMesh(sub);
+            ADD_FAILURE() << name << " accepted";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.source(), sub.string());
+        }
+    }
+}
+
+TEST(MeshIo, TriAndObjOfTheSameMeshAgree) {
+    // Float-representable coordinates, so that a single-precision assimp reads the OBJ exactly.
+    TriMesh mesh = makeIcoSphere(2.0, 2);
+    for (Vec3& v : mesh.vertices) v = toFloatPrecision(v);
+    TempDir dir;
+    writeMesh(mesh, dir.path() / "m.tri");
+    writeMesh(mesh, dir.path() / "m.obj");
+    const MeshReadResult tri = readMesh(dir.path() / "m.tri");
+    const MeshReadResult obj = readMesh(dir.path() / "m.obj");
+    EXPECT_EQ(tri.mesh.vertices.size(), obj.mesh.vertices.size());
+    EXPECT_EQ(tri.mesh.faces.size(), obj.mesh.faces.size());
+    EXPECT_EQ(tri.diagnostics.edgeCount, obj.diagnostics.edgeCount);
+    EXPECT_EQ(boundingBox(tri.mesh).min(), boundingBox(obj.mesh).min());
+    EXPECT_EQ(boundingBox(tri.mesh).max(), boundingBox(obj.mesh).max());
+    // The faces agree as sets of positions, in order.
+    for (std::size_t f = 0; f < tri.mesh.faces.size(); ++f)
+        for (int k = 0; k < 3; ++k)
+            EXPECT_EQ(tri.mesh.vertices[tri.mesh.faces[f][k]], obj.mesh.vertices[obj.mesh.faces[f][k]]);
+}
+
+}  // namespace
+}  // namespace flexfit
