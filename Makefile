@@ -27,7 +27,9 @@ test: release asan
 	ctest --preset asan -j $(JOBS)
 
 bench: release
-	build/release/bench/flexfit_bench --benchmark_out=bench/results/msd_step.csv --benchmark_out_format=csv
+	build/release/bench/flexfit_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+	  --benchmark_min_time=0.5 --benchmark_out=bench/results/msd_step.csv --benchmark_out_format=csv
+	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv BM_FlexfitFullStep BM_NaiveFullStep
 
 clean:
 	rm -rf build out
