@@ -72,6 +72,14 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings,
                    std::span<const PointLoad> loads, PartState& state,
                    StepCounters* counters = nullptr);
 
+// Advances only an active region: the `moving` masses (each listed once; movingMask[i] != 0
+// exactly for them) and the `computed` springs (every spring touching a moving mass). Masses
+// outside the region are read (at their current, rest, positions) but never written. Two
+// passes over the compact arrays: springs, then masses. O(|moving| + |computed|).
+void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, std::span<const Index> moving,
+                      std::span<const Index> computed, std::span<const std::uint16_t> movingMask, PartState& state,
+                      StepCounters* counters = nullptr);
+
 // Total kinetic + spring + anchor potential energy (no gravity), and linear momentum.
 double totalEnergy(const PartModel& model, const SimulationSettings& settings, const PartState& state);
 Vec3 linearMomentum(const PartModel& model, const PartState& state);

@@ -1,33 +1,11 @@
-// One step of the full mass-spring-damper model. Three passes over compact arrays:
-// masses (external and restoring forces), springs (g_ij), masses (integration + constraint).
+// One step of the full mass-spring-damper model: a single sweep over the masses.
 #include "flexfit/simulation.hpp"
+#include "mass_update.hpp"
 
 #include <cmath>
 
 namespace flexfit {
 namespace {
-
-// Per-step constants of the mass update, resolved once from the settings.
-struct MassUpdate {
-    double h, invH;
-    Vec3 gravity;
-    double drag;             // gamma (+ b_a with anchor springs)
-    double anchorStiffness;  // k_a, 0 unless anchor springs
-    double constraint;       // restoration constraint fraction, 0 unless the constraint method
-    bool semiImplicit;
-};
-
-MassUpdate resolveMassUpdate(const SimulationSettings& s) {
-    const bool anchors = s.restoration.method == RestorationMethod::AnchorSprings;
-    const bool constraint = s.restoration.method == RestorationMethod::Constraint;
-    return {s.timeStep,
-            1.0 / s.timeStep,
-            s.gravity,
-            s.globalDamping + (anchors ? s.restoration.anchorDamping : 0.0),
-            anchors ? s.restoration.anchorStiffness : 0.0,
-            constraint ? s.restoration.constraintFraction : 0.0,
-            s.integrator == Integrator::SemiImplicitEuler};
-}
 
 // The whole step is one pass over the masses in index order. Springs are sorted by their first
 // (smaller) mass a, so visiting mass a evaluates springs (a, b > a): g goes to a in a register
@@ -37,7 +15,7 @@ MassUpdate resolveMassUpdate(const SimulationSettings& s) {
 //
 // f_a = (pending external force) + sum_j g_aj + m_a g - drag v_a - k_a (x_a - rest_a)
 // g_ab = -(k (|d| - L) + b (v_a - v_b).u) u,  d = x_a - x_b, u = d/|d|
-void sweep(const PartModel& model, const MassUpdate& p, PartState& state) {
+void sweep(const PartModel& model, const detail::MassUpdate& p, PartState& state) {
     const std::size_t masses = model.massCount();
     const Index* springAdr = model.springAdr.data();
     const Index* springB = model.springB.data();
@@ -51,35 +29,15 @@ void sweep(const PartModel& model, const MassUpdate& p, PartState& state) {
     Vec3* __restrict v = state.velocities.data();
     Vec3* __restrict f = state.forces.data();
     for (std::size_t a = 0; a < masses; ++a) {
-        const Vec3 xa = x[a], va = v[a];
-        Vec3 fa = f[a] + mass[a] * p.gravity - p.drag * va - p.anchorStiffness * (xa - rest[a]);
+        Vec3 fa = f[a] + p.bodyForce(mass[a], x[a], v[a], rest[a]);
         for (Index e = springAdr[a]; e < springAdr[a + 1]; ++e) {
             const Index b = springB[e];
-            const Vec3 d = xa - x[b];
-            const double length = d.norm();
-            const double inverse = length > 0.0 ? 1.0 / length : 0.0;  // coincident masses: no force
-            const double magnitude = k[e] * (length - restLength[e]) + c[e] * (va - v[b]).dot(d) * inverse;
-            const Vec3 g = (magnitude * inverse) * d;
-            fa -= g;
-            f[b] += g;
+            const Vec3 g = detail::springForceOnFirst(k[e], c[e], restLength[e], x[a], x[b], v[a], v[b]);
+            fa += g;
+            f[b] -= g;
         }
         f[a] = Vec3::Zero();  // consumed: the next step starts with no pending force
-        Vec3 xNew, vNew;
-        if (p.semiImplicit) {
-            vNew = va + (p.h * invMass[a]) * fa;
-            xNew = xa + p.h * vNew;
-        } else {
-            xNew = xa + p.h * va;
-            vNew = va + (p.h * invMass[a]) * fa;
-        }
-        if (p.constraint > 0.0) {
-            // Position-based restoration: move a fraction back; the velocity takes the correction.
-            const Vec3 correction = p.constraint * (rest[a] - xNew);
-            xNew += correction;
-            vNew += p.invH * correction;
-        }
-        x[a] = xNew;
-        v[a] = vNew;
+        p.integrate(invMass[a], fa, rest[a], x[a], v[a]);
     }
 }
 
@@ -103,7 +61,7 @@ void validateSettings(const SimulationSettings& s) {
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
                    PartState& state, StepCounters* counters) {
     for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
-    sweep(model, resolveMassUpdate(settings), state);
+    sweep(model, detail::MassUpdate::from(settings), state);
     state.time += settings.timeStep;
     ++state.stepCount;
     if (counters != nullptr) {

@@ -143,22 +143,17 @@ TriMesh makeHeart(double size, int segments, int rings) {
     return unit;
 }
 
-TriMesh makeTorus1() {
-    TriMesh mesh = makeTorus(10.0, 2.5, 24, 24);
-    mesh.name = "torus1";
+namespace {
+// The thesis's tori all share R = 10, r = 2.5 (the container mouth: outer 25, inner 15).
+TriMesh namedTorus(const char* name, int segmentsU, int segmentsV) {
+    TriMesh mesh = makeTorus(10.0, 2.5, segmentsU, segmentsV);
+    mesh.name = name;
     return mesh;
 }
+}  // namespace
 
-TriMesh makeTorus2() {
-    TriMesh mesh = makeTorus(10.0, 2.5, 54, 29);
-    mesh.name = "torus2";
-    return mesh;
-}
-
-TriMesh makeContainerMouth() {
-    TriMesh mesh = makeTorus(10.0, 2.5, 64, 24);
-    mesh.name = "container_mouth";
-    return mesh;
-}
+TriMesh makeTorus1() { return namedTorus("torus1", 24, 24); }
+TriMesh makeTorus2() { return namedTorus("torus2", 54, 29); }
+TriMesh makeContainerMouth() { return namedTorus("container_mouth", 64, 24); }
 
 }  // namespace flexfit

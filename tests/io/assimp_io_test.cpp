@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "temp_dir.hpp"
+
 #include <unistd.h>
 
 #include <cmath>
@@ -20,34 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A unique directory in the system temp directory, removed with its contents at scope exit.
-class TempDir {
-public:
-    TempDir() {
-        static int counter = 0;
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        path_ = fs::temp_directory_path() / ("flexfit_assimp_io_test_" + std::to_string(::getpid()) + "_" +
-                                             (info ? std::string(info->name()) : "x") + "_" + std::to_string(counter++));
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-
-    fs::path write(const std::string& name, const std::string& content) const {
-        const fs::path file = path_ / name;
-        std::ofstream out(file, std::ios::binary);
-        out << content;
-        return file;
-    }
-    const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
-};
+using flexfit::testing::TempDir;
 
 // Rounds each coordinate to the nearest float. Written per scalar: GCC 12 at -O2 was seen to drop
 // the rounding in `v.cast<float>().cast<double>()` inside a loop over Eigen vectors.

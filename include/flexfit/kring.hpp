@@ -1,0 +1,36 @@
+// k-rings over the mass graph (CSR neighbourhoods) by breadth-first search.
+//
+// Visited marks are epoch-stamped: a query bumps the epoch instead of clearing the marks, so
+// after the first queries have sized the queue, a query allocates nothing and costs only
+// what it visits, whatever the mesh size.
+#pragma once
+
+#include "flexfit/topology.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace flexfit {
+
+struct RingMember {
+    Index mass;
+    std::uint8_t depth;  // graph distance from the nearest seed (0 = seed)
+};
+
+class KRingWalker {
+public:
+    explicit KRingWalker(std::size_t vertexCount);
+
+    // Every mass within graph distance `rings` of a seed, seeds first, then by depth. Seeds must
+    // be < vertexCount; duplicates are ignored. rings is clamped to [0, 254].
+    void collect(const Topology& topology, std::span<const Index> seeds, int rings, std::vector<RingMember>& out);
+
+    std::size_t lastVisited() const { return lastVisited_; }  // masses touched by the last query
+
+private:
+    std::vector<std::uint32_t> mark_;  // (V) epoch at which a mass was last visited
+    std::uint32_t epoch_ = 0;
+    std::size_t lastVisited_ = 0;
+};
+
+}  // namespace flexfit

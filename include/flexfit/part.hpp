@@ -1,0 +1,155 @@
+// A rigid-deformable part (SPEC 5, thesis 4.2): a rigid body everywhere except in deformation
+// zones, where its masses move as a mass-spring-damper model.
+//
+// Frames. The model's rest positions live in the part frame; the pose T maps them to the world.
+// A moving mass keeps its position and velocity in the part frame, so moving the part rigidly
+// is O(1) and never disturbs a zone. A mass outside every zone sits at its rest position by
+// construction (its "fixedPosition" T*rest is never stored).
+//
+// Zones. A zone has seeds (a mass, or a face's 3 masses) and a depth level L: level 0 moves
+// nothing; level L moves every mass within graph distance L-1 of a seed; every spring touching
+// a moving mass is computed, and masses beyond stay at their rest positions. Zones may
+// overlap: the region is their union (a mass moves while any zone covers it).
+//
+// Active region. Moving masses and computed springs are compact index arrays maintained
+// incrementally (coverage counts, swap-remove): opening, growing, shrinking or retiring a zone
+// costs what it changes, and a step costs O(moving masses + computed springs). An untouched
+// part's step is O(1).
+//
+// Lifecycle. A zone opens on request or when a force is applied to a mass no zone covers; it
+// stays while any of its masses was loaded in the last `retireCheckInterval` steps; every
+// `retireCheckInterval` steps the zones are checked, and one retires when its springs are all
+// inactive (| |d| - L | <= threshold), its masses slower than
+// `restSpeed` and within `threshold` of rest. Retired masses return exactly to rest.
+//
+// Modes. Rigid: never deforms (zones and forces are ignored). RigidDeformable: zones.
+// FullDeformable: every mass moves always (the thesis's baseline), stepped by stepFullModel.
+// A zone covering the whole mesh is stepped by the same sweep (fullSweepWhenComplete), and the
+// compact-array path gives the same trajectory up to summation order (tested).
+//
+// Known limits: the part's own rigid-body motion (velocities, contacts) belongs to the world
+// (assembly stage); gravity here acts on moving masses only, in the part frame.
+#pragma once
+
+#include "flexfit/kring.hpp"
+#include "flexfit/pose.hpp"
+#include "flexfit/simulation.hpp"
+
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace flexfit {
+
+enum class PartMode { Rigid, RigidDeformable, FullDeformable };
+const char* toString(PartMode mode);
+
+struct ZoneSettings {
+    int defaultLevel = 2;            // level of zones opened by forces
+    double activityThreshold = 0.01; // spring activity and rest-distance threshold (length units)
+    double restSpeed = 1e-3;         // masses slower than this are at rest
+    int retireCheckInterval = 16;    // steps between retirement checks of an unloaded zone
+    bool fullSweepWhenComplete = true;  // step a region covering every mass with the full sweep
+};
+
+struct PartSettings {
+    PartMode mode = PartMode::RigidDeformable;
+    SimulationSettings simulation;
+    ZoneSettings zones;
+};
+
+struct ZoneSeed {
+    enum class Kind { Mass, Triangle } kind = Kind::Mass;
+    Index index = 0;
+    static ZoneSeed mass(Index m) { return {Kind::Mass, m}; }
+    static ZoneSeed face(Index f) { return {Kind::Triangle, f}; }
+};
+
+using ZoneId = std::uint32_t;
+inline constexpr ZoneId kNoZone = 0;
+
+class Part {
+public:
+    // Throws InputError for invalid settings.
+    explicit Part(std::shared_ptr<const PartModel> model, const PartSettings& settings = {});
+
+    const PartModel& model() const { return *model_; }
+    const std::shared_ptr<const PartModel>& sharedModel() const { return model_; }
+    PartMode mode() const { return settings_.mode; }
+    const PartSettings& settings() const { return settings_; }
+
+    // --- Pose (O(1)) ---
+    const Pose& pose() const { return pose_; }
+    void setPose(const Pose& pose);
+    void translate(const Vec3& offset);
+    // Rotation by `angle` radians about `axis` (world frame) through the part's centre.
+    void rotate(const Vec3& axis, double angle);
+    // Rotation about an axis through a world point.
+    void rotateAbout(const Vec3& axis, double angle, const Vec3& point);
+    Vec3 centre() const;  // world position of the rest shape's bounding-box centre
+
+    // --- Zones ---
+    // Opens a zone; returns kNoZone in Rigid and FullDeformable modes. Throws InputError for a
+    // seed out of range or a level outside [0, 255].
+    ZoneId openZone(ZoneSeed seed, int level);
+    void setZoneLevel(ZoneId zone, int level);
+    void retireZone(ZoneId zone);
+    std::size_t zoneCount() const { return zones_.size(); }
+    std::vector<ZoneId> zoneIds() const;
+
+    // --- Loads, for the next step ---
+    // A world-frame force on one mass. Opens a zone (defaultLevel) when no zone covers it and
+    // keeps the covering zones alive. Ignored in Rigid mode. Throws InputError for a bad mass.
+    void applyForce(Index mass, const Vec3& worldForce);
+
+    // --- Step ---
+    void step(StepCounters* counters = nullptr);
+
+    // --- Read-out ---
+    std::span<const Index> movingMasses() const { return moving_; }
+    std::span<const Index> computedSprings() const { return computed_; }
+    bool isMoving(Index mass) const { return cover_[mass] > 0; }
+    const PartState& state() const { return state_; }  // part frame; non-moving masses at rest
+    Vec3 worldPosition(Index mass) const { return pose_.apply(state_.positions[mass]); }
+    void worldPositions(std::vector<Vec3>& out) const;
+    // Depth of each mass in the zones covering it (minimum; 0 = seed), -1 when not moving.
+    void zoneDepths(std::vector<int>& out) const;
+    double time() const { return state_.time; }
+
+private:
+    struct Zone {
+        ZoneId id;
+        std::vector<Index> seeds;
+        int level;
+        std::vector<RingMember> members;
+    };
+
+    void cover(std::span<const RingMember> members);
+    void uncover(std::span<const RingMember> members);
+    void addMoving(Index mass);
+    void removeMoving(Index mass);
+    Zone* findZone(ZoneId id);
+    void collectMembers(Zone& zone);
+    void retireRestingZones();
+    bool zoneAtRest(const Zone& zone) const;
+    void stepRegion(StepCounters* counters);
+    SimulationSettings partFrameSettings() const;
+
+    std::shared_ptr<const PartModel> model_;
+    PartSettings settings_;
+    Pose pose_;
+    PartState state_;
+    KRingWalker walker_;
+
+    std::vector<Zone> zones_;
+    ZoneId nextZoneId_ = 1;
+    std::vector<std::uint16_t> cover_;        // (V) zones covering each mass
+    std::vector<Index> moving_;               // moving masses (compact)
+    std::vector<Index> movingSlot_;           // (V) position in moving_, or kAbsent
+    std::vector<std::uint8_t> springEnds_;    // (E) moving endpoints of each spring
+    std::vector<Index> computed_;             // computed springs (compact)
+    std::vector<Index> computedSlot_;         // (E) position in computed_, or kAbsent
+    std::vector<std::uint64_t> lastLoadStep_; // (V) step of the last force on each mass
+};
+
+}  // namespace flexfit

@@ -1,0 +1,67 @@
+// Internal to src/dynamics: the per-mass half of a step, shared by the full sweep and the
+// active-region step so that both integrate bit for bit alike.
+#pragma once
+
+#include "flexfit/simulation.hpp"
+
+namespace flexfit::detail {
+
+// Per-step constants of the mass update, resolved once from the settings.
+struct MassUpdate {
+    double h, invH;
+    Vec3 gravity;
+    double drag;             // gamma (+ b_a with anchor springs)
+    double anchorStiffness;  // k_a, 0 unless anchor springs
+    double constraint;       // restoration constraint fraction, 0 unless the constraint method
+    bool semiImplicit;
+
+    static MassUpdate from(const SimulationSettings& s) {
+        const bool anchors = s.restoration.method == RestorationMethod::AnchorSprings;
+        const bool constraint = s.restoration.method == RestorationMethod::Constraint;
+        return {s.timeStep,
+                1.0 / s.timeStep,
+                s.gravity,
+                s.globalDamping + (anchors ? s.restoration.anchorDamping : 0.0),
+                anchors ? s.restoration.anchorStiffness : 0.0,
+                constraint ? s.restoration.constraintFraction : 0.0,
+                s.integrator == Integrator::SemiImplicitEuler};
+    }
+
+    // Forces on a mass other than its springs: m g - drag v - k_a (x - rest).
+    Vec3 bodyForce(double mass, const Vec3& x, const Vec3& v, const Vec3& rest) const {
+        return mass * gravity - drag * v - anchorStiffness * (x - rest);
+    }
+
+    // Integrates one mass under total force f, then applies the restoration constraint.
+    void integrate(double inverseMass, const Vec3& f, const Vec3& rest, Vec3& x, Vec3& v) const {
+        Vec3 xNew, vNew;
+        if (semiImplicit) {
+            vNew = v + (h * inverseMass) * f;
+            xNew = x + h * vNew;
+        } else {
+            xNew = x + h * v;
+            vNew = v + (h * inverseMass) * f;
+        }
+        if (constraint > 0.0) {
+            // Position-based restoration: move a fraction back; the velocity takes the correction.
+            const Vec3 correction = constraint * (rest - xNew);
+            xNew += correction;
+            vNew += invH * correction;
+        }
+        x = xNew;
+        v = vNew;
+    }
+};
+
+// Force of spring e on its first mass a (the second mass b receives the opposite):
+// -(k (|d| - L) + b (v_a - v_b).u) u with d = x_a - x_b, u = d/|d|; zero for coincident masses.
+inline Vec3 springForceOnFirst(double k, double c, double restLength, const Vec3& xa, const Vec3& xb, const Vec3& va,
+                               const Vec3& vb) {
+    const Vec3 d = xa - xb;
+    const double length = d.norm();
+    const double inverse = length > 0.0 ? 1.0 / length : 0.0;
+    const double magnitude = k * (length - restLength) + c * (va - vb).dot(d) * inverse;
+    return -(magnitude * inverse) * d;
+}
+
+}  // namespace flexfit::detail

@@ -1,0 +1,272 @@
+#include "flexfit/part.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace flexfit {
+namespace {
+
+constexpr Index kAbsent = std::numeric_limits<Index>::max();
+constexpr std::uint64_t kNeverLoaded = std::numeric_limits<std::uint64_t>::max();
+const std::string kPartSource = "part";
+
+void checkZoneSettings(const ZoneSettings& z) {
+    if (z.defaultLevel < 0 || z.defaultLevel > 255) throw InputError("zone settings", 0, "default level must be in [0, 255]");
+    if (!(z.activityThreshold > 0.0) || !std::isfinite(z.activityThreshold))
+        throw InputError("zone settings", 0, "activity threshold must be finite and > 0");
+    if (!(z.restSpeed >= 0.0) || !std::isfinite(z.restSpeed))
+        throw InputError("zone settings", 0, "rest speed must be finite and >= 0");
+    if (z.retireCheckInterval < 1) throw InputError("zone settings", 0, "retire check interval must be >= 1");
+}
+
+}  // namespace
+
+const char* toString(PartMode mode) {
+    switch (mode) {
+        case PartMode::Rigid: return "rigid";
+        case PartMode::RigidDeformable: return "zones";
+        case PartMode::FullDeformable: return "full";
+    }
+    return "?";
+}
+
+Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
+    : model_(std::move(model)),
+      settings_(settings),
+      state_(PartState::atRest(*model_)),
+      walker_(model_->massCount()),
+      cover_(model_->massCount(), 0),
+      movingSlot_(model_->massCount(), kAbsent),
+      springEnds_(model_->springCount(), 0),
+      computedSlot_(model_->springCount(), kAbsent),
+      lastLoadStep_(model_->massCount(), kNeverLoaded) {
+    validateSettings(settings_.simulation);
+    checkZoneSettings(settings_.zones);
+    if (settings_.mode == PartMode::FullDeformable) {
+        // Every mass moves, always: the region is the whole mesh (kept for the read-out).
+        for (Index m = 0; m < model_->massCount(); ++m) {
+            cover_[m] = 1;
+            addMoving(m);
+        }
+    }
+}
+
+// --- Pose ---
+
+void Part::setPose(const Pose& pose) {
+    pose_ = pose;
+    pose_.rotation.normalize();
+}
+
+void Part::translate(const Vec3& offset) { pose_.translation += offset; }
+
+void Part::rotateAbout(const Vec3& axis, double angle, const Vec3& point) {
+    if (!(axis.norm() > 0.0) || !axis.allFinite() || !std::isfinite(angle) || !point.allFinite())
+        throw InputError(kPartSource, 0, "rotation needs a finite non-zero axis, angle and point");
+    Pose turn;
+    turn.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized()));
+    turn.translation = point - turn.rotation * point;
+    pose_ = pose_.then(turn);
+}
+
+void Part::rotate(const Vec3& axis, double angle) { rotateAbout(axis, angle, centre()); }
+
+Vec3 Part::centre() const { return pose_.apply(boundingBox(model_->mesh).center()); }
+
+// --- Active region bookkeeping ---
+
+void Part::addMoving(Index mass) {
+    movingSlot_[mass] = Index(moving_.size());
+    moving_.push_back(mass);
+    for (Index e : model_->topology.edgesOf(mass))
+        if (springEnds_[e]++ == 0) {
+            computedSlot_[e] = Index(computed_.size());
+            computed_.push_back(e);
+        }
+}
+
+void Part::removeMoving(Index mass) {
+    // Swap-remove from the compact arrays; the mass returns exactly to rest.
+    const Index slot = movingSlot_[mass];
+    moving_[slot] = moving_.back();
+    movingSlot_[moving_[slot]] = slot;
+    moving_.pop_back();
+    movingSlot_[mass] = kAbsent;
+    for (Index e : model_->topology.edgesOf(mass))
+        if (--springEnds_[e] == 0) {
+            const Index s = computedSlot_[e];
+            computed_[s] = computed_.back();
+            computedSlot_[computed_[s]] = s;
+            computed_.pop_back();
+            computedSlot_[e] = kAbsent;
+        }
+    state_.positions[mass] = model_->restPositions[mass];
+    state_.velocities[mass] = Vec3::Zero();
+    state_.forces[mass] = Vec3::Zero();
+}
+
+void Part::cover(std::span<const RingMember> members) {
+    for (const RingMember& m : members)
+        if (cover_[m.mass]++ == 0) addMoving(m.mass);
+}
+
+void Part::uncover(std::span<const RingMember> members) {
+    for (const RingMember& m : members)
+        if (--cover_[m.mass] == 0) removeMoving(m.mass);
+}
+
+// --- Zones ---
+
+Part::Zone* Part::findZone(ZoneId id) {
+    for (Zone& z : zones_)
+        if (z.id == id) return &z;
+    return nullptr;
+}
+
+void Part::collectMembers(Zone& zone) {
+    // Level L moves the masses within distance L-1 of a seed; level 0 moves none.
+    if (zone.level == 0) {
+        zone.members.clear();
+        return;
+    }
+    walker_.collect(model_->topology, zone.seeds, zone.level - 1, zone.members);
+}
+
+ZoneId Part::openZone(ZoneSeed seed, int level) {
+    if (level < 0 || level > 255) throw InputError(kPartSource, 0, "zone level " + std::to_string(level) + " is outside [0, 255]");
+    Zone zone{nextZoneId_, {}, level, {}};
+    if (seed.kind == ZoneSeed::Kind::Mass) {
+        if (seed.index >= model_->massCount())
+            throw InputError(kPartSource, 0, "zone seed mass " + std::to_string(seed.index) + " does not exist (the model has " +
+                                                 std::to_string(model_->massCount()) + " masses)");
+        zone.seeds = {seed.index};
+    } else {
+        if (seed.index >= model_->faceCount())
+            throw InputError(kPartSource, 0, "zone seed face " + std::to_string(seed.index) + " does not exist (the model has " +
+                                                 std::to_string(model_->faceCount()) + " faces)");
+        const Face& f = model_->mesh.faces[seed.index];
+        zone.seeds = {f[0], f[1], f[2]};
+    }
+    if (settings_.mode != PartMode::RigidDeformable) return kNoZone;
+    ++nextZoneId_;
+    collectMembers(zone);
+    cover(zone.members);
+    zones_.push_back(std::move(zone));
+    return zones_.back().id;
+}
+
+void Part::setZoneLevel(ZoneId id, int level) {
+    if (level < 0 || level > 255) throw InputError(kPartSource, 0, "zone level " + std::to_string(level) + " is outside [0, 255]");
+    Zone* zone = findZone(id);
+    if (zone == nullptr || zone->level == level) return;
+    // Cover the new members before uncovering the old, so masses in both keep their state.
+    std::vector<RingMember> old = std::move(zone->members);
+    zone->level = level;
+    collectMembers(*zone);
+    cover(zone->members);
+    uncover(old);
+}
+
+void Part::retireZone(ZoneId id) {
+    auto it = std::find_if(zones_.begin(), zones_.end(), [id](const Zone& z) { return z.id == id; });
+    if (it == zones_.end()) return;
+    uncover(it->members);
+    zones_.erase(it);
+}
+
+std::vector<ZoneId> Part::zoneIds() const {
+    std::vector<ZoneId> ids;
+    for (const Zone& z : zones_) ids.push_back(z.id);
+    return ids;
+}
+
+// --- Loads ---
+
+void Part::applyForce(Index mass, const Vec3& worldForce) {
+    if (mass >= model_->massCount())
+        throw InputError(kPartSource, 0, "mass " + std::to_string(mass) + " does not exist (the model has " +
+                                             std::to_string(model_->massCount()) + " masses)");
+    if (!worldForce.allFinite()) throw InputError(kPartSource, 0, "force must be finite");
+    if (settings_.mode == PartMode::Rigid) return;
+    if (settings_.mode == PartMode::RigidDeformable) {
+        if (cover_[mass] == 0) openZone(ZoneSeed::mass(mass), std::max(settings_.zones.defaultLevel, 1));
+        lastLoadStep_[mass] = state_.stepCount;  // keeps the zones covering it alive
+    }
+    state_.forces[mass] += pose_.rotateInverse(worldForce);
+}
+
+// --- Step ---
+
+SimulationSettings Part::partFrameSettings() const {
+    SimulationSettings s = settings_.simulation;
+    s.gravity = pose_.rotateInverse(s.gravity);  // world gravity seen in the part frame
+    return s;
+}
+
+void Part::stepRegion(StepCounters* counters) {
+    const SimulationSettings s = partFrameSettings();
+    if (moving_.size() == model_->massCount() && settings_.zones.fullSweepWhenComplete) {
+        stepFullModel(*model_, s, {}, state_, counters);
+        return;
+    }
+    stepActiveRegion(*model_, s, moving_, computed_, cover_, state_, counters);
+}
+
+void Part::step(StepCounters* counters) {
+    if (moving_.empty()) {  // rigid, or no zone open: nothing moves, O(1)
+        state_.time += settings_.simulation.timeStep;
+        ++state_.stepCount;
+        return;
+    }
+    stepRegion(counters);
+    if (settings_.mode == PartMode::RigidDeformable) retireRestingZones();
+}
+
+bool Part::zoneAtRest(const Zone& zone) const {
+    const double threshold = settings_.zones.activityThreshold;
+    const double restSpeed2 = settings_.zones.restSpeed * settings_.zones.restSpeed;
+    const auto interval = std::uint64_t(settings_.zones.retireCheckInterval);
+    for (const RingMember& m : zone.members) {
+        const Index i = m.mass;
+        if (lastLoadStep_[i] != kNeverLoaded && state_.stepCount - lastLoadStep_[i] <= interval) return false;
+        if (state_.velocities[i].squaredNorm() > restSpeed2) return false;
+        if ((state_.positions[i] - model_->restPositions[i]).norm() > threshold) return false;
+        for (Index e : model_->topology.edgesOf(i)) {
+            const double length = (state_.positions[model_->springA[e]] - state_.positions[model_->springB[e]]).norm();
+            if (std::abs(length - model_->restLength[e]) > threshold) return false;
+        }
+    }
+    return true;
+}
+
+void Part::retireRestingZones() {
+    if (state_.stepCount % std::uint64_t(settings_.zones.retireCheckInterval) != 0) return;
+    for (std::size_t z = 0; z < zones_.size();) {
+        const Zone& zone = zones_[z];
+        if (zoneAtRest(zone)) {
+            uncover(zone.members);
+            zones_.erase(zones_.begin() + std::ptrdiff_t(z));
+        } else {
+            ++z;
+        }
+    }
+}
+
+// --- Read-out ---
+
+void Part::worldPositions(std::vector<Vec3>& out) const {
+    out.resize(model_->massCount());
+    const Eigen::Matrix3d r = pose_.rotation.toRotationMatrix();
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = r * state_.positions[i] + pose_.translation;
+}
+
+void Part::zoneDepths(std::vector<int>& out) const {
+    out.assign(model_->massCount(), -1);
+    if (settings_.mode == PartMode::FullDeformable) std::fill(out.begin(), out.end(), 0);
+    for (const Zone& z : zones_)
+        for (const RingMember& m : z.members)
+            if (out[m.mass] < 0 || m.depth < out[m.mass]) out[m.mass] = m.depth;
+}
+
+}  // namespace flexfit

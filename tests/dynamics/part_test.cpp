@@ -1,0 +1,287 @@
+// Rigid-deformable parts: zones against brute-force k-rings and spring sets, counters against
+// the active region, frame invariance, retirement, and equivalence with the full MSD model.
+#include "flexfit/flexfit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+using namespace flexfit;
+
+namespace {
+
+PartSettings zoneSettings(double dt = 1e-3) {
+    PartSettings s;
+    s.simulation.timeStep = dt;
+    s.simulation.restoration = {RestorationMethod::AnchorSprings, 0.1, 0.01, 0.05};
+    s.simulation.globalDamping = 0.1;
+    return s;
+}
+
+std::set<Index> asSet(std::span<const Index> s) { return {s.begin(), s.end()}; }
+
+// Springs with at least one end in `masses`, by scanning every spring.
+std::set<Index> springsTouching(const PartModel& model, const std::set<Index>& masses) {
+    std::set<Index> out;
+    for (Index e = 0; e < model.springCount(); ++e)
+        if (masses.count(model.springA[e]) || masses.count(model.springB[e])) out.insert(e);
+    return out;
+}
+
+// Masses within `rings` of the seeds by repeated neighbourhood expansion over the spring list.
+std::set<Index> ringByExpansion(const PartModel& model, std::set<Index> region, int rings) {
+    for (int r = 0; r < rings; ++r) {
+        std::set<Index> next = region;
+        for (Index e = 0; e < model.springCount(); ++e) {
+            if (region.count(model.springA[e])) next.insert(model.springB[e]);
+            if (region.count(model.springB[e])) next.insert(model.springA[e]);
+        }
+        region = next;
+    }
+    return region;
+}
+
+double maxRelativeDifference(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+    double scale = 0.0, diff = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        scale = std::max(scale, a[i].norm());
+        diff = std::max(diff, (a[i] - b[i]).norm());
+    }
+    return diff / scale;
+}
+
+}  // namespace
+
+TEST(Part, LevelZeroMovesNothingLevelOneOnlyTheSeeds) {
+    const auto model = buildPartModel(makeTorus1());
+    Part part(model, zoneSettings());
+    part.openZone(ZoneSeed::mass(10), 0);
+    EXPECT_TRUE(part.movingMasses().empty());
+    EXPECT_TRUE(part.computedSprings().empty());
+    part.openZone(ZoneSeed::mass(10), 1);
+    EXPECT_EQ(asSet(part.movingMasses()), std::set<Index>({10}));
+    EXPECT_EQ(asSet(part.computedSprings()), springsTouching(*model, {10}));
+    const Face& f = model->mesh.faces[40];
+    Part byFace(model, zoneSettings());
+    byFace.openZone(ZoneSeed::face(40), 1);
+    EXPECT_EQ(asSet(byFace.movingMasses()), std::set<Index>({f[0], f[1], f[2]}));
+}
+
+TEST(Part, RegionIsTheUnionOfKRingsAndItsSprings) {
+    const auto model = buildPartModel(makeTorus2());
+    Part part(model, zoneSettings());
+    for (int level = 1; level <= 6; ++level) {
+        Part single(model, zoneSettings());
+        single.openZone(ZoneSeed::mass(77), level);
+        const std::set<Index> expected = ringByExpansion(*model, {77}, level - 1);
+        EXPECT_EQ(asSet(single.movingMasses()), expected) << "level " << level;
+        EXPECT_EQ(asSet(single.computedSprings()), springsTouching(*model, expected)) << "level " << level;
+    }
+    // Two overlapping zones act as one region.
+    part.openZone(ZoneSeed::mass(77), 4);
+    part.openZone(ZoneSeed::mass(79), 3);
+    std::set<Index> expected = ringByExpansion(*model, {77}, 3);
+    for (Index m : ringByExpansion(*model, {79}, 2)) expected.insert(m);
+    EXPECT_EQ(asSet(part.movingMasses()), expected);
+    EXPECT_EQ(asSet(part.computedSprings()), springsTouching(*model, expected));
+    EXPECT_EQ(part.movingMasses().size(), expected.size());  // no duplicates
+}
+
+TEST(Part, SpringsEvaluatedEqualTheActiveRegion) {
+    const auto model = buildPartModel(makeHeart());
+    Part part(model, zoneSettings());
+    StepCounters untouched;
+    for (int i = 0; i < 10; ++i) part.step(&untouched);
+    EXPECT_EQ(untouched.springsEvaluated, 0u);
+    EXPECT_EQ(untouched.massesIntegrated, 0u);
+
+    part.openZone(ZoneSeed::face(500), 3);
+    part.openZone(ZoneSeed::mass(6000), 2);
+    StepCounters counters;
+    part.applyForce(6000, Vec3(0, 0.5, 0));
+    part.step(&counters);
+    EXPECT_EQ(counters.springsEvaluated, part.computedSprings().size());
+    EXPECT_EQ(counters.massesIntegrated, part.movingMasses().size());
+    EXPECT_LT(part.computedSprings().size(), 200u);
+}
+
+TEST(Part, ZonesRetireAndMassesReturnExactlyToRest) {
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}});
+    PartSettings settings = zoneSettings();
+    settings.simulation.restoration = {RestorationMethod::AnchorSprings, 1.0, 0.5, 0.05};
+    Part part(model, settings);
+    for (int i = 0; i < 200; ++i) {
+        part.applyForce(3, Vec3(2.0, 0, 0));
+        part.step();
+    }
+    ASSERT_EQ(part.zoneCount(), 1u);  // opened by the force at the default level
+    ASSERT_GT(countActiveSprings(*model, part.state().positions, 0.01), 0u);
+    int steps = 0;
+    while (part.zoneCount() > 0 && steps < 100000) {
+        part.step();
+        ++steps;
+    }
+    EXPECT_EQ(part.zoneCount(), 0u);
+    EXPECT_TRUE(part.movingMasses().empty());
+    EXPECT_TRUE(part.computedSprings().empty());
+    EXPECT_EQ(part.state().positions, model->restPositions);
+    StepCounters after;
+    part.step(&after);
+    EXPECT_EQ(after.springsEvaluated, 0u);
+}
+
+TEST(Part, LoadedZoneStaysOpen) {
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}});
+    Part part(model, zoneSettings());
+    for (int i = 0; i < 2000; ++i) {
+        part.applyForce(3, Vec3(1e-9, 0, 0));  // tiny: the zone is at rest but loaded
+        part.step();
+    }
+    EXPECT_EQ(part.zoneCount(), 1u);
+}
+
+TEST(Part, GrowingAndShrinkingKeepsTheStateOfMassesThatStay) {
+    const auto model = buildPartModel(makeTorus1());
+    Part part(model, zoneSettings());
+    const ZoneId zone = part.openZone(ZoneSeed::mass(50), 2);
+    for (int i = 0; i < 50; ++i) {
+        part.applyForce(50, Vec3(0, 1, 0));
+        part.step();
+    }
+    const Vec3 seedPosition = part.state().positions[50];
+    ASSERT_NE(seedPosition, model->restPositions[50]);
+    part.setZoneLevel(zone, 5);
+    EXPECT_EQ(asSet(part.movingMasses()), ringByExpansion(*model, {50}, 4));
+    EXPECT_EQ(part.state().positions[50], seedPosition);
+    part.setZoneLevel(zone, 1);
+    EXPECT_EQ(asSet(part.movingMasses()), std::set<Index>({50}));
+    EXPECT_EQ(part.state().positions[50], seedPosition);
+    for (Index m = 0; m < model->massCount(); ++m)
+        if (m != 50) {
+            EXPECT_EQ(part.state().positions[m], model->restPositions[m]);
+        }
+}
+
+TEST(Part, RigidMotionDoesNotDisturbAZone) {
+    const auto model = buildPartModel(makeTorus1());
+    Part still(model, zoneSettings()), moved(model, zoneSettings());
+    still.openZone(ZoneSeed::mass(20), 3);
+    moved.openZone(ZoneSeed::mass(20), 3);
+    const Vec3 localForce(0.3, -0.2, 0.1);
+    for (int i = 0; i < 500; ++i) {
+        moved.rotate(Vec3(0.2, 1.0, -0.4), 0.01);
+        moved.translate(Vec3(0.05, 0.0, -0.02));
+        still.applyForce(20, localForce);
+        moved.applyForce(20, moved.pose().rotate(localForce));  // the same force, in the moved frame
+        still.step();
+        moved.step();
+    }
+    EXPECT_LT(maxRelativeDifference(still.state().positions, moved.state().positions), 1e-12);
+    // World read-out = pose applied to the part-frame state.
+    std::vector<Vec3> world;
+    moved.worldPositions(world);
+    EXPECT_LT((world[20] - moved.pose().apply(moved.state().positions[20])).norm(), 1e-12);
+    EXPECT_LT((world[300] - moved.pose().apply(model->restPositions[300])).norm(), 1e-9);
+}
+
+TEST(Part, WholeMeshZoneMatchesFullDeformableModel) {
+    const auto model = buildPartModel(makeTorus1(), {Material::elastic(), 1.0, {}, {}});
+    PartSettings zones = zoneSettings();
+    zones.zones.fullSweepWhenComplete = false;  // exercise the compact-array path
+    zones.simulation.gravity = Vec3(0, -0.5, 0);
+    PartSettings full = zones;
+    full.mode = PartMode::FullDeformable;
+    Part a(model, zones), b(model, full);
+    a.openZone(ZoneSeed::mass(0), 40);
+    ASSERT_EQ(a.movingMasses().size(), model->massCount());
+    for (int i = 0; i < 1000; ++i) {
+        if (i < 300) {
+            a.applyForce(0, Vec3(0.5, 0.2, 0));
+            b.applyForce(0, Vec3(0.5, 0.2, 0));
+        }
+        a.step();
+        b.step();
+    }
+    EXPECT_LT(maxRelativeDifference(a.state().positions, b.state().positions), 1e-5);
+    EXPECT_LT(maxRelativeDifference(a.state().velocities, b.state().velocities), 1e-5);
+    EXPECT_NE(a.state().positions, model->restPositions);
+}
+
+TEST(Part, PartialRegionMatchesFullModelWithPinnedMasses) {
+    // Independent reference: the full model in which every mass outside the region is pinned
+    // by an enormous mass. Region masses must follow the same trajectory.
+    const TriMesh mesh = makeTorus1();
+    const auto model = buildPartModel(mesh);
+    Part part(model, zoneSettings());
+    part.openZone(ZoneSeed::mass(100), 4);
+    std::vector<double> masses(model->massCount(), 1e300);
+    for (Index m : part.movingMasses()) masses[m] = 1.0;
+    const auto pinned = buildPartModel(mesh, {Material::elastic(), 1.0, masses, {}});
+    PartState reference = PartState::atRest(*pinned);
+    SimulationSettings settings = zoneSettings().simulation;
+    for (int i = 0; i < 1000; ++i) {
+        part.applyForce(100, Vec3(0, 0, 0.4));
+        const PointLoad load{100, Vec3(0, 0, 0.4)};
+        stepFullModel(*pinned, settings, std::span(&load, 1), reference);
+        part.step();
+    }
+    EXPECT_LT(maxRelativeDifference(part.state().positions, reference.positions), 1e-12);
+}
+
+TEST(Part, RigidModeNeverDeforms) {
+    const auto model = buildPartModel(makeTorus1());
+    PartSettings settings;
+    settings.mode = PartMode::Rigid;
+    Part part(model, settings);
+    EXPECT_EQ(part.openZone(ZoneSeed::mass(1), 3), kNoZone);
+    part.applyForce(1, Vec3(100, 0, 0));
+    StepCounters counters;
+    part.step(&counters);
+    EXPECT_EQ(counters.springsEvaluated, 0u);
+    EXPECT_EQ(part.state().positions, model->restPositions);
+}
+
+TEST(Part, BadInputIsRejected) {
+    const auto model = buildPartModel(makeTorus1());
+    Part part(model);
+    EXPECT_THROW(part.openZone(ZoneSeed::mass(576), 1), InputError);
+    EXPECT_THROW(part.openZone(ZoneSeed::face(1152), 1), InputError);
+    EXPECT_THROW(part.openZone(ZoneSeed::mass(0), -1), InputError);
+    EXPECT_THROW(part.applyForce(9999, Vec3::Zero()), InputError);
+    EXPECT_THROW(part.applyForce(0, Vec3(NAN, 0, 0)), InputError);
+    EXPECT_THROW(part.rotate(Vec3::Zero(), 1.0), InputError);
+    PartSettings bad;
+    bad.zones.retireCheckInterval = 0;
+    EXPECT_THROW(Part(model, bad), InputError);
+    EXPECT_TRUE(part.movingMasses().empty());  // nothing half-done by the failed calls
+}
+
+TEST(Part, ZoneDepthsReadOut) {
+    const auto model = buildPartModel(makeTorus1());
+    Part part(model, zoneSettings());
+    part.openZone(ZoneSeed::mass(200), 3);
+    std::vector<int> depth;
+    part.zoneDepths(depth);
+    EXPECT_EQ(depth[200], 0);
+    for (Index n : model->topology.neighborsOf(200)) EXPECT_EQ(depth[n], 1);
+    EXPECT_EQ(std::count(depth.begin(), depth.end(), -1), std::ptrdiff_t(model->massCount() - part.movingMasses().size()));
+}
+
+TEST(Part, DeterministicStateHash) {
+    auto run = [] {
+        const auto model = buildPartModel(makeTorus2());
+        PartSettings settings = zoneSettings();
+        settings.simulation.gravity = Vec3(0, -9.81, 0);
+        Part part(model, settings);
+        part.openZone(ZoneSeed::face(17), 4);
+        for (int i = 0; i < 1500; ++i) {
+            if (i < 400) part.applyForce(900, Vec3(0.2, 0.1, 0));
+            part.rotate(Vec3::UnitY(), 1e-3);
+            part.step();
+        }
+        return stateHash(part.state());
+    };
+    EXPECT_EQ(run(), run());
+}
