@@ -26,10 +26,15 @@ test: release asan
 	ctest --preset release -j $(JOBS)
 	ctest --preset asan -j $(JOBS)
 
+BENCH_FLAGS := --benchmark_repetitions=12 --benchmark_enable_random_interleaving=true \
+	--benchmark_report_aggregates_only=true --benchmark_min_time=0.2 \
+	--benchmark_out_format=csv
 bench: release
-	build/release/bench/flexfit_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
-	  --benchmark_min_time=0.5 --benchmark_out=bench/results/msd_step.csv --benchmark_out_format=csv
-	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv BM_FlexfitFullStep BM_NaiveFullStep
+	build/release/bench/bench_msd_step $(BENCH_FLAGS) --benchmark_out=bench/results/msd_step.csv
+	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitFullStep BM_NaiveFullStep
+	build/release/bench/bench_part_step $(BENCH_FLAGS) --benchmark_out=bench/results/part_step.csv
+	build/release/bench/bench_part_ratios $(BENCH_FLAGS) --benchmark_out=bench/results/part_ratios.csv
+	/usr/bin/python3 tools/bench_ratios.py bench/results/part_ratios.csv --counter a_over_b
 
 clean:
 	rm -rf build out

@@ -1,5 +1,7 @@
 #include "cli_common.hpp"
 
+#include "perturbation_run.hpp"
+
 #include <fmt/core.h>
 
 #include <charconv>
@@ -48,6 +50,20 @@ PointLoad parseLoad(const std::string& text, const std::string& option) {
     if (ec != std::errc() || end != text.data() + colon)
         throw InputError("option " + option, 0, "'" + text + "': mass index is not a non-negative integer");
     return {Index(mass), parseVec3(text.substr(colon + 1), option)};
+}
+
+ZoneRequest parseZone(const std::string& text, const std::string& option) {
+    const std::size_t at = text.find('@');
+    const bool face = text.rfind("face:", 0) == 0;
+    const std::size_t begin = face ? 5 : 0;
+    unsigned long index = 0, level = 0;
+    const char* end = text.data() + text.size();
+    const auto parsedIndex = std::from_chars(text.data() + begin, text.data() + (at == std::string::npos ? text.size() : at), index);
+    const bool ok = at != std::string::npos && parsedIndex.ec == std::errc() && parsedIndex.ptr == text.data() + at &&
+                    std::from_chars(text.data() + at + 1, end, level).ptr == end && at + 1 < text.size();
+    if (!ok || level > 255)
+        throw InputError("option " + option, 0, "'" + text + "' is not MASS@LEVEL or face:F@LEVEL (level 0-255)");
+    return {face ? ZoneSeed::face(Index(index)) : ZoneSeed::mass(Index(index)), int(level)};
 }
 
 MeshReadResult loadMesh(const std::filesystem::path& path, double weldTolerance) {

@@ -15,6 +15,10 @@ Vec3 parseVec3(const std::string& text, const std::string& option);
 // "MASS:FX,FY,FZ" -> PointLoad; throws InputError naming `option`.
 PointLoad parseLoad(const std::string& text, const std::string& option);
 
+// "MASS@LEVEL" or "face:F@LEVEL" -> zone request; throws InputError naming `option`.
+struct ZoneRequest;
+ZoneRequest parseZone(const std::string& text, const std::string& option);
+
 // Reads any supported mesh and prints its warnings to stderr.
 MeshReadResult loadMesh(const std::filesystem::path& path, double weldTolerance = 0.0);
 

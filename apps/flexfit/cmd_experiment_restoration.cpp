@@ -51,15 +51,16 @@ SimulationSettings anchorSettings(const Material& m, const ExperimentOptions& op
 MaterialRun runMaterial(const std::string& name, const Material& material, const ExperimentOptions& opt, std::ostream& series) {
     PerturbationConfig config;
     config.model = buildPartModel(makeTorus1(), PartModelSettings{material, 1.0, {}, {}});
-    config.settings = anchorSettings(material, opt);
+    config.part.mode = PartMode::FullDeformable;
+    config.part.simulation = anchorSettings(material, opt);
     config.loads = {{opt.mass, Vec3(opt.force, 0.0, 0.0)}};
     config.loadDuration = opt.loadDuration;
     config.duration = opt.maxDuration;
     config.stopWhenRestored = true;
     const auto every = std::uint64_t(std::max(1.0, std::round(0.01 / opt.timeStep)));  // 10 ms samples
-    auto observer = [&](const PartState& state, const std::vector<ActivityTracker>& trackers) {
-        if (state.stepCount % every == 0)
-            series << name << "," << fmt::format("{:.3f}", state.time) << "," << trackers[0].activeNow() << ","
+    auto observer = [&](const Part& part, const std::vector<ActivityTracker>& trackers) {
+        if (part.state().stepCount % every == 0)
+            series << name << "," << fmt::format("{:.3f}", part.time()) << "," << trackers[0].activeNow() << ","
                    << trackers[1].activeNow() << "\n";
     };
     ProgressBar bar("restoration " + name);

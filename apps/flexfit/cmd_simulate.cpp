@@ -24,6 +24,9 @@ struct SimulateOptions {
     std::vector<double> objTimes;
     std::string objPrefix = "frame";
     bool untilRestored = false;
+    std::string mode = "full";
+    std::vector<std::string> zones;
+    int defaultLevel = 2;
 };
 
 // Writes the deformed mesh whenever the simulation crosses one of the requested times.
@@ -33,13 +36,13 @@ public:
         : model_(model), times_(std::move(times)), prefix_(std::move(prefix)) {
         std::sort(times_.begin(), times_.end());
     }
-    void observe(const PartState& state) {
-        while (next_ < times_.size() && state.time + 1e-12 >= times_[next_]) {
+    void observe(const Part& part) {
+        while (next_ < times_.size() && part.time() + 1e-12 >= times_[next_]) {
             TriMesh mesh = model_.mesh;
-            mesh.vertices = state.positions;
+            part.worldPositions(mesh.vertices);
             const std::string path = fmt::format("{}_{:.4f}.obj", prefix_, times_[next_]);
             writeObj(mesh, path);
-            fmt::print("wrote {} (t = {:.4f} s)\n", path, state.time);
+            fmt::print("wrote {} (t = {:.4f} s)\n", path, part.time());
             ++next_;
         }
     }
@@ -55,7 +58,11 @@ void run(const SimulateOptions& opt) {
     const MeshReadResult read = loadMesh(opt.file);
     PerturbationConfig config;
     config.model = buildPartModel(read.mesh, opt.sim.modelSettings());
-    config.settings = opt.sim.simulationSettings(*config.model);
+    config.part.simulation = opt.sim.simulationSettings(*config.model);
+    config.part.mode = opt.mode == "rigid" ? PartMode::Rigid : opt.mode == "full" ? PartMode::FullDeformable : PartMode::RigidDeformable;
+    config.part.zones.defaultLevel = opt.defaultLevel;
+    config.part.zones.activityThreshold = opt.thresholds.empty() ? 0.01 : opt.thresholds.front();
+    for (const std::string& z : opt.zones) config.zones.push_back(parseZone(z, "--zone"));
     for (const std::string& f : opt.forces) config.loads.push_back(parseLoad(f, "--force"));
     config.loadDuration = opt.forceDuration;
     config.duration = opt.duration;
@@ -68,30 +75,34 @@ void run(const SimulateOptions& opt) {
         if (!csv) throw InputError(opt.csv, 0, "cannot open the file for writing");
         csv << "step,time";
         for (double t : opt.thresholds) csv << ",active_" << t;
-        csv << ",kinetic_energy,max_displacement\n";
+        csv << ",kinetic_energy,max_displacement,moving_masses,computed_springs,zones\n";
     }
     ObjFrames frames(*config.model, opt.objTimes, opt.objPrefix);
     const PartModel& model = *config.model;
-    auto observer = [&](const PartState& state, const std::vector<ActivityTracker>& trackers) {
-        frames.observe(state);
+    auto observer = [&](const Part& part, const std::vector<ActivityTracker>& trackers) {
+        const PartState& state = part.state();
+        frames.observe(part);
         if (!csv.is_open() || state.stepCount % std::uint64_t(opt.every) != 0) return;
         double kinetic = 0.0, displacement = 0.0;
-        for (std::size_t i = 0; i < model.massCount(); ++i) {
+        for (Index i : part.movingMasses()) {
             kinetic += 0.5 * model.mass[i] * state.velocities[i].squaredNorm();
             displacement = std::max(displacement, (state.positions[i] - model.restPositions[i]).norm());
         }
         csv << state.stepCount << "," << fmt::format("{:.6f}", state.time);
         for (const ActivityTracker& t : trackers) csv << "," << t.activeNow();
-        csv << "," << fmt::format("{:.9g},{:.9g}", kinetic, displacement) << "\n";
+        csv << "," << fmt::format("{:.9g},{:.9g}", kinetic, displacement) << "," << part.movingMasses().size() << ","
+            << part.computedSprings().size() << "," << part.zoneCount() << "\n";
     };
     ProgressBar bar("simulate");
     const PerturbationResult result = runPerturbation(config, observer, [&](double f) { bar.update(f); });
     bar.finish();
 
-    fmt::print("{}: {} masses, {} springs, {} steps of {} s ({}, restore {}), {:.0f} steps/s\n", model.name,
-               model.massCount(), model.springCount(), result.steps, config.settings.timeStep,
-               toString(config.settings.integrator), toString(config.settings.restoration.method),
-               double(result.steps) / std::max(result.wallSeconds, 1e-9));
+    const SimulationSettings& s = config.part.simulation;
+    fmt::print("{}: {} masses, {} springs, mode {}, {} steps of {} s ({}, restore {}), {:.0f} steps/s\n", model.name,
+               model.massCount(), model.springCount(), toString(config.part.mode), result.steps, s.timeStep,
+               toString(s.integrator), toString(s.restoration.method), double(result.steps) / std::max(result.wallSeconds, 1e-9));
+    fmt::print("active region: at most {} moving masses and {} computed springs; {} spring evaluations in all\n",
+               result.maxMovingMasses, result.maxComputedSprings, result.counters.springsEvaluated);
     for (const ActivityTracker& t : result.trackers) {
         const auto restored = t.restorationTime();
         fmt::print("threshold {}: max active {}, total distinct {}, restoration time {}\n", t.threshold(), t.maxActive(),
@@ -106,11 +117,18 @@ void registerSimulate(CLI::App& app) {
     auto* cmd = app.add_subcommand("simulate", "Simulate a full-deformable part under point loads");
     auto opt = std::make_shared<SimulateOptions>();
     cmd->add_option("file", opt->file, "Mesh file")->required();
+    cmd->footer("In --mode zones, a force on a mass no zone covers opens a zone there at --level; zones retire once\n"
+                "their springs are inactive at the first --threshold and their masses at rest.");
     opt->sim.addTo(*cmd);
     cmd->add_option("--force", opt->forces, "Point load MASS:FX,FY,FZ (repeatable)");
     cmd->add_option("--force-duration", opt->forceDuration, "Seconds the loads act before release")->capture_default_str();
     cmd->add_option("--duration", opt->duration, "Simulated seconds")->check(CLI::PositiveNumber)->capture_default_str();
     cmd->add_option("--threshold", opt->thresholds, "Activity thresholds (length units)")->capture_default_str();
+    cmd->add_option("--mode", opt->mode, "rigid (never deforms), zones (rigid-deformable), full (whole-mesh MSD)")
+        ->check(CLI::IsMember({"rigid", "zones", "full"}))->capture_default_str();
+    cmd->add_option("--zone", opt->zones, "Zone MASS@LEVEL or face:F@LEVEL opened at the start (repeatable, --mode zones)");
+    cmd->add_option("--level", opt->defaultLevel, "Level of zones opened by forces (--mode zones)")
+        ->check(CLI::Range(1, 255))->capture_default_str();
     cmd->add_flag("--until-restored", opt->untilRestored, "Stop once every threshold has restored after the release");
     cmd->add_option("--csv", opt->csv, "Per-step metrics CSV");
     cmd->add_option("--every", opt->every, "Write every N-th step to the CSV")->check(CLI::PositiveNumber)->capture_default_str();

@@ -12,5 +12,6 @@ void registerConvert(CLI::App& app);
 void registerGen(CLI::App& app);
 void registerSimulate(CLI::App& app);
 void registerExperimentRestoration(CLI::App& experiment);
+void registerExperimentZones(CLI::App& experiment);
 
 }  // namespace flexfit::cli

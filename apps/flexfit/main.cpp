@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
     CLI::App* experiment = app.add_subcommand("experiment", "Reproduce the thesis's experiments");
     experiment->require_subcommand(1);
     flexfit::cli::registerExperimentRestoration(*experiment);
+    flexfit::cli::registerExperimentZones(*experiment);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

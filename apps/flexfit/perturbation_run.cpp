@@ -12,31 +12,35 @@ PerturbationResult runPerturbation(const PerturbationConfig& config, const StepO
         if (load.mass >= model.massCount())
             throw InputError("load", 0, "mass " + std::to_string(load.mass) + " does not exist (the model has " +
                                             std::to_string(model.massCount()) + " masses)");
+    Part part(config.model, config.part);
+    for (const ZoneRequest& zone : config.zones) part.openZone(zone.seed, zone.level);
     PerturbationResult result;
-    result.state = PartState::atRest(model);
     for (double t : config.thresholds) result.trackers.emplace_back(model, t);
 
-    const double h = config.settings.timeStep;
+    const double h = config.part.simulation.timeStep;
     const auto totalSteps = std::size_t(std::llround(config.duration / h));
     const auto loadSteps = std::size_t(std::llround(config.loadDuration / h));
-    const std::span<const PointLoad> noLoads;
     const auto start = std::chrono::steady_clock::now();
     for (std::size_t step = 0; step < totalSteps; ++step) {
         if (step == loadSteps)
-            for (ActivityTracker& tracker : result.trackers) tracker.markRelease(result.state.time);
-        stepFullModel(model, config.settings, step < loadSteps ? std::span<const PointLoad>(config.loads) : noLoads,
-                      result.state);
+            for (ActivityTracker& tracker : result.trackers) tracker.markRelease(part.time());
+        if (step < loadSteps)
+            for (const PointLoad& load : config.loads) part.applyForce(load.mass, load.force);
+        result.maxMovingMasses = std::max(result.maxMovingMasses, part.movingMasses().size());
+        result.maxComputedSprings = std::max(result.maxComputedSprings, part.computedSprings().size());
+        part.step(&result.counters);
         bool allRestored = step >= loadSteps;
         for (ActivityTracker& tracker : result.trackers) {
-            tracker.observe(model, result.state);
+            tracker.observe(model, part.state(), part.computedSprings());
             allRestored = allRestored && tracker.restorationTime().has_value();
         }
         ++result.steps;
-        if (observer) observer(result.state, result.trackers);
+        if (observer) observer(part, result.trackers);
         if (progress && step % 256 == 0) progress(double(step) / double(totalSteps));
         if (config.stopWhenRestored && allRestored) break;
     }
     result.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.state = part.state();
     return result;
 }
 

@@ -16,7 +16,7 @@ struct SimulationOptions {
     double vertexMass = 1.0;
     std::string restore = "constraint";
     double anchorStiffness = -1.0, anchorDamping = -1.0;  // < 0: the material's k and b
-    double constraintFraction = 0.05;
+    double constraintFraction = 1e-3;
     std::string integrator = "semi-implicit";
     double timeStep = 1e-3;
     std::string gravity = "0,0,0";

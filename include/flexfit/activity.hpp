@@ -21,6 +21,9 @@ public:
 
     // Counts the active springs of `state` and folds them into the run totals; returns the count.
     std::size_t observe(const PartModel& model, const PartState& state);
+    // The same, checking only `springs`: for a rigid-deformable part, its computed springs
+    // (every other spring joins two masses at rest and is inactive by construction).
+    std::size_t observe(const PartModel& model, const PartState& state, std::span<const Index> springs);
     // The load is released at `time`: the restoration clock starts.
     void markRelease(double time);
 
@@ -33,6 +36,9 @@ public:
     std::optional<double> restorationTime() const { return restorationTime_; }
 
 private:
+    void countIfActive(const PartModel& model, const PartState& state, Index spring);
+    std::size_t finishObservation(const PartState& state);
+
     double threshold_;
     std::vector<unsigned char> everActive_;  // (E)
     std::size_t activeNow_ = 0;

@@ -21,15 +21,27 @@ ActivityTracker::ActivityTracker(const PartModel& model, double threshold)
 
 std::size_t ActivityTracker::observe(const PartModel& model, const PartState& state) {
     activeNow_ = 0;
-    for (std::size_t e = 0; e < model.springCount(); ++e) {
-        const double length = (state.positions[model.springA[e]] - state.positions[model.springB[e]]).norm();
-        if (!(std::abs(length - model.restLength[e]) > threshold_)) continue;
-        ++activeNow_;
-        if (everActive_[e] == 0) {
-            everActive_[e] = 1;
-            ++totalDistinct_;
-        }
+    for (Index e = 0; e < model.springCount(); ++e) countIfActive(model, state, e);
+    return finishObservation(state);
+}
+
+std::size_t ActivityTracker::observe(const PartModel& model, const PartState& state, std::span<const Index> springs) {
+    activeNow_ = 0;
+    for (Index e : springs) countIfActive(model, state, e);
+    return finishObservation(state);
+}
+
+void ActivityTracker::countIfActive(const PartModel& model, const PartState& state, Index e) {
+    const double length = (state.positions[model.springA[e]] - state.positions[model.springB[e]]).norm();
+    if (!(std::abs(length - model.restLength[e]) > threshold_)) return;
+    ++activeNow_;
+    if (everActive_[e] == 0) {
+        everActive_[e] = 1;
+        ++totalDistinct_;
     }
+}
+
+std::size_t ActivityTracker::finishObservation(const PartState& state) {
     maxActive_ = std::max(maxActive_, activeNow_);
     if (releaseTime_ && !restorationTime_ && activeNow_ == 0) restorationTime_ = state.time - *releaseTime_;
     return activeNow_;

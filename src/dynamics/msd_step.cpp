@@ -1,5 +1,6 @@
 // One step of the full mass-spring-damper model: a single sweep over the masses.
 #include "flexfit/simulation.hpp"
+#include "flush_denormals.hpp"
 #include "mass_update.hpp"
 
 #include <cmath>
@@ -60,6 +61,7 @@ void validateSettings(const SimulationSettings& s) {
 
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
                    PartState& state, StepCounters* counters) {
+    const detail::FlushDenormals flush;
     for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
     sweep(model, detail::MassUpdate::from(settings), state);
     state.time += settings.timeStep;

@@ -1,5 +1,6 @@
 // The step of an active region (rigid-deformable parts): springs, then moving masses.
 #include "flexfit/simulation.hpp"
+#include "flush_denormals.hpp"
 #include "mass_update.hpp"
 
 namespace flexfit {
@@ -7,6 +8,7 @@ namespace flexfit {
 void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, std::span<const Index> moving,
                       std::span<const Index> computed, std::span<const std::uint16_t> movingMask, PartState& state,
                       StepCounters* counters) {
+    const detail::FlushDenormals flush;
     const detail::MassUpdate p = detail::MassUpdate::from(settings);
     const Index* springA = model.springA.data();
     const Index* springB = model.springB.data();
