@@ -46,6 +46,7 @@ const char* toString(PartMode mode);
 
 struct ZoneSettings {
     int defaultLevel = 2;            // level of zones opened by forces
+    int contactLevel = 2;            // level of zones opened by contacts
     double activityThreshold = 0.01; // spring activity and rest-distance threshold (length units)
     double restSpeed = 1e-3;         // masses slower than this are at rest
     int retireCheckInterval = 16;    // steps between retirement checks of an unloaded zone
@@ -102,6 +103,18 @@ public:
     // keeps the covering zones alive. Ignored in Rigid mode. Throws InputError for a bad mass.
     void applyForce(Index mass, const Vec3& worldForce);
 
+    // --- Contacts (collision response) ---
+    // Opens a zone at `face` (contactLevel) unless zones already move its masses, and keeps the
+    // zones there alive. Ignored in Rigid mode. Throws InputError for a bad face.
+    void touchFace(Index face);
+    // Moves a moving mass by a world-frame displacement and removes the part of its velocity
+    // that points against it (the contact is inelastic). Ignored for masses that do not move.
+    void displaceMass(Index mass, const Vec3& worldDisplacement);
+    // Masses whose position may have changed since clearChangedMasses(): every mass stepped or
+    // displaced, and every mass that returned to rest. Collision hierarchies refit from it.
+    std::span<const Index> changedMasses() const { return changed_; }
+    void clearChangedMasses();
+
     // --- Step ---
     void step(StepCounters* counters = nullptr);
 
@@ -150,6 +163,11 @@ private:
     std::vector<Index> computed_;             // computed springs (compact)
     std::vector<Index> computedSlot_;         // (E) position in computed_, or kAbsent
     std::vector<std::uint64_t> lastLoadStep_; // (V) step of the last force on each mass
+    std::vector<Index> changed_;              // masses changed since clearChangedMasses()
+    std::vector<std::uint32_t> changedMark_;  // (V) epoch at which a mass was listed
+    std::uint32_t changeEpoch_ = 1;
+
+    void markChanged(Index mass);
 };
 
 }  // namespace flexfit

@@ -13,6 +13,7 @@ const std::string kPartSource = "part";
 
 void checkZoneSettings(const ZoneSettings& z) {
     if (z.defaultLevel < 0 || z.defaultLevel > 255) throw InputError("zone settings", 0, "default level must be in [0, 255]");
+    if (z.contactLevel < 0 || z.contactLevel > 255) throw InputError("zone settings", 0, "contact level must be in [0, 255]");
     if (!(z.activityThreshold > 0.0) || !std::isfinite(z.activityThreshold))
         throw InputError("zone settings", 0, "activity threshold must be finite and > 0");
     if (!(z.restSpeed >= 0.0) || !std::isfinite(z.restSpeed))
@@ -40,7 +41,8 @@ Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
       movingSlot_(model_->massCount(), kAbsent),
       springEnds_(model_->springCount(), 0),
       computedSlot_(model_->springCount(), kAbsent),
-      lastLoadStep_(model_->massCount(), kNeverLoaded) {
+      lastLoadStep_(model_->massCount(), kNeverLoaded),
+      changedMark_(model_->massCount(), 0) {
     validateSettings(settings_.simulation);
     checkZoneSettings(settings_.zones);
     if (settings_.mode == PartMode::FullDeformable) {
@@ -104,6 +106,21 @@ void Part::removeMoving(Index mass) {
     state_.positions[mass] = model_->restPositions[mass];
     state_.velocities[mass] = Vec3::Zero();
     state_.forces[mass] = Vec3::Zero();
+    markChanged(mass);
+}
+
+void Part::markChanged(Index mass) {
+    if (changedMark_[mass] == changeEpoch_) return;
+    changedMark_[mass] = changeEpoch_;
+    changed_.push_back(mass);
+}
+
+void Part::clearChangedMasses() {
+    changed_.clear();
+    if (++changeEpoch_ == 0) {
+        std::fill(changedMark_.begin(), changedMark_.end(), 0u);
+        changeEpoch_ = 1;
+    }
 }
 
 void Part::cover(std::span<const RingMember> members) {
@@ -220,7 +237,34 @@ void Part::step(StepCounters* counters) {
         return;
     }
     stepRegion(counters);
+    for (Index m : moving_) markChanged(m);
     if (settings_.mode == PartMode::RigidDeformable) retireRestingZones();
+}
+
+// --- Contacts ---
+
+void Part::touchFace(Index face) {
+    if (face >= model_->faceCount())
+        throw InputError(kPartSource, 0, "face " + std::to_string(face) + " does not exist (the model has " +
+                                             std::to_string(model_->faceCount()) + " faces)");
+    if (settings_.mode == PartMode::Rigid) return;
+    const Face& f = model_->mesh.faces[face];
+    if (settings_.mode == PartMode::RigidDeformable && (cover_[f[0]] == 0 || cover_[f[1]] == 0 || cover_[f[2]] == 0))
+        openZone(ZoneSeed::face(face), std::max(settings_.zones.contactLevel, 1));
+    for (Index m : f) lastLoadStep_[m] = state_.stepCount;
+}
+
+void Part::displaceMass(Index mass, const Vec3& worldDisplacement) {
+    if (mass >= model_->massCount() || cover_[mass] == 0 || settings_.mode == PartMode::Rigid) return;
+    const Vec3 d = pose_.rotateInverse(worldDisplacement);
+    state_.positions[mass] += d;
+    const double length = d.norm();
+    if (length > 0.0) {
+        const Vec3 direction = d / length;
+        const double against = state_.velocities[mass].dot(direction);
+        if (against < 0.0) state_.velocities[mass] -= against * direction;
+    }
+    markChanged(mass);
 }
 
 bool Part::zoneAtRest(const Zone& zone) const {

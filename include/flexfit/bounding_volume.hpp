@@ -1,0 +1,61 @@
+// Bounding volumes of the collision hierarchies, and their overlap tests across part frames.
+//
+// Sphere: the thesis's volume (eq. 4.1-4.2): cheapest test, rotation-invariant, loose on flat
+// or elongated geometry. Aabb: axis-aligned in the part's own frame, so a rigid motion never
+// refits it; against another part's box the test is the separating-axis test of two oriented
+// boxes (Gottschalk et al., 15 axes), since each box is aligned only in its own frame.
+#pragma once
+
+#include "flexfit/core.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+
+namespace flexfit {
+
+enum class BoundingVolumeKind { Sphere, Aabb };
+const char* toString(BoundingVolumeKind kind);
+
+struct Sphere {
+    Vec3 centre = Vec3::Zero();
+    double radius = 0.0;
+
+    // The thesis's construction: centre at the midpoint of the points' bounding box, radius to
+    // the farthest point.
+    static Sphere around(std::span<const Vec3> points);
+    // Smallest sphere enclosing two spheres.
+    static Sphere merge(const Sphere& a, const Sphere& b);
+    double size() const { return radius; }
+};
+
+struct Aabb {
+    Vec3 min = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 max = Vec3::Constant(-std::numeric_limits<double>::infinity());
+
+    static Aabb around(std::span<const Vec3> points);
+    static Aabb merge(const Aabb& a, const Aabb& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
+    Vec3 centre() const { return 0.5 * (min + max); }
+    Vec3 halfExtents() const { return 0.5 * (max - min); }
+    double size() const { return (max - min).norm(); }
+};
+
+// The pose of frame B seen from frame A: x_A = rotation * x_B + translation. absRotation holds
+// |rotation| + epsilon for the box tests (guards parallel axes against round-off).
+struct RelativePose {
+    Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d absRotation = Eigen::Matrix3d::Identity();
+    Vec3 translation = Vec3::Zero();
+
+    RelativePose() = default;
+    RelativePose(const Eigen::Matrix3d& r, const Vec3& t);
+    Vec3 apply(const Vec3& pB) const { return rotation * pB + translation; }
+};
+
+// Overlap of a volume in frame A with a volume in frame B (touching counts as overlap).
+bool overlap(const Sphere& a, const Sphere& b, const RelativePose& bInA);
+bool overlap(const Aabb& a, const Aabb& b, const RelativePose& bInA);
+bool overlap(const Sphere& a, const Aabb& b, const RelativePose& bInA);
+bool overlap(const Aabb& a, const Sphere& b, const RelativePose& bInA);
+
+}  // namespace flexfit

@@ -1,0 +1,147 @@
+// A bounding-volume hierarchy over items (faces of a part, or parts of a scene), generic over
+// the volume (Sphere or Aabb).
+//
+// Built top-down as the thesis does (4.3): the root encloses every item; a node splits its
+// items at the centre of their centres' bounding box along its longest axis (at the median
+// when that leaves a side empty), down to one item per leaf. Nodes live in one array, children
+// after their parent, with parent links for refits.
+//
+// refit() updates the leaves of the items that changed and then only their ancestors, bottom-up
+// in order of depth, so a local deformation costs O(changed x depth), not O(items). Marks are
+// epoch-stamped: a refit allocates nothing once its scratch arrays have grown.
+#pragma once
+
+#include "flexfit/bounding_volume.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <numeric>
+#include <vector>
+
+namespace flexfit {
+
+// Volume enclosing a set of child volumes, as the top-down build makes it.
+Sphere encloseAll(std::span<const Sphere> volumes, std::span<const Index> which);
+Aabb encloseAll(std::span<const Aabb> volumes, std::span<const Index> which);
+inline Sphere mergeVolumes(const Sphere& a, const Sphere& b) { return Sphere::merge(a, b); }
+inline Aabb mergeVolumes(const Aabb& a, const Aabb& b) { return Aabb::merge(a, b); }
+inline Vec3 centreOf(const Sphere& s) { return s.centre; }
+inline Vec3 centreOf(const Aabb& b) { return b.centre(); }
+
+template <class BV>
+class Bvh {
+public:
+    struct Node {
+        BV volume;
+        std::int32_t left = -1;   // child indices; -1 for a leaf
+        std::int32_t right = -1;
+        std::int32_t parent = -1;
+        Index item = 0;           // the leaf's item
+        std::uint16_t depth = 0;
+        bool isLeaf() const { return left < 0; }
+    };
+
+    // Builds over items 0..n-1 with the given leaf volumes.
+    void build(std::span<const BV> leafVolumes) {
+        nodes_.clear();
+        leafOf_.assign(leafVolumes.size(), 0);
+        if (leafVolumes.empty()) return;
+        nodes_.reserve(2 * leafVolumes.size());
+        std::vector<Index> items(leafVolumes.size());
+        std::iota(items.begin(), items.end(), Index(0));
+        buildNode(leafVolumes, items, 0, items.size(), -1, 0);
+        mark_.assign(nodes_.size(), 0);
+    }
+
+    // Leaves of `items` get new volumes from leafVolume(item); their ancestors are refitted.
+    template <class LeafVolume>
+    void refit(std::span<const Index> items, LeafVolume leafVolume) {
+        if (nodes_.empty()) return;
+        if (++epoch_ == 0) {
+            std::fill(mark_.begin(), mark_.end(), 0u);
+            epoch_ = 1;
+        }
+        dirty_.clear();
+        for (Index item : items) {
+            std::int32_t n = std::int32_t(leafOf_[item]);
+            nodes_[std::size_t(n)].volume = leafVolume(item);
+            ++refitNodes_;
+            for (n = nodes_[std::size_t(n)].parent; n >= 0 && mark_[std::size_t(n)] != epoch_; n = nodes_[std::size_t(n)].parent) {
+                mark_[std::size_t(n)] = epoch_;
+                dirty_.push_back(n);
+            }
+        }
+        std::sort(dirty_.begin(), dirty_.end(),
+                  [&](std::int32_t x, std::int32_t y) { return nodes_[std::size_t(x)].depth > nodes_[std::size_t(y)].depth; });
+        for (std::int32_t n : dirty_) {
+            Node& node = nodes_[std::size_t(n)];
+            node.volume = mergeVolumes(nodes_[std::size_t(node.left)].volume, nodes_[std::size_t(node.right)].volume);
+        }
+        refitNodes_ += dirty_.size();
+    }
+
+    // Every leaf from leafVolume(item), then every internal node, bottom-up.
+    template <class LeafVolume>
+    void refitAll(LeafVolume leafVolume) {
+        for (std::size_t i = nodes_.size(); i-- > 0;) {
+            Node& node = nodes_[i];
+            node.volume = node.isLeaf() ? leafVolume(node.item)
+                                        : mergeVolumes(nodes_[std::size_t(node.left)].volume, nodes_[std::size_t(node.right)].volume);
+        }
+        refitNodes_ += nodes_.size();
+    }
+
+    const std::vector<Node>& nodes() const { return nodes_; }
+    bool empty() const { return nodes_.empty(); }
+    const BV& rootVolume() const { return nodes_.front().volume; }
+    std::size_t refitNodeCount() const { return refitNodes_; }  // nodes recomputed by refits so far
+
+private:
+    std::int32_t buildNode(std::span<const BV> leaves, std::vector<Index>& items, std::size_t begin, std::size_t end,
+                           std::int32_t parent, std::uint16_t depth) {
+        const auto index = std::int32_t(nodes_.size());
+        nodes_.push_back({});
+        nodes_.back().parent = parent;
+        nodes_.back().depth = depth;
+        const std::span<const Index> range(items.data() + begin, end - begin);
+        if (end - begin == 1) {
+            nodes_[std::size_t(index)].volume = leaves[items[begin]];
+            nodes_[std::size_t(index)].item = items[begin];
+            leafOf_[items[begin]] = Index(index);
+            return index;
+        }
+        nodes_[std::size_t(index)].volume = encloseAll(leaves, range);
+        const std::size_t middle = split(leaves, items, begin, end);
+        const std::int32_t left = buildNode(leaves, items, begin, middle, index, std::uint16_t(depth + 1));
+        const std::int32_t right = buildNode(leaves, items, middle, end, index, std::uint16_t(depth + 1));
+        nodes_[std::size_t(index)].left = left;
+        nodes_[std::size_t(index)].right = right;
+        return index;
+    }
+
+    // Splits at the centre of the centres' bounds, along its longest axis.
+    static std::size_t split(std::span<const BV> leaves, std::vector<Index>& items, std::size_t begin, std::size_t end) {
+        Eigen::AlignedBox3d centres;
+        for (std::size_t i = begin; i < end; ++i) centres.extend(centreOf(leaves[items[i]]));
+        int axis = 0;
+        centres.sizes().maxCoeff(&axis);
+        const double cut = centres.center()[axis];
+        auto first = items.begin() + std::ptrdiff_t(begin), last = items.begin() + std::ptrdiff_t(end);
+        auto middle = std::partition(first, last, [&](Index i) { return centreOf(leaves[i])[axis] < cut; });
+        if (middle == first || middle == last) {  // all centres on one side: median split
+            middle = first + (last - first) / 2;
+            std::nth_element(first, middle, last,
+                             [&](Index x, Index y) { return centreOf(leaves[x])[axis] < centreOf(leaves[y])[axis]; });
+        }
+        return std::size_t(middle - items.begin());
+    }
+
+    std::vector<Node> nodes_;
+    std::vector<Index> leafOf_;          // item -> leaf node
+    std::vector<std::uint32_t> mark_;    // (nodes) refit epoch marks
+    std::vector<std::int32_t> dirty_;    // scratch
+    std::uint32_t epoch_ = 0;
+    std::size_t refitNodes_ = 0;
+};
+
+}  // namespace flexfit

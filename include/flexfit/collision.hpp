@@ -1,0 +1,93 @@
+// Collision detection between parts (SPEC 6, thesis 4.3): face hierarchies, the narrow phase
+// and contacts.
+//
+// PartCollider keeps one part's face hierarchy in the part's own frame: a rigid motion never
+// touches it (queries carry the relative pose), and a deformation refits only the leaves of
+// the faces around masses that moved and their ancestors. Leaf volumes: the face sphere
+// (barycentre, radius to the farthest vertex, thesis 4.3) or the face's box.
+//
+// queryPair() traverses two hierarchies together (descending the larger volume first) and
+// tests each overlapping leaf pair exactly:
+//   SphereTriangle   (the thesis's test) the face sphere of part A against the triangle of
+//                    part B, closest point on the triangle (Ericson 5.1.5);
+//   TriangleTriangle the two triangles (separating axes; point, normal, depth), which does not
+//                    report sphere-sized false contacts on large faces.
+// A contact's normal is a world unit vector: moving part A by depth * normal (or part B by
+// the opposite) separates the pair.
+#pragma once
+
+#include "flexfit/bvh.hpp"
+#include "flexfit/part.hpp"
+#include "flexfit/triangle_queries.hpp"
+
+#include <variant>
+
+namespace flexfit {
+
+enum class ExactTest { SphereTriangle, TriangleTriangle };
+const char* toString(ExactTest test);
+
+struct Contact {
+    std::uint32_t partA = 0, partB = 0;
+    Index faceA = 0, faceB = 0;
+    Vec3 point = Vec3::Zero();   // world
+    Vec3 normal = Vec3::UnitY(); // world, unit: pushes A out of B
+    double depth = 0.0;
+};
+
+struct QueryStats {
+    std::size_t volumeTests = 0;     // bounding-volume overlap tests (nodes visited in pairs)
+    std::size_t candidatePairs = 0;  // leaf pairs whose volumes overlap
+    std::size_t exactTests = 0;
+    std::size_t contacts = 0;
+    QueryStats& operator+=(const QueryStats& o);
+};
+
+class PartCollider {
+public:
+    // `test` decides what the leaves bound: sphere leaves are face spheres either way; box
+    // leaves bound the triangle for TriangleTriangle and the face sphere for SphereTriangle
+    // (whose exact test uses the sphere, so a box of the triangle could cull true contacts).
+    PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest test = ExactTest::TriangleTriangle);
+
+    BoundingVolumeKind kind() const { return kind_; }
+    ExactTest exactTest() const { return test_; }
+    // Rebuilds the hierarchy from the part's current (part-frame) positions.
+    void rebuild(const Part& part);
+    // Refits the faces around `changedMasses` (positions read from the part).
+    void refit(const Part& part, std::span<const Index> changedMasses);
+
+    // The part's bounding sphere in its own frame: the thesis's sphere of the rest shape
+    // (midpoint of the masses' box, radius to the farthest mass), grown by the largest
+    // displacement of a mass from rest. world: transformed by the pose.
+    Sphere localSphere() const { return {restSphere_.centre, restSphere_.radius + maxDisplacement_}; }
+    Sphere worldSphere(const Part& part) const;
+
+    const Bvh<Sphere>* spheres() const { return std::get_if<Bvh<Sphere>>(&bvh_); }
+    const Bvh<Aabb>* boxes() const { return std::get_if<Bvh<Aabb>>(&bvh_); }
+    std::size_t refitNodeCount() const;
+
+private:
+    BoundingVolumeKind kind_;
+    ExactTest test_;
+    std::variant<Bvh<Sphere>, Bvh<Aabb>> bvh_;
+    Sphere restSphere_;
+    double maxDisplacement_ = 0.0;
+    std::vector<std::uint32_t> faceMark_;  // (F) refit epochs
+    std::vector<Index> changedFaces_;      // scratch
+    std::uint32_t epoch_ = 0;
+};
+
+// Leaf volumes of a face from part-frame positions.
+Sphere faceSphere(std::span<const Vec3> positions, const Face& face);
+Aabb faceBox(std::span<const Vec3> positions, const Face& face);
+Aabb faceSphereBox(std::span<const Vec3> positions, const Face& face);  // box of the face sphere
+
+// Contacts between parts a and b (ids are written into the contacts). Appends to `contacts`;
+// when `candidates` is given, also appends every leaf pair whose volumes overlap. Both
+// colliders must have been built for `test` (std::invalid_argument otherwise).
+void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
+               const PartCollider& colliderB, ExactTest test, std::vector<Contact>& contacts, QueryStats& stats,
+               std::vector<std::pair<Index, Index>>* candidates = nullptr);
+
+}  // namespace flexfit

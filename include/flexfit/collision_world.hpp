@@ -1,0 +1,80 @@
+// The parts that can touch, their collision hierarchies, the broad phase, and the response
+// of rigid-deformable parts to contacts (SPEC 6, thesis 4.3).
+//
+// Broad phase (thesis 4.3): a hierarchy of the parts' bounding spheres in the world, built
+// top-down like the face hierarchies; each part's sphere is tested against it depth-first and
+// gives candidate pairs. Parts move every step, so by default the tree is refitted bottom-up
+// (O(parts)) and rebuilt only on request (BroadPhaseUpdate::Rebuild rebuilds every update).
+//
+// Narrow phase: per candidate pair, the two face hierarchies traversed together (collision.hpp).
+// Part A of a pair is the pressing one: the rigid part when exactly one is deformable, otherwise
+// the lower id. With ExactTest::SphereTriangle A's faces are spheres and B's triangles.
+//
+// Response (respond()): a deformable part in contact gets a zone at each contacted face
+// (contactLevel) and the face's masses are pushed out along the contact normal by the depth,
+// their velocity into the contact removed. When both parts deform, the depth is split by
+// stiffness: part A takes kB / (kA + kB) of it, with k the part's effective stiffness (mean
+// spring stiffness plus the restoration's: k_a for anchors, c m / h^2 for the constraint).
+// Each mass moves once per response, by its deepest contact. Rigid-rigid contacts are only
+// reported (the world's rigid dynamics resolve them).
+#pragma once
+
+#include "flexfit/collision.hpp"
+
+namespace flexfit {
+
+enum class BroadPhaseUpdate { Refit, Rebuild };
+
+struct CollisionSettings {
+    ExactTest exactTest = ExactTest::TriangleTriangle;
+    BroadPhaseUpdate broadPhase = BroadPhaseUpdate::Refit;
+};
+
+struct ResponseStats {
+    std::size_t contacts = 0;         // contacts that moved a deformable part
+    std::size_t displacedMasses = 0;
+    double maxDisplacement = 0.0;
+};
+
+class CollisionWorld {
+public:
+    explicit CollisionWorld(CollisionSettings settings = {});
+
+    // Registers a part (it must outlive the world); returns its id, 0, 1, 2, ...
+    std::uint32_t add(Part& part, BoundingVolumeKind kind = BoundingVolumeKind::Aabb);
+    std::size_t partCount() const { return parts_.size(); }
+    Part& part(std::uint32_t id) { return *parts_[id]; }
+    const PartCollider& collider(std::uint32_t id) const { return colliders_[id]; }
+    const CollisionSettings& settings() const { return settings_; }
+    // Switches the exact test; the face hierarchies are rebuilt for it.
+    void setExactTest(ExactTest test);
+
+    // Refits each part's hierarchy around its changed masses (and clears the part's change
+    // list), then updates the broad phase.
+    void update();
+    // Broad-phase candidate pairs (a < b), from the last update.
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& candidatePairs() const { return pairs_; }
+    // update(), then the narrow phase over the candidate pairs.
+    const std::vector<Contact>& findContacts();
+    const std::vector<Contact>& contacts() const { return contacts_; }
+    const QueryStats& stats() const { return stats_; }  // of the last findContacts()
+
+    ResponseStats respond(std::span<const Contact> contacts);
+    double effectiveStiffness(std::uint32_t id) const { return stiffness_[id]; }
+
+private:
+    void updateBroadPhase();
+    bool pressesFirst(std::uint32_t a, std::uint32_t b) const;
+
+    CollisionSettings settings_;
+    std::vector<Part*> parts_;
+    std::vector<PartCollider> colliders_;
+    std::vector<double> stiffness_;
+    Bvh<Sphere> broadPhase_;
+    std::vector<Sphere> partSpheres_;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;
+    std::vector<Contact> contacts_;
+    QueryStats stats_;
+};
+
+}  // namespace flexfit

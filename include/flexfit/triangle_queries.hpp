@@ -1,0 +1,43 @@
+// Exact geometric queries on triangles: the narrow phase's building blocks.
+//
+// closestPointOnTriangle follows Ericson, Real-Time Collision Detection, 5.1.5: it classifies
+// the point against the triangle's Voronoi regions (3 vertices, 3 edges, the face) with dot
+// products only, and handles degenerate (zero-area, needle) triangles by falling back to the
+// closest point on their edges.
+//
+// intersectTriangles is a separating-axis test on the 11 axes of two triangles (both normals
+// and the 9 edge-edge cross products; in-plane edge normals when they are coplanar). When no
+// axis separates them it reports the minimum-overlap axis as the contact normal, the overlap
+// as the depth, and the centroid of the intersection points (edges of each through the other)
+// as the contact point.
+#pragma once
+
+#include "flexfit/core.hpp"
+
+#include <optional>
+
+namespace flexfit {
+
+struct Triangle {
+    Vec3 a, b, c;
+};
+
+// Closest point of the (closed) triangle to p.
+Vec3 closestPointOnTriangle(const Vec3& p, const Triangle& t);
+
+struct TriangleContact {
+    Vec3 point;   // on the intersection
+    Vec3 normal;  // unit; moving the first triangle by depth * normal separates them
+    double depth = 0.0;
+};
+
+// Contact of a sphere (centre, radius) with a triangle: the point is the closest point on the
+// triangle, the normal points from it to the centre (the triangle's normal when the centre lies
+// on the triangle), depth = radius - distance. nullopt when they do not touch.
+std::optional<TriangleContact> sphereTriangleContact(const Vec3& centre, double radius, const Triangle& t);
+
+// Contact of two triangles; nullopt when they do not intersect (touching counts as
+// intersecting). Normal: pushing `first` by depth * normal separates it from `second`.
+std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second);
+
+}  // namespace flexfit

@@ -1,0 +1,131 @@
+#include "flexfit/collision_world.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <unordered_map>
+
+namespace flexfit {
+namespace {
+
+double effectivePartStiffness(const Part& part) {
+    const PartModel& m = part.model();
+    const double springs = m.springCount() ? std::accumulate(m.stiffness.begin(), m.stiffness.end(), 0.0) / double(m.springCount()) : 0.0;
+    const double meanMass = std::accumulate(m.mass.begin(), m.mass.end(), 0.0) / double(m.massCount());
+    const SimulationSettings& s = part.settings().simulation;
+    switch (s.restoration.method) {
+        case RestorationMethod::AnchorSprings: return springs + s.restoration.anchorStiffness;
+        case RestorationMethod::Constraint:
+            return springs + s.restoration.constraintFraction * meanMass / (s.timeStep * s.timeStep);
+        case RestorationMethod::None: break;
+    }
+    return springs;
+}
+
+bool deformable(const Part& p) { return p.mode() != PartMode::Rigid; }
+
+}  // namespace
+
+CollisionWorld::CollisionWorld(CollisionSettings settings) : settings_(settings) {}
+
+std::uint32_t CollisionWorld::add(Part& part, BoundingVolumeKind kind) {
+    parts_.push_back(&part);
+    colliders_.emplace_back(part, kind, settings_.exactTest);
+    stiffness_.push_back(effectivePartStiffness(part));
+    part.clearChangedMasses();
+    partSpheres_.push_back(colliders_.back().worldSphere(part));
+    broadPhase_.build(partSpheres_);  // the tree's shape changes with the set of parts
+    return std::uint32_t(parts_.size() - 1);
+}
+
+void CollisionWorld::setExactTest(ExactTest test) {
+    if (test == settings_.exactTest) return;
+    settings_.exactTest = test;
+    for (std::size_t i = 0; i < parts_.size(); ++i) colliders_[i] = PartCollider(*parts_[i], colliders_[i].kind(), test);
+}
+
+void CollisionWorld::update() {
+    for (std::size_t i = 0; i < parts_.size(); ++i) {
+        Part& part = *parts_[i];
+        if (!part.changedMasses().empty()) colliders_[i].refit(part, part.changedMasses());
+        part.clearChangedMasses();
+        partSpheres_[i] = colliders_[i].worldSphere(part);
+    }
+    updateBroadPhase();
+}
+
+void CollisionWorld::updateBroadPhase() {
+    if (settings_.broadPhase == BroadPhaseUpdate::Rebuild)
+        broadPhase_.build(partSpheres_);
+    else
+        broadPhase_.refitAll([&](Index i) { return partSpheres_[i]; });
+    // Each part's sphere against the tree, depth-first.
+    pairs_.clear();
+    const RelativePose identity;
+    std::vector<std::int32_t> stack;
+    const auto& nodes = broadPhase_.nodes();
+    for (std::uint32_t i = 0; i < partSpheres_.size(); ++i) {
+        stack.assign(1, 0);
+        while (!stack.empty()) {
+            const auto& node = nodes[std::size_t(stack.back())];
+            stack.pop_back();
+            if (!overlap(partSpheres_[i], node.volume, identity)) continue;
+            if (!node.isLeaf()) {
+                stack.push_back(node.right);
+                stack.push_back(node.left);
+            } else if (node.item > i) {
+                pairs_.emplace_back(i, node.item);
+            }
+        }
+    }
+    std::sort(pairs_.begin(), pairs_.end());
+}
+
+bool CollisionWorld::pressesFirst(std::uint32_t a, std::uint32_t b) const {
+    const bool da = deformable(*parts_[a]), db = deformable(*parts_[b]);
+    return da == db ? a < b : !da;
+}
+
+const std::vector<Contact>& CollisionWorld::findContacts() {
+    update();
+    contacts_.clear();
+    stats_ = {};
+    for (auto [i, j] : pairs_) {
+        if (!pressesFirst(i, j)) std::swap(i, j);
+        queryPair(i, *parts_[i], colliders_[i], j, *parts_[j], colliders_[j], settings_.exactTest, contacts_, stats_);
+    }
+    return contacts_;
+}
+
+ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
+    ResponseStats stats;
+    // The deepest push of each (part, mass).
+    std::unordered_map<std::uint64_t, Vec3> push;
+    auto pushFace = [&](std::uint32_t id, Index face, const Vec3& displacement) {
+        Part& part = *parts_[id];
+        part.touchFace(face);
+        for (Index m : part.model().mesh.faces[face]) {
+            // try_emplace with an explicit zero: Eigen's default constructor leaves Vec3 uninitialised.
+            Vec3& current = push.try_emplace((std::uint64_t(id) << 32) | m, Vec3::Zero()).first->second;
+            if (displacement.squaredNorm() > current.squaredNorm()) current = displacement;
+        }
+    };
+    for (const Contact& c : contacts) {
+        const bool da = deformable(*parts_[c.partA]), db = deformable(*parts_[c.partB]);
+        if (!da && !db) continue;
+        const double ka = stiffness_[c.partA], kb = stiffness_[c.partB];
+        const double shareA = da && db ? (ka + kb > 0 ? kb / (ka + kb) : 0.5) : (da ? 1.0 : 0.0);
+        if (shareA > 0.0) pushFace(c.partA, c.faceA, (c.depth * shareA) * c.normal);
+        if (shareA < 1.0) pushFace(c.partB, c.faceB, (-c.depth * (1.0 - shareA)) * c.normal);
+        ++stats.contacts;
+    }
+    std::vector<std::pair<std::uint64_t, Vec3>> ordered(push.begin(), push.end());  // deterministic order
+    std::sort(ordered.begin(), ordered.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (const auto& [key, displacement] : ordered) {
+        parts_[key >> 32]->displaceMass(Index(key & 0xffffffffu), displacement);
+        stats.maxDisplacement = std::max(stats.maxDisplacement, displacement.norm());
+    }
+    stats.displacedMasses = ordered.size();
+    return stats;
+}
+
+}  // namespace flexfit

@@ -1,0 +1,147 @@
+#include "flexfit/triangle_queries.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace flexfit {
+namespace {
+
+Vec3 closestPointOnSegment(const Vec3& p, const Vec3& a, const Vec3& b) {
+    const Vec3 ab = b - a;
+    const double length2 = ab.squaredNorm();
+    if (!(length2 > 0.0)) return a;
+    const double t = std::clamp((p - a).dot(ab) / length2, 0.0, 1.0);
+    return a + t * ab;
+}
+
+// Degenerate triangle (collinear or coincident vertices): the closest of its three edges.
+Vec3 closestPointOnEdges(const Vec3& p, const Triangle& t) {
+    const Vec3 candidates[3] = {closestPointOnSegment(p, t.a, t.b), closestPointOnSegment(p, t.b, t.c),
+                                closestPointOnSegment(p, t.c, t.a)};
+    return *std::min_element(std::begin(candidates), std::end(candidates),
+                             [&](const Vec3& x, const Vec3& y) { return (x - p).squaredNorm() < (y - p).squaredNorm(); });
+}
+
+struct Interval {
+    double min, max;
+};
+
+Interval project(const Triangle& t, const Vec3& axis) {
+    const double a = t.a.dot(axis), b = t.b.dot(axis), c = t.c.dot(axis);
+    return {std::min({a, b, c}), std::max({a, b, c})};
+}
+
+// Intersection of segment pq with triangle t (coplanar segments excluded); appends the point.
+void segmentTriangle(const Vec3& p, const Vec3& q, const Triangle& t, const Vec3& normal, std::vector<Vec3>& out) {
+    const double dp = (p - t.a).dot(normal), dq = (q - t.a).dot(normal);
+    if ((dp > 0 && dq > 0) || (dp < 0 && dq < 0) || dp == dq) return;
+    const Vec3 x = p + (dp / (dp - dq)) * (q - p);
+    if ((closestPointOnTriangle(x, t) - x).squaredNorm() <= 1e-20 * (1.0 + x.squaredNorm())) out.push_back(x);
+}
+
+}  // namespace
+
+Vec3 closestPointOnTriangle(const Vec3& p, const Triangle& t) {
+    const Vec3& a = t.a;
+    const Vec3& b = t.b;
+    const Vec3& c = t.c;
+    const Vec3 ab = b - a, ac = c - a, ap = p - a;
+    // Zero-area triangles have no face region: use the edges.
+    if (!(ab.cross(ac).squaredNorm() > 1e-30 * std::max(ab.squaredNorm(), ac.squaredNorm()) * std::max(ab.squaredNorm(), ac.squaredNorm())))
+        return closestPointOnEdges(p, t);
+    // Vertex region A.
+    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+    if (d1 <= 0 && d2 <= 0) return a;
+    // Vertex region B.
+    const Vec3 bp = p - b;
+    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+    if (d3 >= 0 && d4 <= d3) return b;
+    // Edge region AB.
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+    // Vertex region C.
+    const Vec3 cp = p - c;
+    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+    if (d6 >= 0 && d5 <= d6) return c;
+    // Edge region AC.
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+    // Edge region BC.
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+    // Face region: barycentric coordinates (u, v, w).
+    const double denominator = 1.0 / (va + vb + vc);
+    return a + ab * (vb * denominator) + ac * (vc * denominator);
+}
+
+std::optional<TriangleContact> sphereTriangleContact(const Vec3& centre, double radius, const Triangle& t) {
+    const Vec3 q = closestPointOnTriangle(centre, t);
+    const Vec3 d = centre - q;
+    const double distance2 = d.squaredNorm();
+    if (distance2 > radius * radius) return std::nullopt;
+    const double distance = std::sqrt(distance2);
+    Vec3 normal = distance > 0.0 ? Vec3(d / distance) : (t.b - t.a).cross(t.c - t.a);
+    if (distance == 0.0) {
+        const double n = normal.norm();
+        normal = n > 0.0 ? Vec3(normal / n) : Vec3::UnitY();
+    }
+    return TriangleContact{q, normal, radius - distance};
+}
+
+std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second) {
+    const std::array<Vec3, 3> e1{first.b - first.a, first.c - first.b, first.a - first.c};
+    const std::array<Vec3, 3> e2{second.b - second.a, second.c - second.b, second.a - second.c};
+    const Vec3 n1 = e1[0].cross(-e1[2]), n2 = e2[0].cross(-e2[2]);
+    const double scale = std::max({e1[0].squaredNorm(), e1[1].squaredNorm(), e2[0].squaredNorm(), e2[1].squaredNorm()});
+    std::vector<Vec3> axes{n1, n2};
+    for (const Vec3& a : e1)
+        for (const Vec3& b : e2) axes.push_back(a.cross(b));
+    const bool coplanar = n1.cross(n2).squaredNorm() <= 1e-24 * n1.squaredNorm() * n2.squaredNorm();
+    if (coplanar)
+        for (const auto* edges : {&e1, &e2})
+            for (const Vec3& e : *edges) axes.push_back(n1.cross(e));
+
+    double bestOverlap = std::numeric_limits<double>::infinity();
+    Vec3 bestAxis = Vec3::UnitY();
+    for (Vec3 axis : axes) {
+        const double length2 = axis.squaredNorm();
+        if (!(length2 > 1e-24 * scale * scale)) continue;  // parallel edges: no axis
+        axis /= std::sqrt(length2);
+        const Interval i1 = project(first, axis), i2 = project(second, axis);
+        const double pushUp = i2.max - i1.min;    // move first along +axis by this to separate
+        const double pushDown = i1.max - i2.min;  // or along -axis by this
+        if (pushUp < 0 || pushDown < 0) return std::nullopt;  // separating axis
+        const double overlap = std::min(pushUp, pushDown);
+        if (overlap < bestOverlap) {
+            bestOverlap = overlap;
+            bestAxis = pushUp <= pushDown ? axis : Vec3(-axis);
+        }
+    }
+    // Contact point: centroid of the edge-through-triangle intersection points.
+    std::vector<Vec3> points;
+    if (!coplanar) {
+        const Vec3 u1 = n1.normalized(), u2 = n2.normalized();
+        segmentTriangle(first.a, first.b, second, u2, points);
+        segmentTriangle(first.b, first.c, second, u2, points);
+        segmentTriangle(first.c, first.a, second, u2, points);
+        segmentTriangle(second.a, second.b, first, u1, points);
+        segmentTriangle(second.b, second.c, first, u1, points);
+        segmentTriangle(second.c, second.a, first, u1, points);
+    }
+    Vec3 point = Vec3::Zero();
+    if (points.empty()) {
+        // Coplanar (or grazing): the centroid of the vertices of each lying on the other.
+        for (const Vec3& v : {first.a, first.b, first.c})
+            if ((closestPointOnTriangle(v, second) - v).squaredNorm() <= 1e-20 * (1 + v.squaredNorm())) points.push_back(v);
+        for (const Vec3& v : {second.a, second.b, second.c})
+            if ((closestPointOnTriangle(v, first) - v).squaredNorm() <= 1e-20 * (1 + v.squaredNorm())) points.push_back(v);
+    }
+    if (points.empty()) points.push_back((first.a + first.b + first.c + second.a + second.b + second.c) / 6.0);
+    for (const Vec3& p : points) point += p;
+    point /= double(points.size());
+    return TriangleContact{point, bestAxis, bestOverlap};
+}
+
+}  // namespace flexfit

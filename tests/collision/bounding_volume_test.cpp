@@ -1,0 +1,107 @@
+// Bounding volumes: the oriented-box test against a corner-projection implementation of the
+// 15 separating axes, and the enclosing constructions against their members.
+#include "flexfit/flexfit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace flexfit;
+
+namespace {
+
+std::array<Vec3, 8> corners(const Aabb& b) {
+    std::array<Vec3, 8> c;
+    for (int i = 0; i < 8; ++i) c[i] = Vec3(i & 1 ? b.max.x() : b.min.x(), i & 2 ? b.max.y() : b.min.y(), i & 4 ? b.max.z() : b.min.z());
+    return c;
+}
+
+// Reference: project all 8 corners of both boxes on the 15 candidate axes.
+bool referenceBoxesOverlap(const Aabb& a, const Aabb& b, const RelativePose& bInA) {
+    const auto ca = corners(a);
+    std::array<Vec3, 8> cb = corners(b);
+    for (Vec3& c : cb) c = bInA.apply(c);
+    std::vector<Vec3> axes{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
+    for (int j = 0; j < 3; ++j) axes.push_back(bInA.rotation.col(j));
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) axes.push_back(axes[std::size_t(i)].cross(bInA.rotation.col(j)));
+    for (const Vec3& axis : axes) {
+        if (axis.squaredNorm() < 1e-18) continue;
+        double aMin = 1e300, aMax = -1e300, bMin = 1e300, bMax = -1e300;
+        for (const Vec3& c : ca) aMin = std::min(aMin, c.dot(axis)), aMax = std::max(aMax, c.dot(axis));
+        for (const Vec3& c : cb) bMin = std::min(bMin, c.dot(axis)), bMax = std::max(bMax, c.dot(axis));
+        if (aMax < bMin || bMax < aMin) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+TEST(BoundingVolume, OrientedBoxTestMatchesCornerProjections) {
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<double> u(-1, 1), e(0.05, 1.0);
+    int overlaps = 0, disagreements = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const Vec3 ca(u(rng), u(rng), u(rng)), cb(u(rng), u(rng), u(rng));
+        const Vec3 ea(e(rng), e(rng), e(rng)), eb(e(rng), e(rng), e(rng));
+        const Aabb a{ca - ea, ca + ea}, b{cb - eb, cb + eb};
+        const Eigen::Matrix3d r = Eigen::Quaterniond(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+        const RelativePose pose(r, Vec3(u(rng), u(rng), u(rng)) * 2.0);
+        const bool reference = referenceBoxesOverlap(a, b, pose);
+        // The tested version pads for round-off (|R| + 1e-12): it may only err towards overlap.
+        if (overlap(a, b, pose) != reference) {
+            ++disagreements;
+            EXPECT_TRUE(overlap(a, b, pose));
+        }
+        overlaps += reference;
+    }
+    EXPECT_GT(overlaps, 2000);
+    EXPECT_LT(disagreements, 5);
+}
+
+TEST(BoundingVolume, MixedTestsAgreeWithSampling) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const Aabb box{{-0.5, -0.2, -0.3}, {0.4, 0.6, 0.2}};
+    for (int k = 0; k < 2000; ++k) {
+        const Sphere s{{u(rng) * 1.5, u(rng) * 1.5, u(rng) * 1.5}, 0.3};
+        const Eigen::Matrix3d r = Eigen::Quaterniond(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+        const RelativePose boxInSphereFrame(r, Vec3(u(rng), u(rng), u(rng)) * 0.5);
+        // Reference: distance from the sphere centre to the box by sampling the box densely.
+        double best = 1e300;
+        for (int i = 0; i <= 20; ++i)
+            for (int j = 0; j <= 20; ++j)
+                for (int l = 0; l <= 20; ++l) {
+                    const Vec3 q = box.min + (box.max - box.min).cwiseProduct(Vec3(i, j, l) / 20.0);
+                    best = std::min(best, (boxInSphereFrame.apply(q) - s.centre).norm());
+                }
+        const bool got = overlap(s, box, boxInSphereFrame);
+        if (best < 0.28) {
+            EXPECT_TRUE(got) << k;
+        }
+        if (best > 0.33) {
+            EXPECT_FALSE(got) << k;
+        }
+    }
+}
+
+TEST(BoundingVolume, EnclosuresContainTheirMembers) {
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<double> u(-3, 3), r(0, 1);
+    std::vector<Sphere> spheres;
+    std::vector<Index> all;
+    for (Index i = 0; i < 50; ++i) {
+        spheres.push_back({{u(rng), u(rng), u(rng)}, r(rng)});
+        all.push_back(i);
+    }
+    const Sphere outer = encloseAll(std::span<const Sphere>(spheres), all);
+    for (const Sphere& s : spheres) EXPECT_LE((s.centre - outer.centre).norm() + s.radius, outer.radius * (1 + 1e-12));
+    for (std::size_t i = 1; i < spheres.size(); ++i) {
+        const Sphere m = Sphere::merge(spheres[i - 1], spheres[i]);
+        for (const Sphere& s : {spheres[i - 1], spheres[i]}) EXPECT_LE((s.centre - m.centre).norm() + s.radius, m.radius * (1 + 1e-9));
+    }
+    const std::vector<Vec3> points{{0, 0, 0}, {4, 0, 0}, {0, 1, 0}};
+    const Sphere thesis = Sphere::around(points);
+    EXPECT_TRUE(thesis.centre.isApprox(Vec3(2, 0.5, 0)));  // midpoint of the box
+    EXPECT_NEAR(thesis.radius, std::sqrt(4.0 + 0.25), 1e-12);  // to the farthest point
+}

@@ -1,0 +1,159 @@
+// The narrow phase against brute force over every face pair, for random and perturbed meshes
+// in random poses, both volumes and both exact tests; frame invariance; refit against rebuild.
+#include "flexfit/flexfit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+
+using namespace flexfit;
+
+namespace {
+
+TriMesh perturbed(TriMesh mesh, double amount, std::mt19937& rng) {
+    std::uniform_real_distribution<double> u(-amount, amount);
+    for (Vec3& v : mesh.vertices) v += Vec3(u(rng), u(rng), u(rng));
+    return mesh;
+}
+
+Pose randomPose(std::mt19937& rng, double spread) {
+    std::uniform_real_distribution<double> u(-1, 1);
+    Pose p;
+    p.rotation = Eigen::Quaterniond(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)).normalized());
+    p.translation = Vec3(u(rng), u(rng), u(rng)) * spread;
+    return p;
+}
+
+using FacePairs = std::set<std::pair<Index, Index>>;
+
+struct BruteForce {
+    FacePairs candidates, contacts;
+};
+
+BruteForce bruteForce(const Part& a, const Part& b, BoundingVolumeKind ka, BoundingVolumeKind kb, ExactTest test) {
+    // Box leaves bound the face sphere for the sphere test, the triangle otherwise.
+    auto box = [test](const std::vector<Vec3>& p, const Face& f) {
+        return test == ExactTest::SphereTriangle ? faceSphereBox(p, f) : faceBox(p, f);
+    };
+    const Eigen::Matrix3d ra = a.pose().rotation.toRotationMatrix(), rb = b.pose().rotation.toRotationMatrix();
+    const RelativePose bInA(ra.transpose() * rb, ra.transpose() * (b.pose().translation - a.pose().translation));
+    const auto& pa = a.state().positions;
+    const auto& pb = b.state().positions;
+    BruteForce out;
+    for (Index fa = 0; fa < a.model().faceCount(); ++fa)
+        for (Index fb = 0; fb < b.model().faceCount(); ++fb) {
+            const Face& x = a.model().mesh.faces[fa];
+            const Face& y = b.model().mesh.faces[fb];
+            bool leaves = false;
+            if (ka == BoundingVolumeKind::Sphere && kb == BoundingVolumeKind::Sphere)
+                leaves = overlap(faceSphere(pa, x), faceSphere(pb, y), bInA);
+            else if (ka == BoundingVolumeKind::Aabb && kb == BoundingVolumeKind::Aabb)
+                leaves = overlap(box(pa, x), box(pb, y), bInA);
+            else if (ka == BoundingVolumeKind::Sphere)
+                leaves = overlap(faceSphere(pa, x), box(pb, y), bInA);
+            else
+                leaves = overlap(box(pa, x), faceSphere(pb, y), bInA);
+            if (leaves) out.candidates.insert({fa, fb});
+            const Triangle ty{bInA.apply(pb[y[0]]), bInA.apply(pb[y[1]]), bInA.apply(pb[y[2]])};
+            const bool hit = test == ExactTest::SphereTriangle
+                                 ? sphereTriangleContact(faceSphere(pa, x).centre, faceSphere(pa, x).radius, ty).has_value()
+                                 : intersectTriangles({pa[x[0]], pa[x[1]], pa[x[2]]}, ty).has_value();
+            if (hit) out.contacts.insert({fa, fb});
+        }
+    return out;
+}
+
+FacePairs contactPairs(const std::vector<Contact>& contacts) {
+    FacePairs out;
+    for (const Contact& c : contacts) out.insert({c.faceA, c.faceB});
+    return out;
+}
+
+}  // namespace
+
+TEST(NarrowPhase, CandidatesAndContactsEqualBruteForce) {
+    std::mt19937 rng(10);
+    const BoundingVolumeKind kinds[2] = {BoundingVolumeKind::Sphere, BoundingVolumeKind::Aabb};
+    int withContacts = 0;
+    for (int trial = 0; trial < 12; ++trial) {
+        const auto ma = buildPartModel(perturbed(makeIcoSphere(1.0, 2), 0.05, rng));
+        const auto mb = buildPartModel(perturbed(makeTorus(1.0, 0.35, 16, 10), 0.03, rng));
+        Part a(ma), b(mb);
+        a.setPose(randomPose(rng, 0.6));
+        b.setPose(randomPose(rng, 0.6));
+        for (BoundingVolumeKind ka : kinds)
+            for (BoundingVolumeKind kb : kinds)
+                for (ExactTest test : {ExactTest::SphereTriangle, ExactTest::TriangleTriangle}) {
+                    const PartCollider ca(a, ka, test), cb(b, kb, test);
+                    std::vector<Contact> contacts;
+                    std::vector<std::pair<Index, Index>> candidates;
+                    QueryStats stats;
+                    queryPair(0, a, ca, 1, b, cb, test, contacts, stats, &candidates);
+                    const BruteForce reference = bruteForce(a, b, ka, kb, test);
+                    EXPECT_EQ(FacePairs(candidates.begin(), candidates.end()), reference.candidates)
+                        << "trial " << trial << " " << toString(ka) << "/" << toString(kb);
+                    EXPECT_EQ(candidates.size(), reference.candidates.size());  // each pair once
+                    EXPECT_EQ(contactPairs(contacts), reference.contacts) << "trial " << trial << " " << toString(test);
+                    withContacts += !contacts.empty();
+                }
+    }
+    EXPECT_GT(withContacts, 20);
+}
+
+TEST(NarrowPhase, SameContactsWhenBothPartsMoveTogether) {
+    std::mt19937 rng(11);
+    const auto ma = buildPartModel(makeTorus1()), mb = buildPartModel(makeTorus(10, 2.5, 20, 12));
+    Part a(ma), b(mb);
+    // A generic pose: no pair of faces sits within round-off of touching.
+    b.setPose(Pose{Eigen::Quaterniond(Eigen::AngleAxisd(1.3, Vec3(0.3, 1.0, 0.2).normalized())), Vec3(23.3, 0.37, -0.21)});
+    for (BoundingVolumeKind kind : {BoundingVolumeKind::Sphere, BoundingVolumeKind::Aabb}) {
+        const PartCollider ca(a, kind), cb(b, kind);
+        std::vector<Contact> before, after;
+        QueryStats stats;
+        queryPair(0, a, ca, 1, b, cb, ExactTest::TriangleTriangle, before, stats);
+        ASSERT_FALSE(before.empty());
+        const Pose move = randomPose(rng, 50.0);
+        Part a2(ma), b2(mb);
+        a2.setPose(a.pose().then(move));
+        b2.setPose(b.pose().then(move));
+        queryPair(0, a2, ca, 1, b2, cb, ExactTest::TriangleTriangle, after, stats);  // hierarchies untouched
+        ASSERT_EQ(contactPairs(before), contactPairs(after));
+        for (std::size_t i = 0; i < before.size(); ++i) {
+            EXPECT_NEAR(before[i].depth, after[i].depth, 1e-9);
+            EXPECT_LT((move.apply(before[i].point) - after[i].point).norm(), 1e-8);
+            EXPECT_LT((move.rotate(before[i].normal) - after[i].normal).norm(), 1e-8);
+        }
+    }
+}
+
+TEST(NarrowPhase, RefitAfterDeformationEqualsRebuild) {
+    std::mt19937 rng(12);
+    const auto ma = buildPartModel(makeTorus1()), mb = buildPartModel(makeIcoSphere(3.0, 3));
+    Part deformed(ma), probe(mb);
+    probe.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(12.0, 0.5, 0.0)});
+    for (BoundingVolumeKind kind : {BoundingVolumeKind::Sphere, BoundingVolumeKind::Aabb}) {
+        Part part(ma);
+        PartCollider refitted(part, kind);
+        part.openZone(ZoneSeed::mass(0), 4);
+        part.clearChangedMasses();
+        for (int i = 0; i < 300; ++i) {
+            part.applyForce(0, Vec3(-40.0, 5.0, 0.0));
+            part.step();
+        }
+        const std::size_t before = refitted.refitNodeCount();
+        refitted.refit(part, part.changedMasses());
+        // Only the faces around the zone and their ancestors were recomputed.
+        EXPECT_LT(refitted.refitNodeCount() - before, 600u);
+        const PartCollider rebuilt(part, kind);
+        const PartCollider probeCollider(probe, BoundingVolumeKind::Sphere);
+        std::vector<Contact> x, y;
+        std::vector<std::pair<Index, Index>> cx, cy;
+        QueryStats stats;
+        queryPair(0, part, refitted, 1, probe, probeCollider, ExactTest::TriangleTriangle, x, stats, &cx);
+        queryPair(0, part, rebuilt, 1, probe, probeCollider, ExactTest::TriangleTriangle, y, stats, &cy);
+        EXPECT_EQ(contactPairs(x), contactPairs(y));
+        EXPECT_EQ(FacePairs(cx.begin(), cx.end()), FacePairs(cy.begin(), cy.end()));
+        EXPECT_FALSE(x.empty()) << toString(kind);
+    }
+}

@@ -1,0 +1,131 @@
+// Triangle queries against independent references: dense sampling of the triangle for the
+// closest point, and edge-through-triangle (Moller-Trumbore) tests for intersection.
+#include "flexfit/flexfit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace flexfit;
+
+namespace {
+
+// Closest point by sampling the triangle on a fine barycentric grid (and its edges finely).
+Vec3 sampledClosest(const Vec3& p, const Triangle& t, int n = 400) {
+    Vec3 best = t.a;
+    auto consider = [&](const Vec3& q) {
+        if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
+    };
+    for (int i = 0; i <= n; ++i)
+        for (int j = 0; i + j <= n; ++j) consider(t.a + (double(i) / n) * (t.b - t.a) + (double(j) / n) * (t.c - t.a));
+    for (int k = 0; k <= 20 * n; ++k) {
+        const double s = double(k) / (20 * n);
+        consider(t.a + s * (t.b - t.a));
+        consider(t.b + s * (t.c - t.b));
+        consider(t.c + s * (t.a - t.c));
+    }
+    return best;
+}
+
+// Segment pq against triangle t (Moller-Trumbore), closed.
+bool segmentHitsTriangle(const Vec3& p, const Vec3& q, const Triangle& t) {
+    const Vec3 d = q - p, e1 = t.b - t.a, e2 = t.c - t.a;
+    const Vec3 h = d.cross(e2);
+    const double det = e1.dot(h);
+    if (std::abs(det) < 1e-14) return false;
+    const double inv = 1.0 / det;
+    const Vec3 s = p - t.a;
+    const double u = inv * s.dot(h);
+    if (u < 0 || u > 1) return false;
+    const Vec3 qv = s.cross(e1);
+    const double v = inv * d.dot(qv);
+    if (v < 0 || u + v > 1) return false;
+    const double w = inv * e2.dot(qv);
+    return w >= 0 && w <= 1;
+}
+
+bool referenceIntersects(const Triangle& x, const Triangle& y) {
+    const Vec3 xs[3] = {x.a, x.b, x.c}, ys[3] = {y.a, y.b, y.c};
+    for (int i = 0; i < 3; ++i)
+        if (segmentHitsTriangle(xs[i], xs[(i + 1) % 3], y) || segmentHitsTriangle(ys[i], ys[(i + 1) % 3], x)) return true;
+    return false;
+}
+
+Triangle shifted(const Triangle& t, const Vec3& d) { return {t.a + d, t.b + d, t.c + d}; }
+
+}  // namespace
+
+TEST(ClosestPoint, MatchesDenseSamplingInEveryRegion) {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(-2, 2);
+    const Triangle shapes[] = {
+        {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},             // right triangle
+        {{0, 0, 0}, {3, 0.01, 0}, {1.5, 0.02, 0.01}},   // needle
+        {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}},             // degenerate: collinear
+        {{0.3, 0.3, 0.3}, {0.3, 0.3, 0.3}, {0.3, 0.3, 0.3}},  // degenerate: a point
+        {{-1, 0.2, 0.5}, {0.7, -0.4, 1.1}, {0.1, 1.3, -0.6}},
+    };
+    for (const Triangle& t : shapes)
+        for (int k = 0; k < 60; ++k) {
+            const Vec3 p(u(rng), u(rng), u(rng));
+            const Vec3 exact = closestPointOnTriangle(p, t);
+            const Vec3 sampled = sampledClosest(p, t);
+            // The exact point is never farther than the best sample, and lies within the grid's spacing of it.
+            EXPECT_LE((exact - p).norm(), (sampled - p).norm() + 1e-12);
+            EXPECT_NEAR((exact - p).norm(), (sampled - p).norm(), 2e-2);
+        }
+}
+
+TEST(ClosestPoint, VoronoiRegionsExactly) {
+    const Triangle t{{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+    EXPECT_TRUE(closestPointOnTriangle({-1, -1, 3}, t).isApprox(Vec3(0, 0, 0)));    // vertex A
+    EXPECT_TRUE(closestPointOnTriangle({3, -1, 1}, t).isApprox(Vec3(2, 0, 0)));     // vertex B
+    EXPECT_TRUE(closestPointOnTriangle({-1, 3, -2}, t).isApprox(Vec3(0, 2, 0)));    // vertex C
+    EXPECT_TRUE(closestPointOnTriangle({1, -1, 0}, t).isApprox(Vec3(1, 0, 0)));     // edge AB
+    EXPECT_TRUE(closestPointOnTriangle({-1, 1, 5}, t).isApprox(Vec3(0, 1, 0)));     // edge AC
+    EXPECT_TRUE(closestPointOnTriangle({2, 2, 0}, t).isApprox(Vec3(1, 1, 0)));      // edge BC
+    EXPECT_TRUE(closestPointOnTriangle({0.5, 0.5, -4}, t).isApprox(Vec3(0.5, 0.5, 0)));  // face
+}
+
+TEST(SphereTriangle, ContactPointNormalDepth) {
+    const Triangle t{{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+    const auto hit = sphereTriangleContact({0.5, 0.5, 0.3}, 0.5, t);
+    ASSERT_TRUE(hit);
+    EXPECT_TRUE(hit->point.isApprox(Vec3(0.5, 0.5, 0)));
+    EXPECT_TRUE(hit->normal.isApprox(Vec3(0, 0, 1)));
+    EXPECT_NEAR(hit->depth, 0.2, 1e-12);
+    EXPECT_FALSE(sphereTriangleContact({0.5, 0.5, 0.6}, 0.5, t));
+    const auto centred = sphereTriangleContact({0.5, 0.5, 0.0}, 0.5, t);  // centre on the face
+    ASSERT_TRUE(centred);
+    EXPECT_NEAR(std::abs(centred->normal.z()), 1.0, 1e-12);
+}
+
+TEST(TriangleTriangle, AgreesWithEdgeTestsOnRandomPairs) {
+    std::mt19937 rng(2);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int hits = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const Triangle x{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+        const Triangle y{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+        const bool reference = referenceIntersects(x, y);
+        const auto contact = intersectTriangles(x, y);
+        ASSERT_EQ(contact.has_value(), reference) << "pair " << k;
+        if (!contact) continue;
+        ++hits;
+        // The minimum translation: a little less still intersects, a little more separates.
+        EXPECT_TRUE(intersectTriangles(shifted(x, (contact->depth * (1 - 1e-6)) * contact->normal), y)) << k;
+        EXPECT_FALSE(intersectTriangles(shifted(x, (contact->depth * (1 + 1e-6) + 1e-9) * contact->normal), y)) << k;
+        EXPECT_NEAR(contact->normal.norm(), 1.0, 1e-12);
+    }
+    EXPECT_GT(hits, 1000);
+}
+
+TEST(TriangleTriangle, CoplanarAndTouching) {
+    const Triangle x{{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+    EXPECT_TRUE(intersectTriangles(x, {{0.5, 0.5, 0}, {3, 0.5, 0}, {0.5, 3, 0}}));   // coplanar, overlapping
+    EXPECT_FALSE(intersectTriangles(x, {{3, 3, 0}, {5, 3, 0}, {3, 5, 0}}));          // coplanar, apart
+    EXPECT_FALSE(intersectTriangles(x, {{0, 0, 0.1}, {2, 0, 0.1}, {0, 2, 0.1}}));    // parallel planes
+    const auto pierce = intersectTriangles(x, {{0.5, 0.5, -1}, {0.6, 0.5, 1}, {0.5, 0.6, 1}});
+    ASSERT_TRUE(pierce);
+    EXPECT_NEAR(pierce->point.z(), 0.0, 1e-9);
+}
