@@ -35,6 +35,12 @@ bench: release
 	build/release/bench/bench_part_step $(BENCH_FLAGS) --benchmark_out=bench/results/part_step.csv
 	build/release/bench/bench_part_ratios $(BENCH_FLAGS) --benchmark_out=bench/results/part_ratios.csv
 	/usr/bin/python3 tools/bench_ratios.py bench/results/part_ratios.csv --counter a_over_b
+	build/release/bench/bench_collision $(BENCH_FLAGS) --benchmark_out=bench/results/collision.csv
+	/usr/bin/python3 tools/bench_ratios.py bench/results/collision.csv \
+	  --pair BM_FclObbrssQuery/0 BM_FlexfitQuery/0/1 --pair BM_FclObbrssQuery/1 BM_FlexfitQuery/1/1 \
+	  --pair BM_FclObbrssQuery/2 BM_FlexfitQuery/2/1 --pair BM_FclObbrssQuery/3 BM_FlexfitQuery/3/1 \
+	  --pair BM_FlexfitQuery/1/0 BM_FlexfitQuery/1/1 --pair BM_FclAabbRefit BM_FlexfitRefitLocal/1 \
+	  --pair BM_BroadPhase/1 BM_BroadPhase/0
 
 clean:
 	rm -rf build out

@@ -11,6 +11,8 @@ void registerInfo(CLI::App& app);
 void registerConvert(CLI::App& app);
 void registerGen(CLI::App& app);
 void registerSimulate(CLI::App& app);
+void registerCollide(CLI::App& app);
+void registerExperimentContact(CLI::App& experiment);
 void registerExperimentRestoration(CLI::App& experiment);
 void registerExperimentZones(CLI::App& experiment);
 

@@ -13,10 +13,12 @@ int main(int argc, char** argv) {
     flexfit::cli::registerConvert(app);
     flexfit::cli::registerGen(app);
     flexfit::cli::registerSimulate(app);
+    flexfit::cli::registerCollide(app);
     CLI::App* experiment = app.add_subcommand("experiment", "Reproduce the thesis's experiments");
     experiment->require_subcommand(1);
     flexfit::cli::registerExperimentRestoration(*experiment);
     flexfit::cli::registerExperimentZones(*experiment);
+    flexfit::cli::registerExperimentContact(*experiment);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

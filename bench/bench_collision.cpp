@@ -1,0 +1,199 @@
+// Collision queries and refits, Flexfit's hierarchies against FCL's (Debian's libfcl-dev) on
+// the same meshes and poses, with contact generation on, in one run.
+//   Scenes: two torus1 in contact, two heart-size meshes in contact, the same separated.
+//   Query: all triangle-triangle contacts (FCL: OBBRSS, exhaustive contacts; Flexfit: spheres
+//          and boxes, triangle-triangle test). The counter same_contacts is 1 when both report
+//          exactly the same face pairs.
+//   Refit after a local deformation (a zone of a few dozen faces on the heart): Flexfit refits
+//          the changed leaves and their ancestors; FCL's AABB model refits in endUpdateModel.
+//   Broad phase over 200 moving parts: refit against rebuild.
+#include "flexfit/flexfit.hpp"
+
+#include <benchmark/benchmark.h>
+#include <fcl/fcl.h>
+
+#include <fmt/core.h>
+
+#include <set>
+
+namespace {
+
+using namespace flexfit;
+
+struct Scene {
+    std::string name;
+    std::shared_ptr<const PartModel> a, b;
+    Pose poseA, poseB;
+};
+
+const Scene& sceneByIndex(int which) {
+    static const std::vector<Scene> scenes = [] {
+        const auto torus = buildPartModel(makeTorus1());
+        const auto heart = buildPartModel(makeHeart());
+        const Pose identity;
+        const Pose torusContact{Eigen::Quaterniond(Eigen::AngleAxisd(1.3, Vec3(0.3, 1.0, 0.2).normalized())), Vec3(23.3, 0.37, -0.21)};
+        const Pose heartContact{Eigen::Quaterniond(Eigen::AngleAxisd(0.9, Vec3(1.0, 0.2, 0.5).normalized())), Vec3(9.0, 1.3, 0.7)};
+        Pose torusApart = torusContact, heartApart = heartContact;
+        torusApart.translation.x() += 6.0;
+        heartApart.translation.x() += 20.0;
+        return std::vector<Scene>{{"torus1 contact", torus, torus, identity, torusContact},
+                                  {"heart contact", heart, heart, identity, heartContact},
+                                  {"torus1 apart", torus, torus, identity, torusApart},
+                                  {"heart apart", heart, heart, identity, heartApart}};
+    }();
+    return scenes[std::size_t(which)];
+}
+
+fcl::Transform3d toFcl(const Pose& p) {
+    fcl::Transform3d t = fcl::Transform3d::Identity();
+    t.linear() = p.rotation.toRotationMatrix();
+    t.translation() = p.translation;
+    return t;
+}
+
+template <class BV>
+std::shared_ptr<fcl::BVHModel<BV>> fclModel(const PartModel& model) {
+    auto m = std::make_shared<fcl::BVHModel<BV>>();
+    std::vector<fcl::Vector3d> vertices(model.restPositions.begin(), model.restPositions.end());
+    std::vector<fcl::Triangle> triangles;
+    for (const Face& f : model.mesh.faces) triangles.emplace_back(f[0], f[1], f[2]);
+    m->beginModel();
+    m->addSubModel(vertices, triangles);
+    m->endModel();
+    return m;
+}
+
+std::set<std::pair<Index, Index>> fclContacts(const Scene& s, const std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>>& a,
+                                              const std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>>& b, std::size_t* count) {
+    fcl::CollisionObjectd oa(a, toFcl(s.poseA)), ob(b, toFcl(s.poseB));
+    fcl::CollisionRequestd request(1000000, true);
+    fcl::CollisionResultd result;
+    fcl::collide(&oa, &ob, request, result);
+    std::set<std::pair<Index, Index>> pairs;
+    for (std::size_t i = 0; i < result.numContacts(); ++i)
+        pairs.insert({Index(result.getContact(i).b1), Index(result.getContact(i).b2)});
+    *count = result.numContacts();
+    return pairs;
+}
+
+std::set<std::pair<Index, Index>> ourContacts(const Part& a, const PartCollider& ca, const Part& b, const PartCollider& cb,
+                                              QueryStats& stats) {
+    std::vector<Contact> contacts;
+    queryPair(0, a, ca, 1, b, cb, ExactTest::TriangleTriangle, contacts, stats);
+    std::set<std::pair<Index, Index>> pairs;
+    for (const Contact& c : contacts) pairs.insert({c.faceA, c.faceB});
+    return pairs;
+}
+
+void setQueryCounters(benchmark::State& state, const std::string& label, std::size_t contacts, std::size_t volumeTests, bool same) {
+    state.SetLabel(label);
+    state.counters["contacts"] = double(contacts);
+    state.counters["volume_tests"] = double(volumeTests);
+    state.counters["same_contacts"] = same ? 1.0 : 0.0;
+}
+
+void BM_FlexfitQuery(benchmark::State& state) {
+    const Scene& s = sceneByIndex(int(state.range(0)));
+    const auto kind = state.range(1) == 0 ? BoundingVolumeKind::Sphere : BoundingVolumeKind::Aabb;
+    PartSettings rigid;
+    rigid.mode = PartMode::Rigid;
+    Part a(s.a, rigid), b(s.b, rigid);
+    a.setPose(s.poseA);
+    b.setPose(s.poseB);
+    const PartCollider ca(a, kind), cb(b, kind);
+    QueryStats stats;
+    std::vector<Contact> contacts;
+    for (auto _ : state) {
+        contacts.clear();
+        stats = {};
+        queryPair(0, a, ca, 1, b, cb, ExactTest::TriangleTriangle, contacts, stats);
+        benchmark::DoNotOptimize(contacts.data());
+    }
+    std::size_t fclCount = 0;
+    const auto fa = fclModel<fcl::OBBRSSd>(*s.a), fb = fclModel<fcl::OBBRSSd>(*s.b);
+    QueryStats check;
+    const bool same = ourContacts(a, ca, b, cb, check) == fclContacts(s, fa, fb, &fclCount);
+    setQueryCounters(state, s.name + " / " + toString(kind), contacts.size(), stats.volumeTests, same);
+}
+
+void BM_FclObbrssQuery(benchmark::State& state) {
+    const Scene& s = sceneByIndex(int(state.range(0)));
+    const auto fa = fclModel<fcl::OBBRSSd>(*s.a), fb = fclModel<fcl::OBBRSSd>(*s.b);
+    fcl::CollisionObjectd oa(fa, toFcl(s.poseA)), ob(fb, toFcl(s.poseB));
+    const fcl::CollisionRequestd request(1000000, true);
+    std::size_t contacts = 0;
+    for (auto _ : state) {
+        fcl::CollisionResultd result;
+        fcl::collide(&oa, &ob, request, result);
+        contacts = result.numContacts();
+        benchmark::DoNotOptimize(contacts);
+    }
+    setQueryCounters(state, s.name + " / fcl obbrss", contacts, 0, true);
+}
+
+// A zone of a few dozen faces on the heart, deformed; the refit of the changed faces.
+void BM_FlexfitRefitLocal(benchmark::State& state) {
+    const auto model = sceneByIndex(1).a;
+    const auto kind = state.range(0) == 0 ? BoundingVolumeKind::Sphere : BoundingVolumeKind::Aabb;
+    Part part(model);
+    PartCollider collider(part, kind);
+    part.openZone(ZoneSeed::mass(3000), 3);
+    for (int i = 0; i < 50; ++i) {
+        part.applyForce(3000, Vec3(0, 80.0, 0));
+        part.step();
+    }
+    const std::vector<Index> changed(part.changedMasses().begin(), part.changedMasses().end());
+    std::set<Index> faces;
+    for (Index m : changed)
+        for (Index f : model->topology.facesOf(m)) faces.insert(f);
+    for (auto _ : state) collider.refit(part, changed);
+    setQueryCounters(state, fmt::format("heart, {} moved masses, {} faces / {}", changed.size(), faces.size(), toString(kind)),
+                     faces.size(), 0, true);
+}
+
+void BM_FclAabbRefit(benchmark::State& state) {
+    const auto model = sceneByIndex(1).a;
+    auto m = fclModel<fcl::AABBd>(*model);
+    std::vector<fcl::Vector3d> vertices(model->restPositions.begin(), model->restPositions.end());
+    vertices[3000].y() += 0.1;
+    for (auto _ : state) {
+        m->beginUpdateModel();
+        m->updateSubModel(vertices);
+        m->endUpdateModel(true, true);
+        benchmark::DoNotOptimize(m.get());
+    }
+    setQueryCounters(state, "heart / fcl aabb endUpdateModel", model->faceCount(), 0, true);
+}
+
+// 200 parts moving every step: refit the broad-phase tree, or rebuild it.
+void BM_BroadPhase(benchmark::State& state) {
+    const auto model = buildPartModel(makeIcoSphere(1.0, 1));
+    std::vector<std::unique_ptr<Part>> parts;
+    CollisionSettings settings;
+    settings.broadPhase = state.range(0) == 0 ? BroadPhaseUpdate::Refit : BroadPhaseUpdate::Rebuild;
+    CollisionWorld world(settings);
+    for (int i = 0; i < 200; ++i) {
+        parts.push_back(std::make_unique<Part>(model));
+        parts.back()->translate(Vec3(i % 10, (i / 10) % 10, i / 100) * 2.5);
+        world.add(*parts.back());
+    }
+    std::size_t pairs = 0;
+    double t = 0.0;
+    for (auto _ : state) {
+        t += 0.01;
+        for (std::size_t i = 0; i < parts.size(); ++i) parts[i]->translate(Vec3(std::sin(t + double(i)), std::cos(t * 1.3 + double(i)), 0.0) * 0.01);
+        world.update();
+        pairs = world.candidatePairs().size();
+    }
+    setQueryCounters(state, settings.broadPhase == BroadPhaseUpdate::Refit ? "200 parts / refit" : "200 parts / rebuild", pairs, 0, true);
+}
+
+BENCHMARK(BM_FlexfitQuery)->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1})->Args({2, 0})->Args({2, 1})->Args({3, 0})->Args({3, 1});
+BENCHMARK(BM_FclObbrssQuery)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
+BENCHMARK(BM_FlexfitRefitLocal)->Arg(0)->Arg(1);
+BENCHMARK(BM_FclAabbRefit);
+BENCHMARK(BM_BroadPhase)->Arg(0)->Arg(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();
