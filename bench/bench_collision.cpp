@@ -147,7 +147,7 @@ void BM_FlexfitRefitLocal(benchmark::State& state) {
     for (Index m : changed)
         for (Index f : model->topology.facesOf(m)) faces.insert(f);
     for (auto _ : state) collider.refit(part, changed);
-    setQueryCounters(state, fmt::format("heart, {} moved masses, {} faces / {}", changed.size(), faces.size(), toString(kind)),
+    setQueryCounters(state, fmt::format("heart: {} moved masses and {} faces / {}", changed.size(), faces.size(), toString(kind)),
                      faces.size(), 0, true);
 }
 

@@ -47,6 +47,9 @@ bool overlap(const Aabb& a, const Aabb& b, const RelativePose& bInA) {
     const Eigen::Matrix3d& r = bInA.rotation;
     const Eigen::Matrix3d& ar = bInA.absRotation;
     const Vec3 t = bInA.apply(b.centre()) - a.centre();  // in A's frame
+    // Bounding spheres of the boxes first: most pairs that miss are rejected here.
+    const double reach = ea.norm() + eb.norm();
+    if (t.squaredNorm() > reach * reach) return false;
     // A's axes.
     for (int i = 0; i < 3; ++i)
         if (std::abs(t[i]) > ea[i] + ar.row(i).dot(eb)) return false;

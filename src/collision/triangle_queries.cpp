@@ -34,11 +34,27 @@ Interval project(const Triangle& t, const Vec3& axis) {
 }
 
 // Intersection of segment pq with triangle t (coplanar segments excluded); appends the point.
-void segmentTriangle(const Vec3& p, const Vec3& q, const Triangle& t, const Vec3& normal, std::vector<Vec3>& out) {
+template <class Points>
+void segmentTriangle(const Vec3& p, const Vec3& q, const Triangle& t, const Vec3& normal, Points& out) {
     const double dp = (p - t.a).dot(normal), dq = (q - t.a).dot(normal);
     if ((dp > 0 && dq > 0) || (dp < 0 && dq < 0) || dp == dq) return;
     const Vec3 x = p + (dp / (dp - dq)) * (q - p);
-    if ((closestPointOnTriangle(x, t) - x).squaredNorm() <= 1e-20 * (1.0 + x.squaredNorm())) out.push_back(x);
+    if ((closestPointOnTriangle(x, t) - x).squaredNorm() <= 1e-20 * (1.0 + x.squaredNorm())) out.push(x);
+}
+
+// A few points on the stack (at most 12 in use).
+struct PointSet {
+    std::array<Vec3, 12> points;
+    int count = 0;
+    void push(const Vec3& p) {
+        if (count < 12) points[std::size_t(count++)] = p;
+    }
+};
+
+// Signed distances of t's vertices to the plane (n, d): all strictly on one side means no contact.
+bool strictlyOneSide(const Triangle& t, const Vec3& n, double d, double tolerance) {
+    const double a = n.dot(t.a) - d, b = n.dot(t.b) - d, c = n.dot(t.c) - d;
+    return (a > tolerance && b > tolerance && c > tolerance) || (a < -tolerance && b < -tolerance && c < -tolerance);
 }
 
 }  // namespace
@@ -95,17 +111,27 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
     const std::array<Vec3, 3> e2{second.b - second.a, second.c - second.b, second.a - second.c};
     const Vec3 n1 = e1[0].cross(-e1[2]), n2 = e2[0].cross(-e2[2]);
     const double scale = std::max({e1[0].squaredNorm(), e1[1].squaredNorm(), e2[0].squaredNorm(), e2[1].squaredNorm()});
-    std::vector<Vec3> axes{n1, n2};
+    // Quick rejection (Moller): a triangle strictly on one side of the other's plane. The
+    // tolerance is far below any overlap the axes below would report.
+    const double tolerance = 1e-12 * scale;
+    if (strictlyOneSide(second, n1, n1.dot(first.a), tolerance * n1.norm()) ||
+        strictlyOneSide(first, n2, n2.dot(second.a), tolerance * n2.norm()))
+        return std::nullopt;
+    std::array<Vec3, 17> axes;
+    std::size_t axisCount = 0;
+    axes[axisCount++] = n1;
+    axes[axisCount++] = n2;
     for (const Vec3& a : e1)
-        for (const Vec3& b : e2) axes.push_back(a.cross(b));
+        for (const Vec3& b : e2) axes[axisCount++] = a.cross(b);
     const bool coplanar = n1.cross(n2).squaredNorm() <= 1e-24 * n1.squaredNorm() * n2.squaredNorm();
     if (coplanar)
         for (const auto* edges : {&e1, &e2})
-            for (const Vec3& e : *edges) axes.push_back(n1.cross(e));
+            for (const Vec3& e : *edges) axes[axisCount++] = n1.cross(e);
 
     double bestOverlap = std::numeric_limits<double>::infinity();
     Vec3 bestAxis = Vec3::UnitY();
-    for (Vec3 axis : axes) {
+    for (std::size_t k = 0; k < axisCount; ++k) {
+        Vec3 axis = axes[k];
         const double length2 = axis.squaredNorm();
         if (!(length2 > 1e-24 * scale * scale)) continue;  // parallel edges: no axis
         axis /= std::sqrt(length2);
@@ -120,7 +146,7 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
         }
     }
     // Contact point: centroid of the edge-through-triangle intersection points.
-    std::vector<Vec3> points;
+    PointSet points;
     if (!coplanar) {
         const Vec3 u1 = n1.normalized(), u2 = n2.normalized();
         segmentTriangle(first.a, first.b, second, u2, points);
@@ -130,17 +156,17 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
         segmentTriangle(second.b, second.c, first, u1, points);
         segmentTriangle(second.c, second.a, first, u1, points);
     }
-    Vec3 point = Vec3::Zero();
-    if (points.empty()) {
+    if (points.count == 0) {
         // Coplanar (or grazing): the centroid of the vertices of each lying on the other.
         for (const Vec3& v : {first.a, first.b, first.c})
-            if ((closestPointOnTriangle(v, second) - v).squaredNorm() <= 1e-20 * (1 + v.squaredNorm())) points.push_back(v);
+            if ((closestPointOnTriangle(v, second) - v).squaredNorm() <= 1e-20 * (1 + v.squaredNorm())) points.push(v);
         for (const Vec3& v : {second.a, second.b, second.c})
-            if ((closestPointOnTriangle(v, first) - v).squaredNorm() <= 1e-20 * (1 + v.squaredNorm())) points.push_back(v);
+            if ((closestPointOnTriangle(v, first) - v).squaredNorm() <= 1e-20 * (1 + v.squaredNorm())) points.push(v);
     }
-    if (points.empty()) points.push_back((first.a + first.b + first.c + second.a + second.b + second.c) / 6.0);
-    for (const Vec3& p : points) point += p;
-    point /= double(points.size());
+    if (points.count == 0) points.push((first.a + first.b + first.c + second.a + second.b + second.c) / 6.0);
+    Vec3 point = Vec3::Zero();
+    for (int i = 0; i < points.count; ++i) point += points.points[std::size_t(i)];
+    point /= double(points.count);
     return TriangleContact{point, bestAxis, bestOverlap};
 }
 

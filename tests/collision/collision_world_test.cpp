@@ -35,7 +35,8 @@ TEST(CollisionWorld, BroadPhaseEqualsBruteForceAndRefitEqualsRebuild) {
     std::uniform_real_distribution<double> u(-12, 12);
     const auto model = buildPartModel(makeIcoSphere(2.0, 1));
     std::vector<std::unique_ptr<Part>> parts;
-    CollisionWorld refit, rebuild(CollisionSettings{ExactTest::TriangleTriangle, BroadPhaseUpdate::Rebuild});
+    CollisionWorld refit(CollisionSettings{ExactTest::TriangleTriangle, BroadPhaseUpdate::Refit}),
+        rebuild(CollisionSettings{ExactTest::TriangleTriangle, BroadPhaseUpdate::Rebuild});
     for (int i = 0; i < 40; ++i) {
         parts.push_back(std::make_unique<Part>(model));
         parts.back()->translate(Vec3(u(rng), u(rng), u(rng)));
