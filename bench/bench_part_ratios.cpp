@@ -4,6 +4,7 @@
 // state, so the slow drifts of a shared VM cancel out (separate benchmarks of identical code
 // differed by up to 6 % here).
 #include "flexfit/flexfit.hpp"
+#include "part_bench_support.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -15,19 +16,8 @@ namespace {
 
 using namespace flexfit;
 
-const std::shared_ptr<const PartModel>& modelByIndex(int which) {
-    static const std::shared_ptr<const PartModel> models[2] = {buildPartModel(makeTorus1()), buildPartModel(makeHeart())};
-    return models[which];
-}
-
-PartSettings settings(PartMode mode) {
-    PartSettings s;
-    s.mode = mode;
-    s.simulation.timeStep = 1e-3;
-    s.simulation.restoration.method = RestorationMethod::Constraint;
-    s.simulation.restoration.constraintFraction = 1e-3;
-    return s;
-}
+using flexfit::bench::modelByIndex;
+using flexfit::bench::settings;
 
 template <class MakeA, class MakeB>
 void paired(benchmark::State& state, MakeA makeA, MakeB makeB, int chunk, bool loadA, bool loadB) {

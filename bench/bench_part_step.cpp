@@ -2,6 +2,7 @@
 // one run: the full MSD step, one zone at level 1, zones covering the whole mesh, and untouched
 // parts of different sizes. Every stepping case loads one mass per step (an operator force).
 #include "flexfit/flexfit.hpp"
+#include "part_bench_support.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -10,19 +11,8 @@ namespace {
 
 using namespace flexfit;
 
-const std::shared_ptr<const PartModel>& modelByIndex(int which) {
-    static const std::shared_ptr<const PartModel> models[2] = {buildPartModel(makeTorus1()), buildPartModel(makeHeart())};
-    return models[which];
-}
-
-PartSettings settings(PartMode mode) {
-    PartSettings s;
-    s.mode = mode;
-    s.simulation.timeStep = 1e-3;
-    s.simulation.restoration.method = RestorationMethod::Constraint;
-    s.simulation.restoration.constraintFraction = 1e-3;
-    return s;
-}
+using flexfit::bench::modelByIndex;
+using flexfit::bench::settings;
 
 void stepLoaded(benchmark::State& state, Part& part) {
     StepCounters counters;

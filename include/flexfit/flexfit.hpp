@@ -10,6 +10,7 @@
 #include "flexfit/part.hpp"
 #include "flexfit/pose.hpp"
 #include "flexfit/kring.hpp"
+#include "flexfit/mass_properties.hpp"
 #include "flexfit/part_model.hpp"
 #include "flexfit/part_state.hpp"
 #include "flexfit/simulation.hpp"
