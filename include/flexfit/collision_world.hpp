@@ -58,6 +58,8 @@ public:
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& candidatePairs() const { return pairs_; }
     // update(), then the narrow phase over the candidate pairs.
     const std::vector<Contact>& findContacts();
+    // The narrow phase alone, over the candidate pairs of the last update.
+    const std::vector<Contact>& narrowPhase();
     const std::vector<Contact>& contacts() const { return contacts_; }
     const QueryStats& stats() const { return stats_; }  // of the last findContacts()
 

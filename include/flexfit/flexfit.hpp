@@ -15,3 +15,4 @@
 #include "flexfit/part_state.hpp"
 #include "flexfit/simulation.hpp"
 #include "flexfit/topology.hpp"
+#include "flexfit/world.hpp"

@@ -87,6 +87,10 @@ bool CollisionWorld::pressesFirst(std::uint32_t a, std::uint32_t b) const {
 
 const std::vector<Contact>& CollisionWorld::findContacts() {
     update();
+    return narrowPhase();
+}
+
+const std::vector<Contact>& CollisionWorld::narrowPhase() {
     contacts_.clear();
     stats_ = {};
     for (auto [i, j] : pairs_) {

@@ -1,0 +1,130 @@
+// The world: parts with rigid-body motion, collisions and deformation, advanced by one step
+// made of named, profiled stages (SPEC 7-8, thesis 4.4).
+//
+// Motion types: Static (never moves), Kinematic (moved by the caller or the operator: its pose
+// is set, its velocity derived), Dynamic (gravity, forces and torques, inertia from the mesh at
+// the body's density). Each body is a Part, so any motion type combines with any deformation
+// mode (rigid, rigid-deformable, full-deformable).
+//
+// No tunnelling (conservative advancement): a dynamic body's motion in a step is cut into
+// sub-steps so that no point of it travels more than `maxTravelFraction` of the thinnest body
+// it can meet (each body's thickness: its smallest bounding-box half-extent unless given), and
+// contacts are detected and resolved after every sub-step. A body can therefore not jump over
+// a part, whatever its speed or the time step; the cost grows with speed x dt / thickness.
+// Known limit: the thickness estimate assumes parts are at least as thick as the smallest
+// half-extent of their box (a thin diagonal feature needs BodySettings::thickness).
+//
+// Rigid contacts are resolved by projection: the dynamic body moves out of its contacts
+// (Gauss-Seidel over their normals and depths, re-detected up to contactIterations times per
+// sub-step) and loses the velocity into them (inelastic, no friction yet). Contacts with
+// deformable parts go to the collision world's response.
+//
+// Stages, in order, each timed into profile(): operator input, broad phase, narrow phase,
+// contact response, zone dynamics (the deformable parts' step, restoration included: the
+// constraint is applied inside the integration), zone retirement, assembly.
+#pragma once
+
+#include "flexfit/collision_world.hpp"
+#include "flexfit/mass_properties.hpp"
+
+#include <array>
+#include <memory>
+
+namespace flexfit {
+
+enum class MotionType { Static, Kinematic, Dynamic };
+const char* toString(MotionType motion);
+
+struct BodySettings {
+    MotionType motion = MotionType::Static;
+    double density = 1.0;                  // mass = density x enclosed volume (dynamic bodies)
+    Vec3 linearVelocity = Vec3::Zero();    // initial, world (m/s)
+    Vec3 angularVelocity = Vec3::Zero();   // initial, world (rad/s)
+    double thickness = 0.0;                // for the no-tunnelling bound; 0: smallest box half-extent
+    BoundingVolumeKind boundingVolume = BoundingVolumeKind::Aabb;
+};
+
+struct RigidBody {
+    MotionType motion = MotionType::Static;
+    double mass = 0.0, inverseMass = 0.0;
+    Vec3 centreOfMass = Vec3::Zero();                        // part frame
+    Eigen::Matrix3d inverseInertia = Eigen::Matrix3d::Zero(); // part frame, about the centre of mass
+    Vec3 linearVelocity = Vec3::Zero();   // world, of the centre of mass
+    Vec3 angularVelocity = Vec3::Zero();  // world
+    Vec3 force = Vec3::Zero();            // world, accumulated for the next step
+    Vec3 torque = Vec3::Zero();           // world, about the centre of mass
+    double thickness = 0.0;
+    double boundingRadius = 0.0;          // from the centre of mass to the farthest mass
+};
+
+enum class Stage { OperatorInput, BroadPhase, NarrowPhase, ContactResponse, ZoneDynamics, ZoneRetirement, Assembly, Count };
+const char* toString(Stage stage);
+
+struct Profile {
+    std::array<double, std::size_t(Stage::Count)> lastSeconds{};   // the last step
+    std::array<double, std::size_t(Stage::Count)> totalSeconds{};  // since the start
+    std::uint64_t steps = 0;
+    std::uint64_t substeps = 0;  // dynamic sub-steps taken in all (no-tunnelling bound)
+};
+
+struct WorldSettings {
+    double timeStep = 1e-3;
+    Vec3 gravity = Vec3(0.0, -9.81, 0.0);
+    CollisionSettings collision;
+    double maxTravelFraction = 0.25;  // of the thinnest body, per sub-step
+    int maxSubsteps = 4096;
+    int contactIterations = 4;        // projection passes per sub-step
+};
+
+using BodyId = std::uint32_t;
+
+class World {
+public:
+    explicit World(WorldSettings settings = {});
+
+    // Adds a part with its rigid-body description; returns its id (0, 1, 2, ...). Dynamic
+    // bodies need a closed mesh (their mass and inertia come from its volume). The part's
+    // simulation time step is set to the world's.
+    BodyId add(std::shared_ptr<const PartModel> model, const PartSettings& part, const BodySettings& body, const Pose& pose);
+
+    std::size_t bodyCount() const { return parts_.size(); }
+    Part& part(BodyId id) { return *parts_[id]; }
+    const Part& part(BodyId id) const { return *parts_[id]; }
+    const RigidBody& body(BodyId id) const { return bodies_[id]; }
+    const WorldSettings& settings() const { return settings_; }
+
+    // Forces for the next step (dynamic bodies; ignored otherwise).
+    void applyForce(BodyId id, const Vec3& worldForce);                           // at the centre of mass
+    void applyForceAt(BodyId id, const Vec3& worldForce, const Vec3& worldPoint);  // adds the torque
+    void setVelocity(BodyId id, const Vec3& linear, const Vec3& angular);
+    // Kinematic bodies: the pose to reach by the end of the next step (velocity derived).
+    void setKinematicTarget(BodyId id, const Pose& target);
+
+    void step();
+    double time() const { return time_; }
+
+    const std::vector<Contact>& contacts() const { return collision_.contacts(); }
+    const Profile& profile() const { return profile_; }
+    CollisionWorld& collision() { return collision_; }
+
+    // World position of a body's centre of mass.
+    Vec3 centreOfMass(BodyId id) const { return parts_[id]->pose().apply(bodies_[id].centreOfMass); }
+
+private:
+    void operatorInput();
+    void integrateDynamicBodies();
+    void advanceBody(BodyId id, double dt);
+    void resolveRigidContacts(BodyId id);
+    double minimumThickness() const;
+
+    WorldSettings settings_;
+    std::vector<std::unique_ptr<Part>> parts_;
+    std::vector<RigidBody> bodies_;
+    std::vector<std::optional<Pose>> kinematicTargets_;
+    CollisionWorld collision_;
+    std::vector<std::pair<Vec3, double>> pushes_;  // scratch: contact direction and depth
+    Profile profile_;
+    double time_ = 0.0;
+};
+
+}  // namespace flexfit

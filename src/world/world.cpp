@@ -1,0 +1,234 @@
+#include "flexfit/world.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <cmath>
+
+namespace flexfit {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Adds the time since `start` to a stage of the profile and restarts the clock.
+class StageTimer {
+public:
+    explicit StageTimer(Profile& profile) : profile_(profile), start_(Clock::now()) {}
+    void restart() { start_ = Clock::now(); }
+    void charge(Stage stage) {
+        const auto now = Clock::now();
+        const double seconds = std::chrono::duration<double>(now - start_).count();
+        profile_.lastSeconds[std::size_t(stage)] += seconds;
+        profile_.totalSeconds[std::size_t(stage)] += seconds;
+        start_ = now;
+    }
+
+private:
+    Profile& profile_;
+    Clock::time_point start_;
+};
+
+const std::string kWorldSource = "world";
+
+}  // namespace
+
+const char* toString(MotionType motion) {
+    switch (motion) {
+        case MotionType::Static: return "static";
+        case MotionType::Kinematic: return "kinematic";
+        case MotionType::Dynamic: return "dynamic";
+    }
+    return "?";
+}
+
+const char* toString(Stage stage) {
+    static const char* names[] = {"operator input", "broad phase", "narrow phase", "contact response",
+                                  "zone dynamics", "zone retirement", "assembly"};
+    return stage < Stage::Count ? names[std::size_t(stage)] : "?";
+}
+
+World::World(WorldSettings settings) : settings_(settings), collision_(settings.collision) {
+    SimulationSettings check;
+    check.timeStep = settings_.timeStep;
+    check.gravity = settings_.gravity;
+    validateSettings(check);
+    if (!(settings_.maxTravelFraction > 0.0 && settings_.maxTravelFraction <= 1.0))
+        throw InputError(kWorldSource, 0, "max travel fraction must be in (0, 1]");
+    if (settings_.maxSubsteps < 1 || settings_.contactIterations < 1)
+        throw InputError(kWorldSource, 0, "max substeps and contact iterations must be >= 1");
+}
+
+BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& partSettings, const BodySettings& settings,
+                  const Pose& pose) {
+    if (!(settings.density > 0.0) || !std::isfinite(settings.density))
+        throw InputError(kWorldSource, 0, "body density must be finite and > 0");
+    if (!(settings.thickness >= 0.0) || !settings.linearVelocity.allFinite() || !settings.angularVelocity.allFinite())
+        throw InputError(kWorldSource, 0, "body thickness and velocities must be finite");
+    RigidBody body;
+    body.motion = settings.motion;
+    const Eigen::AlignedBox3d box = boundingBox(model->mesh);
+    body.thickness = settings.thickness > 0.0 ? settings.thickness : 0.5 * box.sizes().minCoeff();
+    body.centreOfMass = box.center();
+    if (settings.motion == MotionType::Dynamic) {
+        const MassProperties mp = computeMassProperties(model->mesh, model->name);
+        body.mass = settings.density * mp.volume;
+        body.inverseMass = 1.0 / body.mass;
+        body.centreOfMass = mp.centroid;
+        body.inverseInertia = (settings.density * mp.inertia).inverse();
+    }
+    for (const Vec3& p : model->restPositions) body.boundingRadius = std::max(body.boundingRadius, (p - body.centreOfMass).norm());
+    body.linearVelocity = settings.linearVelocity;
+    body.angularVelocity = settings.angularVelocity;
+
+    PartSettings ps = partSettings;
+    ps.simulation.timeStep = settings_.timeStep;
+    ps.simulation.gravity = settings_.gravity;
+    auto part = std::make_unique<Part>(std::move(model), ps);
+    part->setPose(pose);
+    collision_.add(*part, settings.boundingVolume);
+    parts_.push_back(std::move(part));
+    bodies_.push_back(body);
+    kinematicTargets_.emplace_back();
+    return BodyId(parts_.size() - 1);
+}
+
+void World::applyForce(BodyId id, const Vec3& worldForce) {
+    if (bodies_[id].motion == MotionType::Dynamic) bodies_[id].force += worldForce;
+}
+
+void World::applyForceAt(BodyId id, const Vec3& worldForce, const Vec3& worldPoint) {
+    if (bodies_[id].motion != MotionType::Dynamic) return;
+    bodies_[id].force += worldForce;
+    bodies_[id].torque += (worldPoint - centreOfMass(id)).cross(worldForce);
+}
+
+void World::setVelocity(BodyId id, const Vec3& linear, const Vec3& angular) {
+    bodies_[id].linearVelocity = linear;
+    bodies_[id].angularVelocity = angular;
+}
+
+void World::setKinematicTarget(BodyId id, const Pose& target) {
+    if (bodies_[id].motion == MotionType::Kinematic) kinematicTargets_[id] = target;
+}
+
+// --- The step ---
+
+void World::step() {
+    profile_.lastSeconds.fill(0.0);
+    StageTimer timer(profile_);
+    operatorInput();
+    timer.charge(Stage::OperatorInput);
+    integrateDynamicBodies();  // sub-stepped, with its own contact passes (charged inside)
+    timer.restart();  // the sub-steps charged their own stages
+    collision_.update();
+    timer.charge(Stage::BroadPhase);
+    const std::vector<Contact>& contacts = collision_.narrowPhase();
+    timer.charge(Stage::NarrowPhase);
+    collision_.respond(contacts);
+    timer.charge(Stage::ContactResponse);
+    for (auto& part : parts_) part->step();
+    timer.charge(Stage::ZoneDynamics);
+    // Zone retirement runs inside Part::step (every retireCheckInterval steps); assembly
+    // (snapping) arrives with the assembly stage.
+    timer.charge(Stage::ZoneRetirement);
+    timer.charge(Stage::Assembly);
+    time_ += settings_.timeStep;
+    ++profile_.steps;
+}
+
+void World::operatorInput() {
+    const double h = settings_.timeStep;
+    for (BodyId id = 0; id < parts_.size(); ++id) {
+        if (!kinematicTargets_[id]) continue;
+        const Pose target = *kinematicTargets_[id];
+        RigidBody& body = bodies_[id];
+        const Vec3 before = centreOfMass(id);
+        const Eigen::AngleAxisd turn(target.rotation * parts_[id]->pose().rotation.conjugate());
+        parts_[id]->setPose(target);
+        body.linearVelocity = (centreOfMass(id) - before) / h;
+        body.angularVelocity = turn.axis() * (turn.angle() / h);
+        kinematicTargets_[id].reset();
+    }
+}
+
+double World::minimumThickness() const {
+    double thinnest = std::numeric_limits<double>::infinity();
+    for (const RigidBody& b : bodies_) thinnest = std::min(thinnest, b.thickness);
+    return thinnest;
+}
+
+void World::integrateDynamicBodies() {
+    const double h = settings_.timeStep;
+    const double bound = settings_.maxTravelFraction * minimumThickness();
+    for (BodyId id = 0; id < parts_.size(); ++id) {
+        RigidBody& body = bodies_[id];
+        if (body.motion != MotionType::Dynamic) continue;
+        // Velocity first (semi-implicit Euler); then the travel it gives decides the sub-steps.
+        const Eigen::Matrix3d r = parts_[id]->pose().rotation.toRotationMatrix();
+        const Eigen::Matrix3d inverseInertia = r * body.inverseInertia * r.transpose();
+        const Eigen::Matrix3d inertia = inverseInertia.inverse();
+        body.linearVelocity += h * (settings_.gravity + body.inverseMass * body.force);
+        body.angularVelocity += h * (inverseInertia * (body.torque - body.angularVelocity.cross(inertia * body.angularVelocity)));
+        body.force.setZero();
+        body.torque.setZero();
+        const double travel = h * (body.linearVelocity.norm() + body.angularVelocity.norm() * body.boundingRadius);
+        const int substeps = std::clamp(int(std::ceil(travel / bound)), 1, settings_.maxSubsteps);
+        for (int s = 0; s < substeps; ++s) {
+            advanceBody(id, h / substeps);
+            resolveRigidContacts(id);
+        }
+        profile_.substeps += std::uint64_t(substeps);
+    }
+}
+
+void World::advanceBody(BodyId id, double dt) {
+    RigidBody& body = bodies_[id];
+    Part& part = *parts_[id];
+    const Vec3 com = centreOfMass(id) + dt * body.linearVelocity;
+    Pose pose = part.pose();
+    const double speed = body.angularVelocity.norm();
+    if (speed > 0.0)
+        pose.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(speed * dt, body.angularVelocity / speed)) * pose.rotation).normalized();
+    pose.translation = com - pose.rotation * body.centreOfMass;
+    part.setPose(pose);
+}
+
+void World::resolveRigidContacts(BodyId id) {
+    RigidBody& body = bodies_[id];
+    for (int iteration = 0; iteration < settings_.contactIterations; ++iteration) {
+        StageTimer timer(profile_);
+        collision_.update();
+        timer.charge(Stage::BroadPhase);
+        const std::vector<Contact>& contacts = collision_.narrowPhase();
+        timer.charge(Stage::NarrowPhase);
+        // This body's contacts with parts that do not deform: direction out of them, depth.
+        pushes_.clear();
+        for (const Contact& c : contacts) {
+            if (c.partA != id && c.partB != id) continue;
+            const BodyId other = c.partA == id ? c.partB : c.partA;
+            if (parts_[other]->mode() != PartMode::Rigid) continue;
+            pushes_.emplace_back(c.partA == id ? c.normal : Vec3(-c.normal), c.depth);
+        }
+        if (pushes_.empty()) {
+            timer.charge(Stage::ContactResponse);
+            return;
+        }
+        // Gauss-Seidel over the contacts: each takes what the correction so far leaves of its
+        // depth along its normal. Symmetric contacts (a ball on a ring) cancel sideways and add
+        // up along the common direction, instead of pushing the body from side to side.
+        Vec3 correction = Vec3::Zero();
+        for (int pass = 0; pass < 4; ++pass)
+            for (const auto& [out, depth] : pushes_) {
+                const double remaining = depth - correction.dot(out);
+                if (remaining > 0.0) correction += remaining * out;
+            }
+        parts_[id]->translate(correction);
+        for (const auto& [out, depth] : pushes_) {
+            const double into = body.linearVelocity.dot(out);
+            if (into < 0.0) body.linearVelocity -= into * out;  // inelastic
+        }
+        timer.charge(Stage::ContactResponse);
+    }
+}
+
+}  // namespace flexfit
