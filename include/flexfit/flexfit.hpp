@@ -2,6 +2,7 @@
 #pragma once
 
 #include "flexfit/activity.hpp"
+#include "flexfit/assembly.hpp"
 #include "flexfit/collision_world.hpp"
 #include "flexfit/core.hpp"
 #include "flexfit/generators.hpp"

@@ -21,9 +21,11 @@
 //
 // Stages, in order, each timed into profile(): operator input, broad phase, narrow phase,
 // contact response, zone dynamics (the deformable parts' step, restoration included: the
-// constraint is applied inside the integration), zone retirement, assembly.
+// constraint is applied inside the integration), zone retirement (inside the parts' step, so
+// charged to zone dynamics), assembly (the snapping rules).
 #pragma once
 
+#include "flexfit/assembly.hpp"
 #include "flexfit/collision_world.hpp"
 #include "flexfit/mass_properties.hpp"
 
@@ -100,6 +102,14 @@ public:
     // Kinematic bodies: the pose to reach by the end of the next step (velocity derived).
     void setKinematicTarget(BodyId id, const Pose& target);
 
+    // Assembly rules (assembly.hpp), checked in the assembly stage of every step. When a rule
+    // triggers, its primary stops being driven (it becomes kinematic), is brought to its final
+    // pose over the snap duration, and then stays attached to the secondary. Throws InputError
+    // for unknown bodies or a negative duration.
+    std::size_t addAssembly(const AssemblyRule& rule);
+    const std::vector<AssemblyEvent>& assemblyEvents() const { return events_; }
+    bool assembled(std::size_t rule) const { return rules_[rule].phase == RuleState::Phase::Assembled; }
+
     void step();
     double time() const { return time_; }
 
@@ -116,6 +126,17 @@ private:
     void advanceBody(BodyId id, double dt);
     void resolveRigidContacts(BodyId id);
     double minimumThickness() const;
+    void assemble();
+    bool touching(BodyId a, BodyId b) const;
+
+    struct RuleState {
+        AssemblyRule rule;
+        enum class Phase { Waiting, Snapping, Assembled } phase = Phase::Waiting;
+        double start = 0.0;
+        Pose from;
+    };
+    std::vector<RuleState> rules_;
+    std::vector<AssemblyEvent> events_;
 
     WorldSettings settings_;
     std::vector<std::unique_ptr<Part>> parts_;

@@ -128,9 +128,8 @@ void World::step() {
     timer.charge(Stage::ContactResponse);
     for (auto& part : parts_) part->step();
     timer.charge(Stage::ZoneDynamics);
-    // Zone retirement runs inside Part::step (every retireCheckInterval steps); assembly
-    // (snapping) arrives with the assembly stage.
-    timer.charge(Stage::ZoneRetirement);
+    timer.charge(Stage::ZoneRetirement);  // inside Part::step: charged to zone dynamics
+    assemble();
     timer.charge(Stage::Assembly);
     time_ += settings_.timeStep;
     ++profile_.steps;
@@ -148,6 +147,48 @@ void World::operatorInput() {
         body.linearVelocity = (centreOfMass(id) - before) / h;
         body.angularVelocity = turn.axis() * (turn.angle() / h);
         kinematicTargets_[id].reset();
+    }
+}
+
+// --- Assembly ---
+
+std::size_t World::addAssembly(const AssemblyRule& rule) {
+    if (rule.primary >= parts_.size() || rule.secondary >= parts_.size() || rule.primary == rule.secondary)
+        throw InputError(kWorldSource, 0, "assembly rule '" + rule.name + "' needs two different existing bodies");
+    if (!(rule.snapDuration >= 0.0) || !std::isfinite(rule.snapDuration))
+        throw InputError(kWorldSource, 0, "assembly rule '" + rule.name + "': snap duration must be finite and >= 0");
+    RuleState state;
+    state.rule = rule;
+    rules_.push_back(state);
+    return rules_.size() - 1;
+}
+
+bool World::touching(BodyId a, BodyId b) const {
+    for (const Contact& c : collision_.contacts())
+        if ((c.partA == a && c.partB == b) || (c.partA == b && c.partB == a)) return true;
+    return false;
+}
+
+void World::assemble() {
+    for (RuleState& state : rules_) {
+        const AssemblyRule& rule = state.rule;
+        Part& primary = *parts_[rule.primary];
+        const Pose target = finalPose(rule, parts_[rule.secondary]->pose());
+        if (state.phase == RuleState::Phase::Waiting) {
+            if (!snapConditionHolds(rule, primary.pose(), parts_[rule.secondary]->pose(), touching(rule.primary, rule.secondary)))
+                continue;
+            state.phase = RuleState::Phase::Snapping;
+            state.start = time_;
+            state.from = primary.pose();
+            events_.push_back({rule.name, rule.technique, time_, state.from, target});
+            RigidBody& body = bodies_[rule.primary];
+            body.motion = MotionType::Kinematic;  // the snap drives it from now on
+            body.linearVelocity.setZero();
+            body.angularVelocity.setZero();
+        }
+        const double s = rule.snapDuration > 0.0 ? (time_ + settings_.timeStep - state.start) / rule.snapDuration : 1.0;
+        primary.setPose(interpolate(state.from, target, s));
+        if (s >= 1.0) state.phase = RuleState::Phase::Assembled;  // and stays attached
     }
 }
 

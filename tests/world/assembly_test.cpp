@@ -1,0 +1,113 @@
+// Snapping: each technique's positive and negative case (geometry worked out by hand), the
+// interpolated snap, and a ball falling through the container mouth assembled by zone
+// snap-fitting in the world.
+#include "flexfit/flexfit.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace flexfit;
+
+namespace {
+
+Pose at(const Vec3& p, double angle = 0.0, const Vec3& axis = Vec3::UnitY()) {
+    return Pose{Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis)), p};
+}
+
+AssemblyRule rule(SnapTechnique technique) {
+    AssemblyRule r;
+    r.name = toString(technique);
+    r.technique = technique;
+    r.finalRelativePose = at(Vec3(0, -8, 0));
+    r.primaryVector = {Vec3(0, -1, 0), Vec3(0, 1, 0)};  // a vertical diameter of the primary
+    r.secondaryVector = {Vec3(0, -9, 0), Vec3(0, -7, 0)};
+    r.area.shape = AssemblyArea::Shape::Cylinder;
+    r.area.frame = at(Vec3(0, -8, 0));
+    r.area.radius = 3.0;
+    r.area.halfHeight = 2.0;
+    return r;
+}
+
+}  // namespace
+
+TEST(Assembly, CollisionSnapNeedsContact) {
+    const AssemblyRule r = rule(SnapTechnique::CollisionSnap);
+    EXPECT_TRUE(snapConditionHolds(r, at(Vec3(5, 5, 5)), Pose{}, true));
+    EXPECT_FALSE(snapConditionHolds(r, at(Vec3(0, -8, 0)), Pose{}, false));
+}
+
+TEST(Assembly, ProximitySnapWithinDistanceAndAngle) {
+    const AssemblyRule r = rule(SnapTechnique::ProximitySnap);
+    const Pose secondary = at(Vec3(10, 0, 0));
+    EXPECT_TRUE(snapConditionHolds(r, at(Vec3(10.3, -8, 0.2), 0.1), secondary, false));
+    EXPECT_FALSE(snapConditionHolds(r, at(Vec3(10.8, -8, 0)), secondary, false));      // too far
+    EXPECT_FALSE(snapConditionHolds(r, at(Vec3(10, -8, 0), 0.5), secondary, false));   // turned too much
+}
+
+TEST(Assembly, VectorSnapRefusesTheWrongOrientation) {
+    const AssemblyRule r = rule(SnapTechnique::VectorSnap);
+    EXPECT_TRUE(snapConditionHolds(r, at(Vec3(0.2, -8, 0)), Pose{}, false));
+    // Upside down: the primary's origin lands on the secondary's end and vice versa.
+    EXPECT_FALSE(snapConditionHolds(r, at(Vec3(0, -8, 0), M_PI, Vec3::UnitX()), Pose{}, false));
+    EXPECT_FALSE(snapConditionHolds(r, at(Vec3(0, -6, 0)), Pose{}, false));  // ends 2 apart
+}
+
+TEST(Assembly, ZoneSnapNeedsTheWholeVectorInsideTheArea) {
+    const AssemblyRule r = rule(SnapTechnique::ZoneSnap);
+    EXPECT_TRUE(snapConditionHolds(r, at(Vec3(1, -8.5, 0)), Pose{}, false));
+    EXPECT_FALSE(snapConditionHolds(r, at(Vec3(0, -5.5, 0)), Pose{}, false));   // upper end out (y -4.5 > -6)
+    EXPECT_FALSE(snapConditionHolds(r, at(Vec3(3.5, -8, 0)), Pose{}, false));   // beside the cylinder
+    AssemblyRule box = r;
+    box.area.shape = AssemblyArea::Shape::Box;
+    box.area.halfExtents = Vec3(1, 2, 1);
+    EXPECT_TRUE(snapConditionHolds(box, at(Vec3(0.5, -8, -0.5)), Pose{}, false));
+    EXPECT_FALSE(snapConditionHolds(box, at(Vec3(1.5, -8, 0)), Pose{}, false));
+    AssemblyRule sphere = r;
+    sphere.area.shape = AssemblyArea::Shape::Sphere;
+    sphere.area.radius = 1.5;
+    EXPECT_TRUE(snapConditionHolds(sphere, at(Vec3(0, -8.3, 0)), Pose{}, false));
+    EXPECT_FALSE(snapConditionHolds(sphere, at(Vec3(0, -8.7, 0)), Pose{}, false));  // lower end at -9.7
+}
+
+TEST(Assembly, InterpolationIsContinuous) {
+    const Pose a = at(Vec3(0, 0, 0)), b = at(Vec3(2, 4, 0), 1.0);
+    EXPECT_TRUE(interpolate(a, b, 0).translation.isApprox(a.translation));
+    EXPECT_TRUE(interpolate(a, b, 1).rotation.isApprox(b.rotation));
+    const Pose half = interpolate(a, b, 0.5);
+    EXPECT_TRUE(half.translation.isApprox(Vec3(1, 2, 0)));
+    EXPECT_NEAR(half.rotation.angularDistance(a.rotation), 0.5, 1e-12);
+}
+
+TEST(Assembly, BallThroughTheMouthIsAssembledByZoneSnapFitting) {
+    auto run = [](double areaHalfHeight) {
+        World world;
+        PartSettings rigid;
+        rigid.mode = PartMode::Rigid;
+        const BodyId mouth = world.add(buildPartModel(makeContainerMouth()), rigid, BodySettings{}, Pose{});
+        BodySettings ball;
+        ball.motion = MotionType::Dynamic;
+        const BodyId b = world.add(buildPartModel(makeIcoSphere(7.0, 2)), rigid, ball, at(Vec3(0, 9, 0)));
+        AssemblyRule r = rule(SnapTechnique::ZoneSnap);
+        r.primary = b;
+        r.secondary = mouth;
+        r.primaryVector = {Vec3(0, -7, 0), Vec3(0, 7, 0)};  // the ball's vertical diameter
+        r.area.frame = at(Vec3(0, -12, 0));                  // inside the container, below the mouth
+        r.area.radius = 7.5;
+        r.area.halfHeight = areaHalfHeight;
+        r.finalRelativePose = at(Vec3(0, -12, 0));
+        r.snapDuration = 0.1;
+        world.addAssembly(r);
+        for (int i = 0; i < 2500; ++i) world.step();
+        return std::make_tuple(world.assemblyEvents(), world.centreOfMass(b), world.assembled(0));
+    };
+    const auto [events, centre, done] = run(8.0);
+    ASSERT_EQ(events.size(), 1u);
+    EXPECT_EQ(events[0].technique, SnapTechnique::ZoneSnap);
+    EXPECT_TRUE(done);
+    EXPECT_LT((centre - Vec3(0, -12, 0)).norm(), 1e-9);  // exactly at its final place, held there
+    EXPECT_LT(events[0].primaryPoseBefore.translation.y(), 0.0);
+    // An area too short for the 14-long vector never takes it: the ball falls on.
+    const auto [none, fallen, never] = run(6.0);
+    EXPECT_TRUE(none.empty());
+    EXPECT_FALSE(never);
+    EXPECT_LT(fallen.y(), -20.0);
+}
