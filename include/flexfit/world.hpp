@@ -14,6 +14,10 @@
 // Known limit: the thickness estimate assumes parts are at least as thick as the smallest
 // half-extent of their box (a thin diagonal feature needs BodySettings::thickness).
 //
+// Deformable contacts: the collision response deforms the part, and a dynamic body pressing it
+// receives the force of the displaced springs, k_eff (rest - x) summed over the contacted
+// masses (k_eff as in collision_world.hpp), for the next step.
+//
 // Rigid contacts are resolved by projection: the dynamic body moves out of its contacts
 // (Gauss-Seidel over their normals and depths, re-detected up to contactIterations times per
 // sub-step) and loses the velocity into them (inelastic, no friction yet). Contacts with
@@ -31,6 +35,7 @@
 
 #include <array>
 #include <memory>
+#include <tuple>
 
 namespace flexfit {
 
@@ -127,6 +132,8 @@ private:
     void resolveRigidContacts(BodyId id);
     double minimumThickness() const;
     void assemble();
+    void applyDeformableReactions(std::span<const Contact> contacts);
+    std::vector<std::tuple<BodyId, BodyId, Index>> reactionMasses_;  // scratch: (body, part, mass)
     bool touching(BodyId a, BodyId b) const;
 
     struct RuleState {

@@ -125,6 +125,7 @@ void World::step() {
     const std::vector<Contact>& contacts = collision_.narrowPhase();
     timer.charge(Stage::NarrowPhase);
     collision_.respond(contacts);
+    applyDeformableReactions(contacts);
     timer.charge(Stage::ContactResponse);
     for (auto& part : parts_) part->step();
     timer.charge(Stage::ZoneDynamics);
@@ -147,6 +148,26 @@ void World::operatorInput() {
         body.linearVelocity = (centreOfMass(id) - before) / h;
         body.angularVelocity = turn.axis() * (turn.angle() / h);
         kinematicTargets_[id].reset();
+    }
+}
+
+// A dynamic body pressing a deformable part feels the springs it displaced: the contacted
+// masses sit at x (pushed from their rest positions by the response) and the part pulls them
+// back with k_eff (rest - x); through the contact, the body receives that force, for the next
+// step. A weak push is stopped by a stiff rim; a strong one deforms it and passes.
+void World::applyDeformableReactions(std::span<const Contact> contacts) {
+    reactionMasses_.clear();
+    for (const Contact& c : contacts)
+        for (const auto& [body, part, face] : {std::tuple{c.partA, c.partB, c.faceB}, std::tuple{c.partB, c.partA, c.faceA}}) {
+            if (bodies_[body].motion != MotionType::Dynamic || parts_[part]->mode() == PartMode::Rigid) continue;
+            for (Index m : parts_[part]->model().mesh.faces[face]) reactionMasses_.push_back({body, part, m});
+        }
+    std::sort(reactionMasses_.begin(), reactionMasses_.end());
+    reactionMasses_.erase(std::unique(reactionMasses_.begin(), reactionMasses_.end()), reactionMasses_.end());
+    for (const auto& [body, part, m] : reactionMasses_) {
+        const Part& p = *parts_[part];
+        const Vec3 displacement = p.pose().rotate(p.state().positions[m] - p.model().restPositions[m]);
+        bodies_[body].force -= collision_.effectiveStiffness(part) * displacement;
     }
 }
 

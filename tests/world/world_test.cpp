@@ -134,3 +134,36 @@ TEST(World, DeterministicRun) {
     EXPECT_EQ(a.first, b.first);
     EXPECT_EQ(a.second, b.second);
 }
+
+TEST(World, DeformableRimStopsAWeakPushAndYieldsToAStrongOne) {
+    auto run = [](double constraint, double push) {
+        World world;
+        PartSettings rim;
+        rim.simulation.restoration = {RestorationMethod::Constraint, 0.0, 0.0, constraint};
+        rim.simulation.globalDamping = 1.0;
+        rim.zones.contactLevel = 3;
+        BodySettings ball;
+        ball.motion = MotionType::Dynamic;
+        ball.density = 0.01;  // about 25 kg
+        const BodyId torus = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}}), rim, BodySettings{}, Pose{});
+        PartSettings rigid;
+        rigid.mode = PartMode::Rigid;
+        const BodyId b = world.add(buildPartModel(makeIcoSphere(8.5, 2)), rigid, ball, at(Vec3(0, 11, 0)));
+        std::size_t deformed = 0;
+        for (int i = 0; i < 2500; ++i) {
+            if (push > 0) world.applyForce(b, Vec3(0, -push, 0));
+            world.step();
+            deformed = std::max(deformed, world.part(torus).movingMasses().size());
+        }
+        return std::make_pair(world.centreOfMass(b).y(), deformed);
+    };
+    // A 17 ball under its weight on a stiff rim (k_eff about 5,000 N/m per kg): it rests on the
+    // locally deformed rim.
+    const auto [resting, deformedStiff] = run(5e-3, 0.0);
+    EXPECT_GT(resting, 2.0);
+    EXPECT_GT(deformedStiff, 0u);
+    // The same ball pushed with 2,500 N against a soft rim (about 11 N/m per kg): it passes.
+    const auto [passed, deformedSoft] = run(1e-5, 2500.0);
+    EXPECT_LT(passed, -20.0);
+    EXPECT_GT(deformedSoft, deformedStiff / 2);
+}
