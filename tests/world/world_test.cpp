@@ -87,15 +87,22 @@ TEST(World, BallWiderThanTheOpeningRestsOnTheRim) {
     EXPECT_LT(scene.world.body(scene.ball).linearVelocity.norm(), 0.2);
 }
 
+// Sanitizer builds run ~30x slower: they check the largest time step only.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kTimeSteps[] = {2e-2};
+#else
+constexpr double kTimeSteps[] = {1e-3, 2e-2};
+#endif
+
 TEST(World, NoTunnellingAtAnySpeedOrTimeStep) {
     // Every ball wider than the opening is stopped, thrown down at up to 2,000 units/s with time
-    // steps up to 20 ms; the narrower ones fall through.
+    // steps up to 20 ms; the narrower one falls through.
     for (double diameter : {14.0, 15.1, 17.0})
         for (double speed : {0.0, 2000.0})
-            for (double dt : {1e-3, 2e-2}) {
-                BallTorus scene(diameter, dt, Vec3(0, -speed, 0));
+            for (double dt : kTimeSteps) {
+                BallTorus scene(diameter, dt, Vec3(0, -speed, 0), 10.0);
                 double lowest = scene.ballHeight();
-                for (double t = 0; t < 2.5; t += dt) {
+                for (double t = 0; t < 1.8; t += dt) {
                     scene.world.step();
                     lowest = std::min(lowest, scene.ballHeight());
                 }
@@ -104,7 +111,7 @@ TEST(World, NoTunnellingAtAnySpeedOrTimeStep) {
                 if (diameter > 15.0)
                     EXPECT_GT(lowest, 0.0) << "diameter " << diameter << " speed " << speed << " dt " << dt;
                 else
-                    EXPECT_LT(scene.ballHeight(), -10.0) << "diameter " << diameter << " speed " << speed << " dt " << dt;
+                    EXPECT_LT(scene.ballHeight(), -5.0) << "diameter " << diameter << " speed " << speed << " dt " << dt;
             }
 }
 
