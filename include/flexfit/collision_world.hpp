@@ -60,6 +60,12 @@ public:
     const std::vector<Contact>& findContacts();
     // The narrow phase alone, over the candidate pairs of the last update.
     const std::vector<Contact>& narrowPhase();
+    // Refits every part's hierarchy around its changed masses (the first half of update()).
+    void refitChanged();
+    // The contacts of one part with every part whose sphere touches its own, without updating
+    // the broad-phase tree or querying other pairs: for a body moving in sub-steps while the
+    // others wait. Same pairs and order as update() + narrowPhase() restricted to that part.
+    const std::vector<Contact>& contactsOf(std::uint32_t id);
     const std::vector<Contact>& contacts() const { return contacts_; }
     const QueryStats& stats() const { return stats_; }  // of the last findContacts()
 
@@ -78,6 +84,7 @@ private:
     std::vector<Sphere> partSpheres_;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;
     std::vector<Contact> contacts_;
+    std::vector<Contact> partContacts_;  // contactsOf()
     QueryStats stats_;
 };
 

@@ -44,13 +44,32 @@ void CollisionWorld::setExactTest(ExactTest test) {
 }
 
 void CollisionWorld::update() {
+    refitChanged();
+    updateBroadPhase();
+}
+
+void CollisionWorld::refitChanged() {
     for (std::size_t i = 0; i < parts_.size(); ++i) {
         Part& part = *parts_[i];
         if (!part.changedMasses().empty()) colliders_[i].refit(part, part.changedMasses());
         part.clearChangedMasses();
         partSpheres_[i] = colliders_[i].worldSphere(part);
     }
-    updateBroadPhase();
+}
+
+const std::vector<Contact>& CollisionWorld::contactsOf(std::uint32_t id) {
+    refitChanged();
+    partContacts_.clear();
+    const RelativePose identity;
+    // Other parts in ascending id: the same pairs, in the same order, as the broad phase gives.
+    for (std::uint32_t other = 0; other < parts_.size(); ++other) {
+        if (other == id || !overlap(partSpheres_[id], partSpheres_[other], identity)) continue;
+        std::uint32_t a = std::min(id, other), b = std::max(id, other);
+        if (!pressesFirst(a, b)) std::swap(a, b);
+        QueryStats ignored;
+        queryPair(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, partContacts_, ignored);
+    }
+    return partContacts_;
 }
 
 void CollisionWorld::updateBroadPhase() {
