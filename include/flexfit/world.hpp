@@ -23,6 +23,16 @@
 // sub-step) and loses the velocity into them (inelastic, no friction yet). Contacts with
 // deformable parts go to the collision world's response.
 //
+// The operator (thesis 4.1.4; SHARP, VEDAP-II): grab() holds a body; setGrabTarget() moves the
+// pose the operator wants it at. A dynamic body is pulled by a spring-damper coupling between
+// that target and its pose (linear at the centre of mass, angular on the rotation error), so
+// it still collides, deforms parts and snaps; the coupling force and torque are reported for a
+// haptic device (the device feels their opposite). A kinematic body follows the target
+// exactly. The coupling damps the velocity relative to the target's, so a moving target is
+// followed without lag; move the target continuously (a jump d gives an impulse b d).
+// A body that snaps is released. Forces on selected masses or faces deform a
+// deformable part (zones open there) and push a rigid dynamic one at that point.
+//
 // Stages, in order, each timed into profile(): operator input, broad phase, narrow phase,
 // contact response, zone dynamics (the deformable parts' step, restoration included: the
 // constraint is applied inside the integration), zone retirement (inside the parts' step, so
@@ -85,6 +95,25 @@ struct WorldSettings {
 
 using BodyId = std::uint32_t;
 
+// The operator's spring-damper coupling. Zero stiffness: the body's mass (and smallest
+// principal inertia) times w^2, w = min(2 pi frequency, 0.4 / dt), so the explicit coupling is
+// stable at any time step; negative damping: critical (2 sqrt(k m)).
+struct GrabSettings {
+    double frequency = 10.0;          // Hz, for the default stiffnesses
+    double stiffness = 0.0;           // N/m
+    double damping = -1.0;            // N s/m
+    double angularStiffness = 0.0;    // N m/rad
+    double angularDamping = -1.0;     // N m s/rad
+};
+
+// What the coupling applied to the grabbed body in the last step (world frame).
+struct Coupling {
+    bool active = false;
+    BodyId body = 0;
+    Vec3 force = Vec3::Zero();
+    Vec3 torque = Vec3::Zero();
+};
+
 class World {
 public:
     explicit World(WorldSettings settings = {});
@@ -107,6 +136,20 @@ public:
     // Kinematic bodies: the pose to reach by the end of the next step (velocity derived).
     void setKinematicTarget(BodyId id, const Pose& target);
 
+    // --- The operator ---
+    // Grabs a dynamic or kinematic body (throws InputError for a static one, or for coupling
+    // settings the time step cannot integrate stably); the target starts at its pose.
+    void grab(BodyId id, const GrabSettings& settings = {});
+    void setGrabTarget(const Pose& target);  // the grabbed body's desired pose
+    void release();
+    std::optional<BodyId> grabbed() const { return grabbed_; }
+    const Pose& grabTarget() const { return grabTarget_; }
+    const Coupling& coupling() const { return coupling_; }
+    // A world-frame force for the next step on one mass, or spread over a face's three masses.
+    // Throws InputError for an index out of range.
+    void applyMassForce(BodyId id, Index mass, const Vec3& worldForce);
+    void applyFaceForce(BodyId id, Index face, const Vec3& worldForce);
+
     // Assembly rules (assembly.hpp), checked in the assembly stage of every step. When a rule
     // triggers, its primary stops being driven (it becomes kinematic), is brought to its final
     // pose over the snap duration, and then stays attached to the secondary. Throws InputError
@@ -127,6 +170,14 @@ public:
 
 private:
     void operatorInput();
+    void applyCoupling();
+    struct CouplingGains { double k, b, kr, br; };
+    CouplingGains couplingGains(BodyId id, const GrabSettings& settings) const;
+    std::optional<BodyId> grabbed_;
+    CouplingGains gains_{};
+    Pose grabTarget_, previousGrabTarget_;
+    Coupling coupling_;
+
     void integrateDynamicBodies();
     void advanceBody(BodyId id, double dt);
     void resolveRigidContacts(BodyId id);

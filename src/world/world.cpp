@@ -5,6 +5,8 @@
 #include <limits>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
+
 namespace flexfit {
 namespace {
 
@@ -111,6 +113,91 @@ void World::setKinematicTarget(BodyId id, const Pose& target) {
     if (bodies_[id].motion == MotionType::Kinematic) kinematicTargets_[id] = target;
 }
 
+// --- The operator ---
+
+World::CouplingGains World::couplingGains(BodyId id, const GrabSettings& g) const {
+    const RigidBody& body = bodies_[id];
+    const double h = settings_.timeStep;
+    const double omega = std::min(2.0 * M_PI * g.frequency, 0.4 / h);
+    const double smallestInertia = 1.0 / Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(body.inverseInertia).eigenvalues().maxCoeff();
+    CouplingGains c;
+    c.k = g.stiffness > 0.0 ? g.stiffness : body.mass * omega * omega;
+    c.b = g.damping >= 0.0 ? g.damping : 2.0 * std::sqrt(c.k * body.mass);
+    c.kr = g.angularStiffness > 0.0 ? g.angularStiffness : smallestInertia * omega * omega;
+    c.br = g.angularDamping >= 0.0 ? g.angularDamping : 2.0 * std::sqrt(c.kr * smallestInertia);
+    // Explicit coupling: stable while h sqrt(k/m) and h b/m stay below 1 (with margin to 2).
+    const bool stable = h * std::sqrt(c.k / body.mass) <= 1.0 && h * c.b / body.mass <= 1.0 &&
+                        h * std::sqrt(c.kr / smallestInertia) <= 1.0 && h * c.br / smallestInertia <= 1.0;
+    if (!stable)
+        throw InputError(kWorldSource, 0, "grab coupling too stiff or too damped for the time step (need h*sqrt(k/m) <= 1 and h*b/m <= 1)");
+    return c;
+}
+
+void World::grab(BodyId id, const GrabSettings& settings) {
+    if (id >= parts_.size()) throw InputError(kWorldSource, 0, "grab: no body " + std::to_string(id));
+    const RigidBody& body = bodies_[id];
+    if (body.motion == MotionType::Static) throw InputError(kWorldSource, 0, "grab: body " + std::to_string(id) + " is static");
+    if (!(settings.frequency > 0.0) || !std::isfinite(settings.frequency) || !(settings.stiffness >= 0.0) ||
+        !(settings.angularStiffness >= 0.0) || !std::isfinite(settings.damping) || !std::isfinite(settings.angularDamping))
+        throw InputError(kWorldSource, 0, "grab: coupling settings must be finite, frequency > 0 and stiffnesses >= 0");
+    gains_ = body.motion == MotionType::Dynamic ? couplingGains(id, settings) : CouplingGains{};
+    grabbed_ = id;
+    grabTarget_ = previousGrabTarget_ = parts_[id]->pose();
+    coupling_ = Coupling{true, id, Vec3::Zero(), Vec3::Zero()};
+}
+
+void World::setGrabTarget(const Pose& target) { grabTarget_ = target; }
+
+void World::release() {
+    grabbed_.reset();
+    coupling_ = Coupling{};
+}
+
+void World::applyMassForce(BodyId id, Index mass, const Vec3& worldForce) {
+    if (id >= parts_.size()) throw InputError(kWorldSource, 0, "force: no body " + std::to_string(id));
+    Part& part = *parts_[id];
+    if (mass >= part.model().massCount())
+        throw InputError(kWorldSource, 0, "force: mass " + std::to_string(mass) + " out of range for body " + std::to_string(id));
+    if (part.mode() != PartMode::Rigid)
+        part.applyForce(mass, worldForce);
+    else
+        applyForceAt(id, worldForce, part.worldPosition(mass));
+}
+
+void World::applyFaceForce(BodyId id, Index face, const Vec3& worldForce) {
+    if (id >= parts_.size()) throw InputError(kWorldSource, 0, "force: no body " + std::to_string(id));
+    const auto& faces = parts_[id]->model().mesh.faces;
+    if (face >= faces.size())
+        throw InputError(kWorldSource, 0, "force: face " + std::to_string(face) + " out of range for body " + std::to_string(id));
+    for (Index m : faces[face]) applyMassForce(id, m, worldForce / 3.0);
+}
+
+// The spring-damper between the operator's target and the grabbed body, for this step.
+void World::applyCoupling() {
+    if (!grabbed_) return;
+    const BodyId id = *grabbed_;
+    RigidBody& body = bodies_[id];
+    if (body.motion == MotionType::Kinematic) {
+        kinematicTargets_[id] = grabTarget_;
+        coupling_ = Coupling{true, id, Vec3::Zero(), Vec3::Zero()};
+        return;
+    }
+    const double h = settings_.timeStep;
+    const Pose& pose = parts_[id]->pose();
+    const Vec3 targetCentre = grabTarget_.apply(body.centreOfMass);
+    const Vec3 targetVelocity = (targetCentre - previousGrabTarget_.apply(body.centreOfMass)) / h;
+    Eigen::AngleAxisd error(grabTarget_.rotation * pose.rotation.conjugate());
+    if (error.angle() > M_PI) error.angle() -= 2.0 * M_PI;  // the short way round
+    Eigen::AngleAxisd targetTurn(grabTarget_.rotation * previousGrabTarget_.rotation.conjugate());
+    if (targetTurn.angle() > M_PI) targetTurn.angle() -= 2.0 * M_PI;
+    const Vec3 targetSpin = targetTurn.axis() * (targetTurn.angle() / h);
+    coupling_.force = gains_.k * (targetCentre - centreOfMass(id)) + gains_.b * (targetVelocity - body.linearVelocity);
+    coupling_.torque = gains_.kr * error.angle() * error.axis() + gains_.br * (targetSpin - body.angularVelocity);
+    body.force += coupling_.force;
+    body.torque += coupling_.torque;
+    previousGrabTarget_ = grabTarget_;
+}
+
 // --- The step ---
 
 void World::step() {
@@ -137,6 +224,7 @@ void World::step() {
 }
 
 void World::operatorInput() {
+    applyCoupling();
     const double h = settings_.timeStep;
     for (BodyId id = 0; id < parts_.size(); ++id) {
         if (!kinematicTargets_[id]) continue;
@@ -202,6 +290,7 @@ void World::assemble() {
             state.start = time_;
             state.from = primary.pose();
             events_.push_back({rule.name, rule.technique, time_, state.from, target});
+            if (grabbed_ == rule.primary) release();  // the snap takes the part from the operator
             RigidBody& body = bodies_[rule.primary];
             body.motion = MotionType::Kinematic;  // the snap drives it from now on
             body.linearVelocity.setZero();

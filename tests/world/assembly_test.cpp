@@ -111,3 +111,26 @@ TEST(Assembly, BallThroughTheMouthIsAssembledByZoneSnapFitting) {
     EXPECT_FALSE(never);
     EXPECT_LT(fallen.y(), -20.0);
 }
+
+TEST(Assembly, SnappingTakesThePartFromTheOperator) {
+    World world(WorldSettings{1e-3, Vec3::Zero(), {}, 0.25, 4096, 4});
+    PartSettings rigid;
+    rigid.mode = PartMode::Rigid;
+    const BodyId base = world.add(buildPartModel(makeIcoSphere(1.0, 1)), rigid, BodySettings{}, Pose{});
+    BodySettings dynamic;
+    dynamic.motion = MotionType::Dynamic;
+    const BodyId peg = world.add(buildPartModel(makeIcoSphere(1.0, 1)), rigid, dynamic, at(Vec3(10, 0, 0)));
+    AssemblyRule r = rule(SnapTechnique::ProximitySnap);
+    r.primary = peg;
+    r.secondary = base;
+    r.finalRelativePose = at(Vec3(5, 0, 0));
+    world.addAssembly(r);
+    world.grab(peg);
+    for (int i = 0; i < 1000 && world.assemblyEvents().empty(); ++i) {
+        world.setGrabTarget(at(Vec3(10 - 5e-3 * (i + 1), 0, 0)));  // the operator brings it in at 5 m/s
+        world.step();
+    }
+    ASSERT_EQ(world.assemblyEvents().size(), 1u);
+    EXPECT_FALSE(world.grabbed());
+    EXPECT_NEAR(world.assemblyEvents()[0].primaryPoseBefore.translation.x(), 5.5, 0.05);  // within 0.5 of the goal
+}
