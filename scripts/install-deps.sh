@@ -11,6 +11,7 @@ packages=(
   libspdlog-dev libfmt-dev             # logging and formatting
   libgtest-dev libgmock-dev            # tests
   libbenchmark-dev                     # benchmarks
+  libtomlplusplus-dev                  # scene files (TOML, with the line of every key)
   libfcl-dev                           # FCL: reference for collision tests and benchmarks
   python3-matplotlib                   # plots of experiment results (/usr/bin/python3)
 )

@@ -12,6 +12,7 @@ void registerConvert(CLI::App& app);
 void registerGen(CLI::App& app);
 void registerSimulate(CLI::App& app);
 void registerCollide(CLI::App& app);
+void registerRun(CLI::App& app);
 void registerExperimentContact(CLI::App& experiment);
 void registerExperimentRestoration(CLI::App& experiment);
 void registerExperimentZones(CLI::App& experiment);

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
     flexfit::cli::registerGen(app);
     flexfit::cli::registerSimulate(app);
     flexfit::cli::registerCollide(app);
+    flexfit::cli::registerRun(app);
     CLI::App* experiment = app.add_subcommand("experiment", "Reproduce the thesis's experiments");
     experiment->require_subcommand(1);
     flexfit::cli::registerExperimentRestoration(*experiment);

@@ -17,3 +17,4 @@
 #include "flexfit/simulation.hpp"
 #include "flexfit/topology.hpp"
 #include "flexfit/world.hpp"
+#include "flexfit/scene.hpp"

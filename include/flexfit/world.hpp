@@ -14,6 +14,10 @@
 // Known limit: the thickness estimate assumes parts are at least as thick as the smallest
 // half-extent of their box (a thin diagonal feature needs BodySettings::thickness).
 //
+// Gravity acts on bodies (dynamic ones fall), not on the masses of deformation zones: a part's
+// rest shape is its shape under its own weight, and in a falling body's frame its masses feel
+// none, so zones deform from contacts and operator forces only.
+//
 // Deformable contacts: the collision response deforms the part, and a dynamic body pressing it
 // receives the force of the displaced springs, k_eff (rest - x) summed over the contacted
 // masses (k_eff as in collision_world.hpp), for the next step.
@@ -120,7 +124,7 @@ public:
 
     // Adds a part with its rigid-body description; returns its id (0, 1, 2, ...). Dynamic
     // bodies need a closed mesh (their mass and inertia come from its volume). The part's
-    // simulation time step is set to the world's.
+    // simulation time step is set to the world's, its gravity to zero (see above).
     BodyId add(std::shared_ptr<const PartModel> model, const PartSettings& part, const BodySettings& body, const Pose& pose);
 
     std::size_t bodyCount() const { return parts_.size(); }
@@ -164,6 +168,10 @@ public:
     const std::vector<Contact>& contacts() const { return collision_.contacts(); }
     const Profile& profile() const { return profile_; }
     CollisionWorld& collision() { return collision_; }
+
+    // 64-bit FNV-1a over time, every pose, body velocity and part state (part_state.hpp), bit
+    // for bit, plus the assembly events: equal hashes mean the same run (determinism tests).
+    std::uint64_t stateHash() const;
 
     // World position of a body's centre of mass.
     Vec3 centreOfMass(BodyId id) const { return parts_[id]->pose().apply(bodies_[id].centreOfMass); }

@@ -5,7 +5,7 @@
 namespace flexfit {
 namespace {
 
-constexpr std::uint64_t kFnvOffset = 1469598103934665603ull;
+constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;  // the FNV-1a 64-bit offset basis
 constexpr std::uint64_t kFnvPrime = 1099511628211ull;
 
 void hashBytes(std::uint64_t& h, const void* data, std::size_t size) {

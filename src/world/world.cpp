@@ -84,7 +84,9 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
 
     PartSettings ps = partSettings;
     ps.simulation.timeStep = settings_.timeStep;
-    ps.simulation.gravity = settings_.gravity;
+    // Gravity moves bodies, not zone masses: the rest shape is the part's shape under its own
+    // weight, and in a falling body's frame the masses feel no gravity.
+    ps.simulation.gravity = Vec3::Zero();
     auto part = std::make_unique<Part>(std::move(model), ps);
     part->setPose(pose);
     collision_.add(*part, settings.boundingVolume);
@@ -300,6 +302,29 @@ void World::assemble() {
         primary.setPose(interpolate(state.from, target, s));
         if (s >= 1.0) state.phase = RuleState::Phase::Assembled;  // and stays attached
     }
+}
+
+std::uint64_t World::stateHash() const {
+    std::uint64_t h = 14695981039346656037ull;
+    auto mix = [&h](const void* data, std::size_t bytes) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    };
+    mix(&time_, sizeof time_);
+    for (BodyId id = 0; id < parts_.size(); ++id) {
+        const Pose& pose = parts_[id]->pose();
+        mix(pose.rotation.coeffs().data(), 4 * sizeof(double));
+        mix(pose.translation.data(), 3 * sizeof(double));
+        mix(bodies_[id].linearVelocity.data(), 3 * sizeof(double));
+        mix(bodies_[id].angularVelocity.data(), 3 * sizeof(double));
+        const std::uint64_t part = flexfit::stateHash(parts_[id]->state());
+        mix(&part, sizeof part);
+    }
+    for (const AssemblyEvent& e : events_) {
+        mix(e.rule.data(), e.rule.size());
+        mix(&e.time, sizeof e.time);
+    }
+    return h;
 }
 
 double World::minimumThickness() const {

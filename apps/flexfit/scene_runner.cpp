@@ -1,0 +1,191 @@
+#include "scene_runner.hpp"
+
+#include "cli_common.hpp"
+#include "progress.hpp"
+
+#include <fmt/core.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+
+namespace flexfit::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::size_t zoneCount(const World& w) {
+    std::size_t n = 0;
+    for (BodyId id = 0; id < w.bodyCount(); ++id) n += w.part(id).zoneCount();
+    return n;
+}
+
+std::size_t movingMasses(const World& w) {
+    std::size_t n = 0;
+    for (BodyId id = 0; id < w.bodyCount(); ++id) n += w.part(id).movingMasses().size();
+    return n;
+}
+
+std::size_t computedSprings(const World& w) {
+    std::size_t n = 0;
+    for (BodyId id = 0; id < w.bodyCount(); ++id) n += w.part(id).computedSprings().size();
+    return n;
+}
+
+// Largest distance of a moving mass from its rest position (part frame = length in the world).
+double deformation(const Part& part) {
+    double d = 0.0;
+    for (Index m : part.movingMasses()) d = std::max(d, (part.state().positions[m] - part.model().restPositions[m]).norm());
+    return d;
+}
+
+std::string csvHeader(const Scene& scene) {
+    std::string h = "time,contacts,zones,moving_masses,computed_springs,coupling_fx,coupling_fy,coupling_fz,coupling_tx,coupling_ty,coupling_tz";
+    for (int s = 0; s < int(Stage::Count); ++s) {
+        std::string name = toString(Stage(s));
+        std::replace(name.begin(), name.end(), ' ', '_');
+        h += ",us_" + name;
+    }
+    for (const ScenePart& p : scene.parts) {
+        if (p.body.motion != MotionType::Static) h += "," + p.name + "_x," + p.name + "_y," + p.name + "_z";
+        if (p.part.mode != PartMode::Rigid) h += "," + p.name + "_deformation";
+    }
+    return h + "\n";
+}
+
+std::string csvRow(const Scene& scene, const World& w) {
+    const Coupling& c = w.coupling();
+    std::string row = fmt::format("{:.6f},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}", w.time(), w.contacts().size(), zoneCount(w),
+                                  movingMasses(w), computedSprings(w), c.force.x(), c.force.y(), c.force.z(), c.torque.x(),
+                                  c.torque.y(), c.torque.z());
+    for (double s : w.profile().lastSeconds) row += fmt::format(",{:.3f}", s * 1e6);
+    for (BodyId id = 0; id < scene.parts.size(); ++id) {
+        if (scene.parts[id].body.motion != MotionType::Static) {
+            const Vec3 p = w.centreOfMass(id);
+            row += fmt::format(",{:.9g},{:.9g},{:.9g}", p.x(), p.y(), p.z());
+        }
+        if (scene.parts[id].part.mode != PartMode::Rigid) row += fmt::format(",{:.9g}", deformation(w.part(id)));
+    }
+    return row + "\n";
+}
+
+void writeObjFrame(const std::filesystem::path& path, const World& w, const Scene& scene) {
+    std::ostringstream obj;
+    obj << fmt::format("# flexfit run {} t={:.6f}\n", scene.source, w.time());
+    std::size_t base = 1;
+    std::vector<Vec3> positions;
+    for (BodyId id = 0; id < w.bodyCount(); ++id) {
+        obj << "o " << scene.parts[id].name << "\n";
+        w.part(id).worldPositions(positions);
+        for (const Vec3& v : positions) obj << fmt::format("v {:.9g} {:.9g} {:.9g}\n", v.x(), v.y(), v.z());
+        for (const Face& f : w.part(id).model().mesh.faces) obj << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
+        base += positions.size();
+    }
+    writeTextFile(path, obj.str());
+}
+
+std::string poseJson(const Pose& p) {
+    const auto& q = p.rotation;
+    return fmt::format("{{\"position\": [{:.9g}, {:.9g}, {:.9g}], \"rotation_wxyz\": [{:.9g}, {:.9g}, {:.9g}, {:.9g}]}}", p.translation.x(),
+                       p.translation.y(), p.translation.z(), q.w(), q.x(), q.y(), q.z());
+}
+
+std::string jsonString(const std::string& s) {
+    std::string out = "\"";
+    for (char c : s) {
+        if (c == '"' || c == '\\') out += '\\';
+        if (static_cast<unsigned char>(c) < 0x20) {
+            out += fmt::format("\\u{:04x}", int(c));
+            continue;
+        }
+        out += c;
+    }
+    return out + "\"";
+}
+
+std::string optionalJson(const std::optional<double>& v) { return v ? fmt::format("{:.6f}", *v) : "null"; }
+
+}  // namespace
+
+RunSummary runScene(const Scene& scene, const RunOptions& options) {
+    SceneRun run(scene);
+    World& w = run.world();
+    const double duration = options.duration.value_or(scene.duration);
+    const auto steps = std::uint64_t(std::llround(duration / scene.world.timeStep));
+    std::ofstream csv;
+    if (!options.out.empty()) {
+        makeDirectory(options.out);
+        csv.open(options.out / "metrics.csv");
+        if (!csv) throw InputError((options.out / "metrics.csv").string(), 0, "cannot write");
+        csv << csvHeader(scene);
+    }
+    RunSummary s;
+    const std::uint64_t objStride = scene.objEvery > 0.0 ? std::max<std::uint64_t>(1, std::llround(scene.objEvery / scene.world.timeStep)) : 0;
+    ProgressBar bar("run " + std::filesystem::path(scene.source).filename().string(), options.progress);
+    const auto start = Clock::now();
+    for (std::uint64_t i = 0; i < steps; ++i) {
+        const auto before = Clock::now();
+        run.step();
+        const double wall = std::chrono::duration<double>(Clock::now() - before).count();
+        const std::size_t contacts = w.contacts().size();
+        if (contacts > 0) {
+            ++s.contactSteps;
+            s.contactWallSeconds += wall;
+            s.lastContact = w.time();
+            s.restored.reset();
+        }
+        const std::size_t moving = movingMasses(w);
+        if (s.lastContact && !s.restored && moving == 0) s.restored = w.time();
+        s.maxContacts = std::max(s.maxContacts, contacts);
+        s.maxMovingMasses = std::max(s.maxMovingMasses, moving);
+        s.maxComputedSprings = std::max(s.maxComputedSprings, computedSprings(w));
+        s.maxZones = std::max(s.maxZones, zoneCount(w));
+        for (BodyId id = 0; id < w.bodyCount(); ++id) s.maxDeformation = std::max(s.maxDeformation, deformation(w.part(id)));
+        if (w.coupling().active) s.maxCouplingForce = std::max(s.maxCouplingForce, w.coupling().force.norm());
+        if (csv.is_open()) csv << csvRow(scene, w);
+        if (objStride && !options.out.empty() && (i + 1) % objStride == 0)
+            writeObjFrame(options.out / fmt::format("frame_{:06d}.obj", i + 1), w, scene);
+        bar.update(double(i + 1) / double(steps));
+    }
+    bar.finish();
+    s.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    s.steps = steps;
+    s.simulatedSeconds = w.time();
+    s.profile = w.profile();
+    s.events = w.assemblyEvents();
+    s.stateHash = w.stateHash();
+    for (BodyId id = 0; id < w.bodyCount(); ++id) s.finalCentres.push_back(w.centreOfMass(id));
+    if (!options.out.empty()) writeTextFile(options.out / "summary.json", summaryJson(scene, s));
+    return s;
+}
+
+std::string summaryJson(const Scene& scene, const RunSummary& s) {
+    std::string j = "{\n";
+    j += fmt::format("  \"scene\": {},\n  \"steps\": {},\n  \"time_step\": {},\n  \"simulated_seconds\": {:.6f},\n", jsonString(scene.source), s.steps,
+                     scene.world.timeStep, s.simulatedSeconds);
+    j += fmt::format("  \"wall_seconds\": {:.6f},\n  \"steps_per_second\": {:.1f},\n", s.wallSeconds, double(s.steps) / s.wallSeconds);
+    j += fmt::format("  \"contact_steps\": {},\n  \"contact_steps_per_second\": {},\n", s.contactSteps,
+                     s.contactSteps ? fmt::format("{:.1f}", double(s.contactSteps) / s.contactWallSeconds) : "null");
+    j += fmt::format("  \"max_contacts\": {},\n  \"max_zones\": {},\n  \"max_moving_masses\": {},\n  \"max_computed_springs\": {},\n",
+                     s.maxContacts, s.maxZones, s.maxMovingMasses, s.maxComputedSprings);
+    j += fmt::format("  \"max_deformation\": {:.9g},\n  \"last_contact\": {},\n  \"restored_at\": {},\n  \"max_coupling_force\": {:.9g},\n",
+                     s.maxDeformation, optionalJson(s.lastContact), optionalJson(s.restored), s.maxCouplingForce);
+    j += fmt::format("  \"substeps\": {},\n  \"stage_seconds\": {{", s.profile.substeps);
+    for (int i = 0; i < int(Stage::Count); ++i)
+        j += fmt::format("{}{}: {:.6f}", i ? ", " : "", jsonString(toString(Stage(i))), s.profile.totalSeconds[std::size_t(i)]);
+    j += "},\n  \"assembly_events\": [";
+    for (std::size_t i = 0; i < s.events.size(); ++i) {
+        const AssemblyEvent& e = s.events[i];
+        j += fmt::format("{}\n    {{\"rule\": {}, \"technique\": {}, \"time\": {:.6f}, \"from\": {}, \"to\": {}}}", i ? "," : "",
+                         jsonString(e.rule), jsonString(toString(e.technique)), e.time, poseJson(e.primaryPoseBefore), poseJson(e.primaryPoseAfter));
+    }
+    j += s.events.empty() ? "],\n" : "\n  ],\n";
+    j += "  \"final_centres\": {";
+    for (std::size_t i = 0; i < s.finalCentres.size(); ++i)
+        j += fmt::format("{}{}: [{:.9g}, {:.9g}, {:.9g}]", i ? ", " : "", jsonString(scene.parts[i].name), s.finalCentres[i].x(),
+                         s.finalCentres[i].y(), s.finalCentres[i].z());
+    j += fmt::format("}},\n  \"state_hash\": \"{:016x}\"\n}}\n", s.stateHash);
+    return j;
+}
+
+}  // namespace flexfit::cli

@@ -1,0 +1,105 @@
+// Scene files (SPEC 7-8): a world described in TOML, and the scripted run of it.
+//
+// Why TOML (toml++ from Debian's libtomlplusplus-dev): a scene is a handful of flat tables
+// ([world], [[part]], [[assembly]], [[action]], [output]) that engineers write by hand. TOML
+// has no indentation rules to get wrong and no implicit typing surprises (YAML's "no" is a
+// boolean), and toml++ keeps the line of every key, so each error names file, line and key.
+//
+// Schema (every key is checked: an unknown key is an error, as is a value of the wrong type
+// or out of range; see examples/*.toml and the README for a complete table):
+//   [world]      time_step, gravity, duration, max_travel_fraction, max_substeps,
+//                contact_iterations, exact_test = "triangle" | "sphere"
+//   [[part]]     name, mesh (path relative to the scene) or generator ("torus1", "torus2",
+//                "heart", "container-mouth", or a table {type = "torus" | "sphere", ...}),
+//                mode, motion, material (preset or {stiffness, damping}), vertex_mass, position,
+//                rotation (degrees about x, then y, then z, world axes), density, velocity,
+//                angular_velocity (rad/s), thickness, bounding_volume, restoration,
+//                constraint_fraction, anchor_stiffness, anchor_damping, global_damping,
+//                integrator, default_level, contact_level, activity_threshold, rest_speed
+//   [[assembly]] name, primary, secondary (part names), technique, final_position,
+//                final_rotation, snap_duration, distance_tolerance, angle_tolerance (degrees),
+//                primary_vector / secondary_vector = {origin, end}, vector_tolerance,
+//                area = {shape, position, rotation, half_extents, radius, half_height}
+//   [[action]]   time, type = "grab" | "move" | "release" | "push" | "force" | "velocity",
+//                part, and per type: grab {frequency, stiffness, damping, angular_stiffness,
+//                angular_damping}; move {position, rotation, duration}; push {force,
+//                duration}; force {force, masses or faces, duration}; velocity {linear,
+//                angular}
+//   [output]     obj_every (s; 0 = no OBJ frames)
+//
+// Loading builds every mesh and model up front: a scene either loads whole or throws
+// InputError, never half-built.
+#pragma once
+
+#include "flexfit/world.hpp"
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace flexfit {
+
+struct ScenePart {
+    std::string name;
+    std::shared_ptr<const PartModel> model;
+    PartSettings part;
+    BodySettings body;
+    Pose pose;
+};
+
+struct SceneAction {
+    enum class Kind { Grab, Move, Release, Push, Force, Velocity } kind = Kind::Push;
+    std::size_t line = 0;     // in the scene file
+    double time = 0.0;        // s
+    double duration = 0.0;    // s (move, push, force; 0: one step)
+    BodyId body = 0;
+    GrabSettings grab;
+    Pose target;              // move: the grab target reached at time + duration
+    Vec3 force = Vec3::Zero();
+    std::vector<Index> masses, faces;
+    Vec3 linear = Vec3::Zero(), angular = Vec3::Zero();
+};
+const char* toString(SceneAction::Kind kind);
+
+struct Scene {
+    std::string source;       // the file, for messages
+    WorldSettings world;
+    double duration = 1.0;    // s
+    std::vector<ScenePart> parts;
+    std::vector<AssemblyRule> assemblies;
+    std::vector<SceneAction> actions;  // by time (stable: file order among equal times)
+    double objEvery = 0.0;    // s between OBJ frames; 0: none
+
+    // The part named `name`, or nullopt.
+    std::optional<BodyId> find(std::string_view name) const;
+};
+
+// Throws InputError naming the file, the line and the key for every problem.
+Scene loadScene(const std::filesystem::path& file);
+// The same from text; mesh paths are resolved against `baseDirectory`.
+Scene parseScene(std::string_view text, const std::string& source, const std::filesystem::path& baseDirectory);
+
+// A scene's world, driven by its scripted actions: the same run for `flexfit run`, the
+// experiments and the viewer.
+class SceneRun {
+public:
+    explicit SceneRun(const Scene& scene);
+    World& world() { return *world_; }
+    const World& world() const { return *world_; }
+    const Scene& scene() const { return scene_; }
+    // Applies the actions due in this step, then steps the world.
+    void step();
+    bool finished() const;
+    // Operator actions that the scene did not script (the viewer's mouse) go to world() directly.
+
+private:
+    void start(const SceneAction& action);
+    void apply(const SceneAction& action, const Pose& moveStart, double t);
+    Scene scene_;
+    std::unique_ptr<World> world_;
+    std::size_t next_ = 0;                           // first action not yet started
+    std::vector<std::pair<SceneAction, Pose>> running_;  // actions with a duration, and a move's start target
+};
+
+}  // namespace flexfit
