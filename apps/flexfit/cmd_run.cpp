@@ -35,7 +35,7 @@ void registerRun(CLI::App& app) {
             fmt::print(" {} {:.1f};", toString(Stage(i)), 1e6 * s.profile.totalSeconds[std::size_t(i)] / double(std::max<std::uint64_t>(1, s.steps)));
         fmt::print("\n");
         for (const AssemblyEvent& e : s.events)
-            fmt::print("  assembled: '{}' by {} snap-fitting at t = {:.3f} s\n", e.rule, toString(e.technique), e.time);
+            fmt::print("  assembled: '{}' by {} at t = {:.3f} s\n", e.rule, toString(e.technique), e.time);
         fmt::print("  state hash {:016x}\n", s.stateHash);
     });
 }

@@ -46,6 +46,7 @@ struct RelativePose {
     Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
     Eigen::Matrix3d absRotation = Eigen::Matrix3d::Identity();
     Vec3 translation = Vec3::Zero();
+    bool pureTranslation = true;  // rotation is exactly the identity: boxes stay axis-aligned
 
     RelativePose() = default;
     RelativePose(const Eigen::Matrix3d& r, const Vec3& t);

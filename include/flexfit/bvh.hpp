@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <numeric>
 #include <vector>
 
@@ -71,11 +72,18 @@ public:
                 dirty_.push_back(n);
             }
         }
-        std::sort(dirty_.begin(), dirty_.end(),
-                  [&](std::int32_t x, std::int32_t y) { return nodes_[std::size_t(x)].depth > nodes_[std::size_t(y)].depth; });
-        for (std::int32_t n : dirty_) {
-            Node& node = nodes_[std::size_t(n)];
+        // Children come after their parent in the node array: descending index is bottom-up.
+        // Many dirty nodes: one backward scan of the marks beats sorting them.
+        auto merge = [&](std::size_t n) {
+            Node& node = nodes_[n];
             node.volume = mergeVolumes(nodes_[std::size_t(node.left)].volume, nodes_[std::size_t(node.right)].volume);
+        };
+        if (dirty_.size() * 16 > nodes_.size()) {
+            for (std::size_t n = nodes_.size(); n-- > 0;)
+                if (mark_[n] == epoch_) merge(n);
+        } else {
+            std::sort(dirty_.begin(), dirty_.end(), std::greater<>());
+            for (std::int32_t n : dirty_) merge(std::size_t(n));
         }
         refitNodes_ += dirty_.size();
     }

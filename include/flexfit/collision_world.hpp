@@ -64,8 +64,10 @@ public:
     void refitChanged();
     // The contacts of one part with every part whose sphere touches its own, without updating
     // the broad-phase tree or querying other pairs: for a body moving in sub-steps while the
-    // others wait. Same pairs and order as update() + narrowPhase() restricted to that part.
-    const std::vector<Contact>& contactsOf(std::uint32_t id);
+    // others wait. Same pairs and order as update() + narrowPhase() restricted to that part;
+    // with rigidPartnersOnly, pairs with deformable parts are skipped (the world's rigid
+    // projection only needs the others).
+    const std::vector<Contact>& contactsOf(std::uint32_t id, bool rigidPartnersOnly = false);
     const std::vector<Contact>& contacts() const { return contacts_; }
     const QueryStats& stats() const { return stats_; }  // of the last findContacts()
 

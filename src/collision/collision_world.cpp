@@ -57,13 +57,14 @@ void CollisionWorld::refitChanged() {
     }
 }
 
-const std::vector<Contact>& CollisionWorld::contactsOf(std::uint32_t id) {
+const std::vector<Contact>& CollisionWorld::contactsOf(std::uint32_t id, bool rigidPartnersOnly) {
     refitChanged();
     partContacts_.clear();
     const RelativePose identity;
     // Other parts in ascending id: the same pairs, in the same order, as the broad phase gives.
     for (std::uint32_t other = 0; other < parts_.size(); ++other) {
         if (other == id || !overlap(partSpheres_[id], partSpheres_[other], identity)) continue;
+        if (rigidPartnersOnly && parts_[other]->mode() != PartMode::Rigid) continue;
         std::uint32_t a = std::min(id, other), b = std::max(id, other);
         if (!pressesFirst(a, b)) std::swap(a, b);
         QueryStats ignored;

@@ -373,7 +373,7 @@ void World::resolveRigidContacts(BodyId id) {
     RigidBody& body = bodies_[id];
     for (int iteration = 0; iteration < settings_.contactIterations; ++iteration) {
         StageTimer timer(profile_);
-        const std::vector<Contact>& contacts = collision_.contactsOf(id);  // only this body's pairs
+        const std::vector<Contact>& contacts = collision_.contactsOf(id, true);  // this body's pairs with rigid parts
         timer.charge(Stage::NarrowPhase);
         // This body's contacts with parts that do not deform: direction out of them, depth.
         pushes_.clear();
