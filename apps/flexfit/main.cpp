@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     flexfit::cli::registerExperimentRestoration(*experiment);
     flexfit::cli::registerExperimentZones(*experiment);
     flexfit::cli::registerExperimentContact(*experiment);
+    flexfit::cli::registerExperimentBallTorus(*experiment);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -142,7 +142,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         s.maxZones = std::max(s.maxZones, zoneCount(w));
         for (BodyId id = 0; id < w.bodyCount(); ++id) s.maxDeformation = std::max(s.maxDeformation, deformation(w.part(id)));
         if (w.coupling().active) s.maxCouplingForce = std::max(s.maxCouplingForce, w.coupling().force.norm());
-        if (csv.is_open()) csv << csvRow(scene, w);
+        if (csv.is_open() && (i + 1) % std::uint64_t(std::max(1, options.csvEvery)) == 0) csv << csvRow(scene, w);
         if (objStride && !options.out.empty() && (i + 1) % objStride == 0)
             writeObjFrame(options.out / fmt::format("frame_{:06d}.obj", i + 1), w, scene);
         bar.update(double(i + 1) / double(steps));

@@ -14,6 +14,7 @@ struct RunOptions {
     std::optional<double> duration;      // overrides the scene's
     std::filesystem::path out;           // empty: record nothing on disk
     bool progress = true;
+    int csvEvery = 1;                    // write every k-th step to metrics.csv
 };
 
 struct RunSummary {
