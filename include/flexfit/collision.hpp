@@ -16,6 +16,8 @@
 // the opposite) separates the pair.
 #pragma once
 
+#include <array>
+
 #include "flexfit/bvh.hpp"
 #include "flexfit/part.hpp"
 #include "flexfit/triangle_queries.hpp"
@@ -67,7 +69,14 @@ public:
     const Bvh<Aabb>* boxes() const { return std::get_if<Bvh<Aabb>>(&bvh_); }
     std::size_t refitNodeCount() const;
 
+    // Planes of a face of the rest shape, in the part frame: [0] its own (unit normal n,
+    // offset n.a), [1..3] through each edge, perpendicular to it, normals pointing out. The
+    // narrow phase's cheap rejection for faces whose masses are at rest: a triangle entirely
+    // beyond one of them cannot touch the face.
+    const std::array<Eigen::Vector4d, 4>& restPlanes(Index face) const { return restPlanes_[face]; }
+
 private:
+    std::vector<std::array<Eigen::Vector4d, 4>> restPlanes_;  // (F)
     BoundingVolumeKind kind_;
     ExactTest test_;
     std::variant<Bvh<Sphere>, Bvh<Aabb>> bvh_;

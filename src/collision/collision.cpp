@@ -93,6 +93,19 @@ PartCollider::PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest 
     if (kind == BoundingVolumeKind::Aabb) bvh_.emplace<Bvh<Aabb>>();
     restSphere_ = Sphere::around(part.model().restPositions);
     faceMark_.assign(part.model().faceCount(), 0);
+    const auto& rest = part.model().restPositions;
+    restPlanes_.reserve(part.model().faceCount());
+    for (const Face& f : part.model().mesh.faces) {
+        const Vec3 n = (rest[f[1]] - rest[f[0]]).cross(rest[f[2]] - rest[f[0]]).normalized();
+        std::array<Eigen::Vector4d, 4> planes;
+        planes[0] << n, n.dot(rest[f[0]]);
+        for (int e = 0; e < 3; ++e) {
+            const Vec3& p = rest[f[e]];
+            const Vec3 out = (rest[f[(e + 1) % 3]] - p).cross(n).normalized();
+            planes[std::size_t(e) + 1] << out, out.dot(p);
+        }
+        restPlanes_.push_back(planes);
+    }
     rebuild(part);
 }
 
@@ -137,6 +150,61 @@ std::size_t PartCollider::refitNodeCount() const {
     return std::visit([](const auto& bvh) { return bvh.refitNodeCount(); }, bvh_);
 }
 
+// Cheap rejection before the triangle test, when A's face is at rest (its planes are cached
+// in A's frame, and moved to B's frame once per face and query): B's triangle entirely beyond
+// the face's plane (either side) or beyond one of its edge planes is separated from it along
+// that direction, and needs no transform. The margin is far wider than the triangle test's
+// own tolerance, so only pairs that test would also reject are skipped.
+class RestPlaneFilter {
+public:
+    RestPlaneFilter(const Part& a, const PartCollider& colliderA, const RelativePose& bInA) : a_(a), collider_(colliderA), bInA_(bInA) {
+        if (++epoch_ == 0) {
+            std::fill(stamp_.begin(), stamp_.end(), 0u);
+            epoch_ = 1;
+        }
+        if (stamp_.size() < a.model().faceCount()) {
+            stamp_.resize(a.model().faceCount(), 0u);
+            planesInB_.resize(a.model().faceCount());
+        }
+    }
+    bool separated(Index fa, std::span<const Vec3> pb, const Face& fb) {
+        const Face& f = a_.model().mesh.faces[fa];
+        if (a_.mode() != PartMode::Rigid && (a_.isMoving(f[0]) || a_.isMoving(f[1]) || a_.isMoving(f[2]))) return false;
+        const auto& planes = planesInB(fa);
+        for (std::size_t k = 0; k < planes.size(); ++k) {
+            const Vec3 n = planes[k].head<3>();
+            const double margin = 1e-9 * (1.0 + std::abs(collider_.restPlanes(fa)[k][3]));
+            const double d0 = n.dot(pb[fb[0]]) - planes[k][3], d1 = n.dot(pb[fb[1]]) - planes[k][3], d2 = n.dot(pb[fb[2]]) - planes[k][3];
+            if (d0 > margin && d1 > margin && d2 > margin) return true;
+            if (k == 0 && d0 < -margin && d1 < -margin && d2 < -margin) return true;
+        }
+        return false;
+    }
+
+private:
+    // n.(R x + t) = d  <=>  (R^T n).x = d - n.t
+    const std::array<Eigen::Vector4d, 4>& planesInB(Index fa) {
+        if (stamp_[fa] != epoch_) {
+            stamp_[fa] = epoch_;
+            const auto& planes = collider_.restPlanes(fa);
+            for (std::size_t k = 0; k < planes.size(); ++k) {
+                const Vec3 n = planes[k].head<3>();
+                planesInB_[fa][k] << bInA_.rotation.transpose() * n, planes[k][3] - n.dot(bInA_.translation);
+            }
+        }
+        return planesInB_[fa];
+    }
+    const Part& a_;
+    const PartCollider& collider_;
+    const RelativePose& bInA_;
+    static thread_local std::vector<std::array<Eigen::Vector4d, 4>> planesInB_;
+    static thread_local std::vector<std::uint32_t> stamp_;
+    static thread_local std::uint32_t epoch_;
+};
+thread_local std::vector<std::array<Eigen::Vector4d, 4>> RestPlaneFilter::planesInB_;
+thread_local std::vector<std::uint32_t> RestPlaneFilter::stamp_;
+thread_local std::uint32_t RestPlaneFilter::epoch_ = 0;
+
 void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
                const PartCollider& colliderB, ExactTest test, std::vector<Contact>& contacts, QueryStats& stats,
                std::vector<std::pair<Index, Index>>* candidates) {
@@ -148,11 +216,13 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
     const std::span<const Vec3> pa = a.state().positions, pb = b.state().positions;
     const auto& facesA = a.model().mesh.faces;
     const auto& facesB = b.model().mesh.faces;
+    RestPlaneFilter filter(a, colliderA, bInA);
     auto leafPair = [&](Index fa, Index fb) {
         if (candidates) candidates->emplace_back(fa, fb);
         const Face& f = facesB[fb];
-        const Triangle tb{bInA.apply(pb[f[0]]), bInA.apply(pb[f[1]]), bInA.apply(pb[f[2]])};
         ++stats.exactTests;
+        if (test == ExactTest::TriangleTriangle && filter.separated(fa, pb, f)) return;
+        const Triangle tb{bInA.apply(pb[f[0]]), bInA.apply(pb[f[1]]), bInA.apply(pb[f[2]])};
         std::optional<TriangleContact> hit;
         if (test == ExactTest::SphereTriangle) {
             const Sphere s = faceSphere(pa, facesA[fa]);

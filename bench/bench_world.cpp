@@ -1,0 +1,77 @@
+// The world step while a ball is in contact with the container mouth (issue 5's haptic-rate
+// goal: >= 1 kHz with the mouth at heart resolution, about 7,300 masses). Each iteration loads
+// the scene, runs it (untimed) to `settle` steps after the first contact, then times
+// kTimedSteps steps in contact. Counters: steps_per_s (in contact), contacts, moving masses,
+// and the mean per-stage time in microseconds (the world's own profile over the timed steps).
+#include "flexfit/scene.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+
+using namespace flexfit;
+
+namespace {
+
+constexpr int kTimedSteps = 200;
+
+Scene scene(const char* file, bool push) {
+    Scene s = loadScene(std::string(FLEXFIT_EXAMPLES_DIR) + "/" + file);
+    if (!push) s.actions.clear();  // gravity only: the ball rests on the rim
+    return s;
+}
+
+void stepInContact(benchmark::State& state, const char* file, bool push, int settle) {
+    const Scene base = scene(file, push);
+    double seconds = 0.0, contacts = 0.0, moving = 0.0;
+    std::array<double, std::size_t(Stage::Count)> stages{};
+    for (auto _ : state) {
+        SceneRun run(base);
+        World& w = run.world();
+        int touching = 0;
+        for (int i = 0; i < 100000 && touching <= settle; ++i) {
+            run.step();
+            if (!w.contacts().empty() || touching > 0) ++touching;
+        }
+        const Profile before = w.profile();
+        const auto start = std::chrono::steady_clock::now();
+        for (int i = 0; i < kTimedSteps; ++i) run.step();
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        state.SetIterationTime(elapsed);
+        seconds += elapsed;
+        contacts += double(w.contacts().size());
+        moving += double(w.part(0).movingMasses().size());
+        for (std::size_t s = 0; s < stages.size(); ++s) stages[s] += w.profile().totalSeconds[s] - before.totalSeconds[s];
+    }
+    const double n = double(state.iterations());
+    state.counters["steps_per_s"] = double(kTimedSteps) * n / seconds;
+    state.counters["contacts"] = contacts / n;
+    state.counters["moving_masses"] = moving / n;
+    for (std::size_t s = 0; s < stages.size(); ++s) {
+        std::string name = std::string("us_") + toString(Stage(s));
+        for (char& c : name)
+            if (c == ' ') c = '_';
+        state.counters[name] = 1e6 * stages[s] / (n * kTimedSteps);
+    }
+}
+
+// Pushed with 2,500 through the mouth: the timed steps start 20 steps after the first contact,
+// while the rim is being pushed open (the deepest contact of the run).
+void BM_HapticMouthPushed(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", true, 20); }
+// Resting on the rim under its weight, 500 steps after the first contact.
+void BM_HapticMouthResting(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", false, 500); }
+// The same at the container-mouth resolution (64 x 24 = 1,536 masses).
+void BM_MouthPushed(benchmark::State& s) { stepInContact(s, "ball_torus.toml", true, 20); }
+void BM_MouthResting(benchmark::State& s) { stepInContact(s, "ball_torus.toml", false, 500); }
+// A rigid mouth: the ball rests on it, projected by the rigid contact dynamics.
+void BM_RigidMouthResting(benchmark::State& s) { stepInContact(s, "ball_torus_rigid.toml", false, 500); }
+
+}  // namespace
+
+BENCHMARK(BM_HapticMouthPushed)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_HapticMouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_MouthPushed)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_MouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_RigidMouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+
+BENCHMARK_MAIN();
