@@ -87,6 +87,7 @@ private:
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;
     std::vector<Contact> contacts_;
     std::vector<Contact> partContacts_;  // contactsOf()
+    std::vector<std::pair<std::uint64_t, Vec3>> pushes_;  // respond(): (part << 32 | mass, displacement)
     QueryStats stats_;
 };
 

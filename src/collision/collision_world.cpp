@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <numeric>
-#include <unordered_map>
 
 namespace flexfit {
 namespace {
@@ -122,16 +121,12 @@ const std::vector<Contact>& CollisionWorld::narrowPhase() {
 
 ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
     ResponseStats stats;
-    // The deepest push of each (part, mass).
-    std::unordered_map<std::uint64_t, Vec3> push;
+    // Every push of a (part, mass), then the deepest of each, in key order (deterministic).
+    pushes_.clear();
     auto pushFace = [&](std::uint32_t id, Index face, const Vec3& displacement) {
         Part& part = *parts_[id];
         part.touchFace(face);
-        for (Index m : part.model().mesh.faces[face]) {
-            // try_emplace with an explicit zero: Eigen's default constructor leaves Vec3 uninitialised.
-            Vec3& current = push.try_emplace((std::uint64_t(id) << 32) | m, Vec3::Zero()).first->second;
-            if (displacement.squaredNorm() > current.squaredNorm()) current = displacement;
-        }
+        for (Index m : part.model().mesh.faces[face]) pushes_.emplace_back((std::uint64_t(id) << 32) | m, displacement);
     };
     for (const Contact& c : contacts) {
         const bool da = deformable(*parts_[c.partA]), db = deformable(*parts_[c.partB]);
@@ -142,13 +137,18 @@ ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
         if (shareA < 1.0) pushFace(c.partB, c.faceB, (-c.depth * (1.0 - shareA)) * c.normal);
         ++stats.contacts;
     }
-    std::vector<std::pair<std::uint64_t, Vec3>> ordered(push.begin(), push.end());  // deterministic order
-    std::sort(ordered.begin(), ordered.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-    for (const auto& [key, displacement] : ordered) {
+    // Stable: among equally deep pushes of a mass, the first contact's wins.
+    std::stable_sort(pushes_.begin(), pushes_.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (std::size_t i = 0; i < pushes_.size();) {
+        std::size_t deepest = i, j = i + 1;
+        for (; j < pushes_.size() && pushes_[j].first == pushes_[i].first; ++j)
+            if (pushes_[j].second.squaredNorm() > pushes_[deepest].second.squaredNorm()) deepest = j;
+        const auto& [key, displacement] = pushes_[deepest];
         parts_[key >> 32]->displaceMass(Index(key & 0xffffffffu), displacement);
         stats.maxDisplacement = std::max(stats.maxDisplacement, displacement.norm());
+        ++stats.displacedMasses;
+        i = j;
     }
-    stats.displacedMasses = ordered.size();
     return stats;
 }
 
