@@ -193,6 +193,9 @@ private:
     void assemble();
     void applyDeformableReactions(std::span<const Contact> contacts);
     std::vector<std::tuple<BodyId, BodyId, Index>> reactionMasses_;  // scratch: (body, part, mass)
+    // Per part and mass: the epoch it was last counted in, and for which body.
+    std::vector<std::pair<std::vector<std::uint32_t>, std::vector<BodyId>>> reactionStamp_;
+    std::uint32_t reactionEpoch_ = 0;
     bool touching(BodyId a, BodyId b) const;
 
     struct RuleState {

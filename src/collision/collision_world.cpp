@@ -30,6 +30,8 @@ std::uint32_t CollisionWorld::add(Part& part, BoundingVolumeKind kind) {
     parts_.push_back(&part);
     colliders_.emplace_back(part, kind, settings_.exactTest);
     stiffness_.push_back(effectivePartStiffness(part));
+    pushStamp_.emplace_back();
+    pushSlot_.emplace_back();
     part.clearChangedMasses();
     partSpheres_.push_back(colliders_.back().worldSphere(part));
     broadPhase_.build(partSpheres_);  // the tree's shape changes with the set of parts
@@ -121,12 +123,31 @@ const std::vector<Contact>& CollisionWorld::narrowPhase() {
 
 ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
     ResponseStats stats;
-    // Every push of a (part, mass), then the deepest of each, in key order (deterministic).
+    // The deepest push of each (part, mass), kept in a slot per mass in first-contact order
+    // (deterministic; each mass then moves once, independently of the others).
+    if (++pushEpoch_ == 0) {
+        for (auto& stamps : pushStamp_) std::fill(stamps.begin(), stamps.end(), 0u);
+        pushEpoch_ = 1;
+    }
     pushes_.clear();
     auto pushFace = [&](std::uint32_t id, Index face, const Vec3& displacement) {
         Part& part = *parts_[id];
         part.touchFace(face);
-        for (Index m : part.model().mesh.faces[face]) pushes_.emplace_back((std::uint64_t(id) << 32) | m, displacement);
+        auto& stamps = pushStamp_[id];
+        auto& slots = pushSlot_[id];
+        if (stamps.empty()) {
+            stamps.assign(part.model().massCount(), 0u);
+            slots.assign(part.model().massCount(), 0u);
+        }
+        for (Index m : part.model().mesh.faces[face]) {
+            if (stamps[m] != pushEpoch_) {
+                stamps[m] = pushEpoch_;
+                slots[m] = Index(pushes_.size());
+                pushes_.push_back({(std::uint64_t(id) << 32) | m, displacement});
+            } else if (displacement.squaredNorm() > pushes_[slots[m]].second.squaredNorm()) {
+                pushes_[slots[m]].second = displacement;
+            }
+        }
     };
     for (const Contact& c : contacts) {
         const bool da = deformable(*parts_[c.partA]), db = deformable(*parts_[c.partB]);
@@ -137,18 +158,11 @@ ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
         if (shareA < 1.0) pushFace(c.partB, c.faceB, (-c.depth * (1.0 - shareA)) * c.normal);
         ++stats.contacts;
     }
-    // Stable: among equally deep pushes of a mass, the first contact's wins.
-    std::stable_sort(pushes_.begin(), pushes_.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-    for (std::size_t i = 0; i < pushes_.size();) {
-        std::size_t deepest = i, j = i + 1;
-        for (; j < pushes_.size() && pushes_[j].first == pushes_[i].first; ++j)
-            if (pushes_[j].second.squaredNorm() > pushes_[deepest].second.squaredNorm()) deepest = j;
-        const auto& [key, displacement] = pushes_[deepest];
+    for (const auto& [key, displacement] : pushes_) {
         parts_[key >> 32]->displaceMass(Index(key & 0xffffffffu), displacement);
         stats.maxDisplacement = std::max(stats.maxDisplacement, displacement.norm());
-        ++stats.displacedMasses;
-        i = j;
     }
+    stats.displacedMasses = pushes_.size();
     return stats;
 }
 

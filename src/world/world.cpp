@@ -93,6 +93,7 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
     parts_.push_back(std::move(part));
     bodies_.push_back(body);
     kinematicTargets_.emplace_back();
+    reactionStamp_.emplace_back();
     return BodyId(parts_.size() - 1);
 }
 
@@ -246,14 +247,28 @@ void World::operatorInput() {
 // back with k_eff (rest - x); through the contact, the body receives that force, for the next
 // step. A weak push is stopped by a stiff rim; a strong one deforms it and passes.
 void World::applyDeformableReactions(std::span<const Contact> contacts) {
+    // Each (body, contacted mass) once, in first-contact order (deterministic).
+    if (++reactionEpoch_ == 0) {
+        for (auto& marks : reactionStamp_) std::fill(marks.first.begin(), marks.first.end(), 0u);
+        reactionEpoch_ = 1;
+    }
     reactionMasses_.clear();
     for (const Contact& c : contacts)
         for (const auto& [body, part, face] : {std::tuple{c.partA, c.partB, c.faceB}, std::tuple{c.partB, c.partA, c.faceA}}) {
             if (bodies_[body].motion != MotionType::Dynamic || parts_[part]->mode() == PartMode::Rigid) continue;
-            for (Index m : parts_[part]->model().mesh.faces[face]) reactionMasses_.push_back({body, part, m});
+            auto& [stamps, owners] = reactionStamp_[part];
+            if (stamps.empty()) {
+                stamps.assign(parts_[part]->model().massCount(), 0u);
+                owners.assign(parts_[part]->model().massCount(), 0u);
+            }
+            // Contacts come grouped by pair, so a mass pressed by two bodies counts once for each.
+            for (Index m : parts_[part]->model().mesh.faces[face])
+                if (stamps[m] != reactionEpoch_ || owners[m] != body) {
+                    stamps[m] = reactionEpoch_;
+                    owners[m] = body;
+                    reactionMasses_.push_back({body, part, m});
+                }
         }
-    std::sort(reactionMasses_.begin(), reactionMasses_.end());
-    reactionMasses_.erase(std::unique(reactionMasses_.begin(), reactionMasses_.end()), reactionMasses_.end());
     for (const auto& [body, part, m] : reactionMasses_) {
         const Part& p = *parts_[part];
         const Vec3 displacement = p.pose().rotate(p.state().positions[m] - p.model().restPositions[m]);
@@ -401,6 +416,9 @@ void World::resolveRigidContacts(BodyId id) {
             if (into < 0.0) body.linearVelocity -= into * out;  // inelastic
         }
         timer.charge(Stage::ContactResponse);
+        // Resting contact: nothing left to push out (a nanometre per unit of thickness), so
+        // another pass would find the same contacts.
+        if (correction.norm() <= 1e-9 * body.thickness) return;
     }
 }
 
