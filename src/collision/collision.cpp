@@ -24,8 +24,9 @@ double volumeSize(const Sphere& s) { return 2.0 * s.radius; }
 double volumeSize(const Aabb& b) { return b.size(); }
 
 // Simultaneous depth-first traversal; leafPair(faceA, faceB) for every overlapping leaf pair.
-template <class BA, class BB, class LeafPair>
-void traverse(const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, QueryStats& stats, LeafPair leafPair) {
+// prune(faceA, volumeB) may cut a subtree of B that cannot touch A's leaf face.
+template <class BA, class BB, class LeafPair, class Prune>
+void traverse(const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, QueryStats& stats, LeafPair leafPair, Prune prune) {
     if (a.empty() || b.empty()) return;
     thread_local std::vector<std::pair<std::int32_t, std::int32_t>> stack;
     stack.clear();
@@ -39,6 +40,7 @@ void traverse(const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, Quer
         const auto& y = nb[std::size_t(j)];
         ++stats.volumeTests;
         if (!overlap(x.volume, y.volume, bInA)) continue;
+        if (x.isLeaf() && !y.isLeaf() && prune(x.item, y.volume)) continue;
         if (x.isLeaf() && y.isLeaf()) {
             ++stats.candidatePairs;
             leafPair(x.item, y.item);
@@ -168,8 +170,7 @@ public:
         }
     }
     bool separated(Index fa, std::span<const Vec3> pb, const Face& fb) {
-        const Face& f = a_.model().mesh.faces[fa];
-        if (a_.mode() != PartMode::Rigid && (a_.isMoving(f[0]) || a_.isMoving(f[1]) || a_.isMoving(f[2]))) return false;
+        if (!atRest(fa)) return false;
         const auto& planes = planesInB(fa);
         for (std::size_t k = 0; k < planes.size(); ++k) {
             const Vec3 n = planes[k].head<3>();
@@ -181,7 +182,36 @@ public:
         return false;
     }
 
+    // A subtree of B whose volume lies entirely beyond one of A's face planes holds no
+    // triangle the face can touch (each would be rejected by separated()).
+    template <class Volume>
+    bool separated(Index fa, const Volume& volumeB) {
+        if (!atRest(fa)) return false;
+        const auto& planes = planesInB(fa);
+        for (std::size_t k = 0; k < planes.size(); ++k) {
+            const Vec3 n = planes[k].head<3>();
+            const double margin = 1e-9 * (1.0 + std::abs(collider_.restPlanes(fa)[k][3]));
+            const auto [lowest, highest] = extent(volumeB, n);
+            if (lowest - planes[k][3] > margin) return true;
+            if (k == 0 && highest - planes[k][3] < -margin) return true;
+        }
+        return false;
+    }
+
 private:
+    bool atRest(Index fa) const {
+        const Face& f = a_.model().mesh.faces[fa];
+        return a_.mode() == PartMode::Rigid || !(a_.isMoving(f[0]) || a_.isMoving(f[1]) || a_.isMoving(f[2]));
+    }
+    // Range of n.x over the volume.
+    static std::pair<double, double> extent(const Aabb& box, const Vec3& n) {
+        const double centre = n.dot(box.centre()), reach = n.cwiseAbs().dot(box.halfExtents());
+        return {centre - reach, centre + reach};
+    }
+    static std::pair<double, double> extent(const Sphere& sphere, const Vec3& n) {
+        const double centre = n.dot(sphere.centre);
+        return {centre - sphere.radius, centre + sphere.radius};
+    }
     // n.(R x + t) = d  <=>  (R^T n).x = d - n.t
     const std::array<Eigen::Vector4d, 4>& planesInB(Index fa) {
         if (stamp_[fa] != epoch_) {
@@ -234,7 +264,10 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
         ++stats.contacts;
         contacts.push_back({idA, idB, fa, fb, a.pose().apply(hit->point), ra * hit->normal, hit->depth});
     };
-    dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) { traverse(bvhA, bvhB, bInA, stats, leafPair); });
+    dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) { 
+        auto prune = [&](Index fa, const auto& volumeB) { return test == ExactTest::TriangleTriangle && filter.separated(fa, volumeB); };
+        traverse(bvhA, bvhB, bInA, stats, leafPair, prune);
+    });
 }
 
 }  // namespace flexfit
