@@ -93,7 +93,9 @@ Aabb faceBox(std::span<const Vec3> positions, const Face& face);
 Aabb faceSphereBox(std::span<const Vec3> positions, const Face& face);  // box of the face sphere
 
 // Contacts between parts a and b (ids are written into the contacts). Appends to `contacts`;
-// when `candidates` is given, also appends every leaf pair whose volumes overlap. Both
+// when `candidates` is given, also appends every leaf pair whose volumes overlap (otherwise
+// subtrees that lie beyond the planes of an at-rest face of A are pruned, and the statistics
+// count what was visited; the contacts are the same either way). Both
 // colliders must have been built for `test` (std::invalid_argument otherwise).
 void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
                const PartCollider& colliderB, ExactTest test, std::vector<Contact>& contacts, QueryStats& stats,

@@ -265,7 +265,10 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
         contacts.push_back({idA, idB, fa, fb, a.pose().apply(hit->point), ra * hit->normal, hit->depth});
     };
     dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) { 
-        auto prune = [&](Index fa, const auto& volumeB) { return test == ExactTest::TriangleTriangle && filter.separated(fa, volumeB); };
+        // Listing candidates means every leaf pair whose volumes overlap: no pruning then.
+        auto prune = [&](Index fa, const auto& volumeB) {
+            return !candidates && test == ExactTest::TriangleTriangle && filter.separated(fa, volumeB);
+        };
         traverse(bvhA, bvhB, bInA, stats, leafPair, prune);
     });
 }

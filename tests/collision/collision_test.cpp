@@ -72,6 +72,35 @@ FacePairs contactPairs(const std::vector<Contact>& contacts) {
 
 }  // namespace
 
+TEST(NarrowPhase, PlanePruningKeepsEveryContact) {
+    // Without a candidate list the query prunes by the rest planes of A's faces: the contacts
+    // must still be exactly the brute force's, also where A's faces are deformed (not at rest).
+    std::mt19937 rng(11);
+    int withContacts = 0;
+    for (int trial = 0; trial < 16; ++trial) {
+        const auto ma = buildPartModel(perturbed(makeIcoSphere(1.0, 2), 0.05, rng));
+        const auto mb = buildPartModel(perturbed(makeTorus(1.0, 0.35, 16, 10), 0.03, rng));
+        PartSettings soft;
+        Part a(ma, soft), b(mb);
+        if (trial % 2) {
+            a.applyForce(0, Vec3(0.3, 0.2, -0.1));  // a zone around mass 0 deforms A's faces there
+            a.step();
+        }
+        a.setPose(randomPose(rng, 0.6));
+        b.setPose(randomPose(rng, 0.6));
+        for (BoundingVolumeKind kb : {BoundingVolumeKind::Sphere, BoundingVolumeKind::Aabb}) {
+            const PartCollider ca(a, BoundingVolumeKind::Aabb), cb(b, kb);
+            std::vector<Contact> contacts;
+            QueryStats stats;
+            queryPair(0, a, ca, 1, b, cb, ExactTest::TriangleTriangle, contacts, stats);
+            EXPECT_EQ(contactPairs(contacts), bruteForce(a, b, BoundingVolumeKind::Aabb, kb, ExactTest::TriangleTriangle).contacts)
+                << "trial " << trial;
+            withContacts += !contacts.empty();
+        }
+    }
+    EXPECT_GT(withContacts, 8);
+}
+
 TEST(NarrowPhase, CandidatesAndContactsEqualBruteForce) {
     std::mt19937 rng(10);
     const BoundingVolumeKind kinds[2] = {BoundingVolumeKind::Sphere, BoundingVolumeKind::Aabb};
