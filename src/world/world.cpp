@@ -32,6 +32,13 @@ private:
 
 const std::string kWorldSource = "world";
 
+// The rotation as axis and angle in (-pi, pi]: the short way round.
+Eigen::AngleAxisd shortestTurn(const Eigen::Quaterniond& q) {
+    Eigen::AngleAxisd turn(q);
+    if (turn.angle() > M_PI) turn.angle() -= 2.0 * M_PI;
+    return turn;
+}
+
 }  // namespace
 
 const char* toString(MotionType motion) {
@@ -189,10 +196,8 @@ void World::applyCoupling() {
     const Pose& pose = parts_[id]->pose();
     const Vec3 targetCentre = grabTarget_.apply(body.centreOfMass);
     const Vec3 targetVelocity = (targetCentre - previousGrabTarget_.apply(body.centreOfMass)) / h;
-    Eigen::AngleAxisd error(grabTarget_.rotation * pose.rotation.conjugate());
-    if (error.angle() > M_PI) error.angle() -= 2.0 * M_PI;  // the short way round
-    Eigen::AngleAxisd targetTurn(grabTarget_.rotation * previousGrabTarget_.rotation.conjugate());
-    if (targetTurn.angle() > M_PI) targetTurn.angle() -= 2.0 * M_PI;
+    const Eigen::AngleAxisd error = shortestTurn(grabTarget_.rotation * pose.rotation.conjugate());
+    const Eigen::AngleAxisd targetTurn = shortestTurn(grabTarget_.rotation * previousGrabTarget_.rotation.conjugate());
     const Vec3 targetSpin = targetTurn.axis() * (targetTurn.angle() / h);
     coupling_.force = gains_.k * (targetCentre - centreOfMass(id)) + gains_.b * (targetVelocity - body.linearVelocity);
     coupling_.torque = gains_.kr * error.angle() * error.axis() + gains_.br * (targetSpin - body.angularVelocity);
