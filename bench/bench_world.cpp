@@ -15,14 +15,15 @@ namespace {
 
 constexpr int kTimedSteps = 200;
 
-Scene scene(const char* file, bool push) {
+Scene scene(const char* file, bool push, bool faceQuery) {
     Scene s = loadScene(std::string(FLEXFIT_EXAMPLES_DIR) + "/" + file);
     if (!push) s.actions.clear();  // gravity only: the ball rests on the rim
+    if (faceQuery) s.world.collision.rigidDeformable = RigidDeformableQuery::Faces;
     return s;
 }
 
-void stepInContact(benchmark::State& state, const char* file, bool push, int settle) {
-    const Scene base = scene(file, push);
+void stepInContact(benchmark::State& state, const char* file, bool push, int settle, bool faceQuery = false) {
+    const Scene base = scene(file, push, faceQuery);
     double seconds = 0.0, contacts = 0.0, moving = 0.0;
     std::array<double, std::size_t(Stage::Count)> stages{};
     for (auto _ : state) {
@@ -56,10 +57,13 @@ void stepInContact(benchmark::State& state, const char* file, bool push, int set
 }
 
 // Pushed with 2,500 through the mouth: the timed steps start 20 steps after the first contact,
-// while the rim is being pushed open (the deepest contact of the run).
+// while the rim is being pushed open (the deepest contact of the run). The scene's point-shell
+// query, and beside it the face-face query it replaces for this pair.
 void BM_HapticMouthPushed(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", true, 20); }
+void BM_HapticMouthPushedFaceQuery(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", true, 20, true); }
 // Resting on the rim under its weight, 500 steps after the first contact.
 void BM_HapticMouthResting(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", false, 500); }
+void BM_HapticMouthRestingFaceQuery(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", false, 500, true); }
 // The same at the container-mouth resolution (64 x 24 = 1,536 masses).
 void BM_MouthPushed(benchmark::State& s) { stepInContact(s, "ball_torus.toml", true, 20); }
 void BM_MouthResting(benchmark::State& s) { stepInContact(s, "ball_torus.toml", false, 500); }
@@ -69,7 +73,9 @@ void BM_RigidMouthResting(benchmark::State& s) { stepInContact(s, "ball_torus_ri
 }  // namespace
 
 BENCHMARK(BM_HapticMouthPushed)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_HapticMouthPushedFaceQuery)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_HapticMouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_HapticMouthRestingFaceQuery)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_MouthPushed)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_MouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_RigidMouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);

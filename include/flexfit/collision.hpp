@@ -17,6 +17,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 
 #include "flexfit/bvh.hpp"
 #include "flexfit/part.hpp"
@@ -29,12 +30,17 @@ namespace flexfit {
 enum class ExactTest { SphereTriangle, TriangleTriangle };
 const char* toString(ExactTest test);
 
+inline constexpr Index kNoMass = std::numeric_limits<Index>::max();
+
 struct Contact {
     std::uint32_t partA = 0, partB = 0;
     Index faceA = 0, faceB = 0;
     Vec3 point = Vec3::Zero();   // world
     Vec3 normal = Vec3::UnitY(); // world, unit: pushes A out of B
     double depth = 0.0;
+    // Point-shell contacts: the one mass of B inside A (faceB is a face around it; faceA is not
+    // looked up and stays 0). kNoMass for face-face contacts.
+    Index massB = kNoMass;
 };
 
 struct QueryStats {
@@ -58,6 +64,15 @@ public:
     void rebuild(const Part& part);
     // Refits the faces around `changedMasses` (positions read from the part).
     void refit(const Part& part, std::span<const Index> changedMasses);
+    // Lazy refit: notePending() remembers changed masses (and updates the bounding sphere),
+    // refitPending() refits them all at once when a face query needs the hierarchy. A part met
+    // only by point-shell queries never pays for refits.
+    void notePending(const Part& part, std::span<const Index> changedMasses);
+    void refitPending(const Part& part);
+    bool hasPending() const { return !pending_.empty(); }
+    // Masses at their rest positions in a hierarchy of points, built on first use (point-shell
+    // queries: the masses at rest never move, so this tree never needs a refit).
+    const Bvh<Aabb>& restPointTree(const Part& part);
 
     // The part's bounding sphere in its own frame: the thesis's sphere of the rest shape
     // (midpoint of the masses' box, radius to the farthest mass), grown by the largest
@@ -84,6 +99,9 @@ private:
     double maxDisplacement_ = 0.0;
     std::vector<std::uint32_t> faceMark_;  // (F) refit epochs
     std::vector<Index> changedFaces_;      // scratch
+    std::vector<Index> pending_;           // changed masses not yet refitted
+    std::vector<bool> isPending_;          // (V)
+    Bvh<Aabb> restPoints_;
     std::uint32_t epoch_ = 0;
 };
 
@@ -100,5 +118,18 @@ Aabb faceSphereBox(std::span<const Vec3> positions, const Face& face);  // box o
 void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
                const PartCollider& colliderB, ExactTest test, std::vector<Contact>& contacts, QueryStats& stats,
                std::vector<std::pair<Index, Index>>* candidates = nullptr);
+
+// Point-shell contacts of a rigid part A with part B: every mass of B whose distance sampled
+// from A's field (distance_field.hpp) is <= 0 is one contact (massB), with depth = minus that
+// distance, point = the mass, normal = minus the field's normalised gradient (so it pushes A
+// out of B, as for face contacts). B's moving masses are each sampled; its masses at rest are
+// found through restPointsB (PartCollider::restPointTree), pruned with the field's Lipschitz
+// bound, so the cost follows the masses near A's surface, not the pairs of faces, and needs no
+// refit. Faces of A that poke between B's masses are not seen: meant for B finer than A (a
+// deformable part against a rigid tool or ball). stats: volumeTests = tree nodes visited,
+// candidatePairs = masses reached, exactTests = masses sampled.
+class SignedDistanceField;
+void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField& fieldA, std::uint32_t idB, const Part& b,
+                     const Bvh<Aabb>& restPointsB, std::vector<Contact>& contacts, QueryStats& stats);
 
 }  // namespace flexfit

@@ -5,6 +5,7 @@
 #include "flexfit/assembly.hpp"
 #include "flexfit/collision_world.hpp"
 #include "flexfit/core.hpp"
+#include "flexfit/distance_field.hpp"
 #include "flexfit/generators.hpp"
 #include "flexfit/mesh.hpp"
 #include "flexfit/mesh_io.hpp"

@@ -1,5 +1,7 @@
 #include "flexfit/collision.hpp"
 
+#include "flexfit/distance_field.hpp"
+
 #include <stdexcept>
 
 namespace flexfit {
@@ -82,8 +84,8 @@ Sphere faceSphere(std::span<const Vec3> positions, const Face& face) {
 }
 
 Aabb faceBox(std::span<const Vec3> positions, const Face& face) {
-    const Vec3 p[3] = {positions[face[0]], positions[face[1]], positions[face[2]]};
-    return Aabb::around(p);
+    const Vec3 &a = positions[face[0]], &b = positions[face[1]], &c = positions[face[2]];
+    return {a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)};
 }
 
 Aabb faceSphereBox(std::span<const Vec3> positions, const Face& face) {
@@ -141,6 +143,35 @@ void PartCollider::refit(const Part& part, std::span<const Index> changedMasses)
     maxDisplacement_ = 0.0;
     for (Index m : part.movingMasses())
         maxDisplacement_ = std::max(maxDisplacement_, (positions[m] - model.restPositions[m]).norm());
+}
+
+void PartCollider::notePending(const Part& part, std::span<const Index> changedMasses) {
+    if (isPending_.empty()) isPending_.assign(part.model().massCount(), false);
+    for (Index m : changedMasses)
+        if (!isPending_[m]) {
+            isPending_[m] = true;
+            pending_.push_back(m);
+        }
+    maxDisplacement_ = 0.0;
+    for (Index m : part.movingMasses())
+        maxDisplacement_ = std::max(maxDisplacement_, (part.state().positions[m] - part.model().restPositions[m]).norm());
+}
+
+void PartCollider::refitPending(const Part& part) {
+    if (pending_.empty()) return;
+    refit(part, pending_);
+    for (Index m : pending_) isPending_[m] = false;
+    pending_.clear();
+}
+
+const Bvh<Aabb>& PartCollider::restPointTree(const Part& part) {
+    if (restPoints_.empty()) {
+        const auto& rest = part.model().restPositions;
+        std::vector<Aabb> points(rest.size());
+        for (std::size_t m = 0; m < rest.size(); ++m) points[m] = {rest[m], rest[m]};
+        restPoints_.build(points);
+    }
+    return restPoints_;
 }
 
 Sphere PartCollider::worldSphere(const Part& part) const {
@@ -271,6 +302,47 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
         };
         traverse(bvhA, bvhB, bInA, stats, leafPair, prune);
     });
+}
+
+void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField& fieldA, std::uint32_t idB, const Part& b,
+                     const Bvh<Aabb>& restPointsB, std::vector<Contact>& contacts, QueryStats& stats) {
+    const Eigen::Matrix3d ra = a.pose().rotation.toRotationMatrix(), rb = b.pose().rotation.toRotationMatrix();
+    const RelativePose bInA(ra.transpose() * rb, ra.transpose() * (b.pose().translation - a.pose().translation));
+    const std::span<const Vec3> pb = b.state().positions;
+    const Topology& topology = b.model().topology;
+    auto sampleMass = [&](Index m) {
+        const Vec3 p = bInA.apply(pb[m]);
+        ++stats.candidatePairs;
+        if (!fieldA.inGrid(p)) return;
+        ++stats.exactTests;
+        const SignedDistanceField::Interpolated s = fieldA.sample(p);
+        if (s.distance > 0.0) return;
+        // The gradient is the outward normal (zero only on a symmetry plane of the field,
+        // where the exact closest point decides).
+        const double g = s.gradient.norm();
+        const Vec3 outward = g > 1e-9 ? Vec3(s.gradient / g) : fieldA.query(p).normal;
+        ++stats.contacts;
+        contacts.push_back({idA, idB, 0, topology.facesOf(m)[0], a.pose().apply(p), -(ra * outward), -s.distance, m});
+    };
+    for (Index m : b.movingMasses()) sampleMass(m);
+    // The masses at rest, through the tree of rest positions (their current positions).
+    if (restPointsB.empty()) return;
+    const auto& nodes = restPointsB.nodes();
+    thread_local std::vector<std::int32_t> stack;
+    stack.assign(1, 0);
+    while (!stack.empty()) {
+        const auto& node = nodes[std::size_t(stack.back())];
+        stack.pop_back();
+        ++stats.volumeTests;
+        if (node.isLeaf()) {
+            if (!b.isMoving(node.item)) sampleMass(node.item);
+            continue;
+        }
+        if (!fieldA.clearOf(bInA.apply(node.volume.centre()), node.volume.halfExtents().norm())) {
+            stack.push_back(node.right);
+            stack.push_back(node.left);
+        }
+    }
 }
 
 }  // namespace flexfit

@@ -24,12 +24,18 @@ bool deformable(const Part& p) { return p.mode() != PartMode::Rigid; }
 
 }  // namespace
 
+const char* toString(RigidDeformableQuery query) { return query == RigidDeformableQuery::PointShell ? "point-shell" : "faces"; }
+
 CollisionWorld::CollisionWorld(CollisionSettings settings) : settings_(settings) {}
 
 std::uint32_t CollisionWorld::add(Part& part, BoundingVolumeKind kind) {
     parts_.push_back(&part);
     colliders_.emplace_back(part, kind, settings_.exactTest);
     stiffness_.push_back(effectivePartStiffness(part));
+    fields_.emplace_back();
+    fieldTried_.push_back(false);
+    // Built now rather than at the first contact, where it would stall a haptic loop.
+    if (settings_.rigidDeformable == RigidDeformableQuery::PointShell && !deformable(part)) distanceField(std::uint32_t(parts_.size() - 1));
     pushStamp_.emplace_back();
     pushSlot_.emplace_back();
     part.clearChangedMasses();
@@ -52,10 +58,15 @@ void CollisionWorld::update() {
 void CollisionWorld::refitChanged() {
     for (std::size_t i = 0; i < parts_.size(); ++i) {
         Part& part = *parts_[i];
-        if (!part.changedMasses().empty()) colliders_[i].refit(part, part.changedMasses());
+        if (!part.changedMasses().empty()) colliders_[i].notePending(part, part.changedMasses());
         part.clearChangedMasses();
         partSpheres_[i] = colliders_[i].worldSphere(part);
     }
+}
+
+const PartCollider& CollisionWorld::collider(std::uint32_t id) {
+    colliders_[id].refitPending(*parts_[id]);
+    return colliders_[id];
 }
 
 const std::vector<Contact>& CollisionWorld::contactsOf(std::uint32_t id, bool rigidPartnersOnly) {
@@ -69,7 +80,7 @@ const std::vector<Contact>& CollisionWorld::contactsOf(std::uint32_t id, bool ri
         std::uint32_t a = std::min(id, other), b = std::max(id, other);
         if (!pressesFirst(a, b)) std::swap(a, b);
         QueryStats ignored;
-        queryPair(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, partContacts_, ignored);
+        queryCandidates(a, b, partContacts_, ignored);
     }
     return partContacts_;
 }
@@ -116,9 +127,27 @@ const std::vector<Contact>& CollisionWorld::narrowPhase() {
     stats_ = {};
     for (auto [i, j] : pairs_) {
         if (!pressesFirst(i, j)) std::swap(i, j);
-        queryPair(i, *parts_[i], colliders_[i], j, *parts_[j], colliders_[j], settings_.exactTest, contacts_, stats_);
+        queryCandidates(i, j, contacts_, stats_);
     }
     return contacts_;
+}
+
+void CollisionWorld::queryCandidates(std::uint32_t a, std::uint32_t b, std::vector<Contact>& out, QueryStats& stats) {
+    if (settings_.rigidDeformable == RigidDeformableQuery::PointShell && !deformable(*parts_[a]) && deformable(*parts_[b]))
+        if (const SignedDistanceField* field = distanceField(a))
+            return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(*parts_[b]), out, stats);
+    queryPair(a, *parts_[a], collider(a), b, *parts_[b], collider(b), settings_.exactTest, out, stats);
+}
+
+const SignedDistanceField* CollisionWorld::distanceField(std::uint32_t id) {
+    if (!fieldTried_[id]) {
+        fieldTried_[id] = true;
+        const PartModel& model = parts_[id]->model();
+        bool closed = true;
+        for (Index count : model.topology.edgeFaceCount) closed = closed && count == 2;
+        if (closed) fields_[id] = std::make_shared<SignedDistanceField>(model.mesh, model.topology);
+    }
+    return fields_[id].get();
 }
 
 ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
@@ -130,7 +159,8 @@ ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
         pushEpoch_ = 1;
     }
     pushes_.clear();
-    auto pushFace = [&](std::uint32_t id, Index face, const Vec3& displacement) {
+    // Pushes the face's masses, or only `mass` when the contact has one (point shell).
+    auto pushFace = [&](std::uint32_t id, Index face, Index mass, const Vec3& displacement) {
         Part& part = *parts_[id];
         part.touchFace(face);
         auto& stamps = pushStamp_[id];
@@ -139,7 +169,8 @@ ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
             stamps.assign(part.model().massCount(), 0u);
             slots.assign(part.model().massCount(), 0u);
         }
-        for (Index m : part.model().mesh.faces[face]) {
+        const Face& masses = part.model().mesh.faces[face];
+        for (Index m : mass == kNoMass ? std::span<const Index>(masses) : std::span<const Index>(&mass, 1)) {
             if (stamps[m] != pushEpoch_) {
                 stamps[m] = pushEpoch_;
                 slots[m] = Index(pushes_.size());
@@ -154,8 +185,8 @@ ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
         if (!da && !db) continue;
         const double ka = stiffness_[c.partA], kb = stiffness_[c.partB];
         const double shareA = da && db ? (ka + kb > 0 ? kb / (ka + kb) : 0.5) : (da ? 1.0 : 0.0);
-        if (shareA > 0.0) pushFace(c.partA, c.faceA, (c.depth * shareA) * c.normal);
-        if (shareA < 1.0) pushFace(c.partB, c.faceB, (-c.depth * (1.0 - shareA)) * c.normal);
+        if (shareA > 0.0) pushFace(c.partA, c.faceA, kNoMass, (c.depth * shareA) * c.normal);
+        if (shareA < 1.0) pushFace(c.partB, c.faceB, c.massB, (-c.depth * (1.0 - shareA)) * c.normal);
         ++stats.contacts;
     }
     for (const auto& [key, displacement] : pushes_) {

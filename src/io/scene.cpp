@@ -396,6 +396,8 @@ void readWorld(Table& root, Scene& scene) {
     s.contactIterations = w.integer("contact_iterations", s.contactIterations, 1, 1000);
     s.collision.exactTest = w.choice("exact_test", ExactTest::TriangleTriangle,
                                      {{"triangle", ExactTest::TriangleTriangle}, {"sphere", ExactTest::SphereTriangle}});
+    s.collision.rigidDeformable = w.choice("rigid_deformable_query", RigidDeformableQuery::Faces,
+                                           {{"faces", RigidDeformableQuery::Faces}, {"point-shell", RigidDeformableQuery::PointShell}});
     w.finish();
     try {
         SimulationSettings check;

@@ -259,7 +259,8 @@ void World::applyDeformableReactions(std::span<const Contact> contacts) {
     }
     reactionMasses_.clear();
     for (const Contact& c : contacts)
-        for (const auto& [body, part, face] : {std::tuple{c.partA, c.partB, c.faceB}, std::tuple{c.partB, c.partA, c.faceA}}) {
+        for (const auto& [body, part, face, mass] :
+             {std::tuple{c.partA, c.partB, c.faceB, c.massB}, std::tuple{c.partB, c.partA, c.faceA, kNoMass}}) {
             if (bodies_[body].motion != MotionType::Dynamic || parts_[part]->mode() == PartMode::Rigid) continue;
             auto& [stamps, owners] = reactionStamp_[part];
             if (stamps.empty()) {
@@ -267,7 +268,8 @@ void World::applyDeformableReactions(std::span<const Contact> contacts) {
                 owners.assign(parts_[part]->model().massCount(), 0u);
             }
             // Contacts come grouped by pair, so a mass pressed by two bodies counts once for each.
-            for (Index m : parts_[part]->model().mesh.faces[face])
+            const Face& masses = parts_[part]->model().mesh.faces[face];
+            for (Index m : mass == kNoMass ? std::span<const Index>(masses) : std::span<const Index>(&mass, 1))
                 if (stamps[m] != reactionEpoch_ || owners[m] != body) {
                     stamps[m] = reactionEpoch_;
                     owners[m] = body;

@@ -186,3 +186,48 @@ TEST(NarrowPhase, RefitAfterDeformationEqualsRebuild) {
         EXPECT_FALSE(x.empty()) << toString(kind);
     }
 }
+
+TEST(NarrowPhase, PointShellContactsEqualBruteForceOverEveryMass) {
+    // A rigid ball against a deformable torus, at rest and with a deformed zone, in random
+    // poses: the contacts are exactly the masses whose sampled distance is <= 0 (every mass
+    // tested, no tree), and each depth is the exact penetration within the field's error.
+    std::mt19937 rng(21);
+    const auto ballModel = buildPartModel(makeIcoSphere(0.9, 2));
+    const auto torusModel = buildPartModel(makeTorus(1.0, 0.35, 48, 16));
+    const SignedDistanceField field(ballModel->mesh, ballModel->topology);
+    const double error = std::sqrt(3.0) * field.cellSize();
+    int withContacts = 0;
+    for (int trial = 0; trial < 12; ++trial) {
+        Part ball(ballModel, [] { PartSettings s; s.mode = PartMode::Rigid; return s; }());
+        Part torus(torusModel);
+        if (trial % 2) {
+            torus.applyForce(0, Vec3(0.4, 0.3, -0.2));
+            for (int i = 0; i < 30; ++i) torus.step();
+        }
+        ball.setPose(randomPose(rng, 0.4));
+        torus.setPose(randomPose(rng, 0.4));
+        PartCollider torusCollider(torus, BoundingVolumeKind::Aabb);
+        std::vector<Contact> contacts;
+        QueryStats stats;
+        queryPointShell(0, ball, field, 1, torus, torusCollider.restPointTree(torus), contacts, stats);
+
+        const Eigen::Matrix3d ra = ball.pose().rotation.toRotationMatrix();
+        std::set<Index> expected, found;
+        for (Index m = 0; m < torusModel->massCount(); ++m) {
+            const Vec3 p = ra.transpose() * (torus.pose().apply(torus.state().positions[m]) - ball.pose().translation);
+            if (field.inGrid(p) && field.sample(p).distance <= 0.0) expected.insert(m);
+        }
+        for (const Contact& c : contacts) {
+            EXPECT_TRUE(found.insert(c.massB).second) << "mass " << c.massB << " twice";
+            const Vec3 p = ra.transpose() * (c.point - ball.pose().translation);
+            EXPECT_NEAR(c.depth, -field.query(p).distance, error);
+            EXPECT_NEAR(c.normal.norm(), 1.0, 1e-9);
+            const Face& f = torusModel->mesh.faces[c.faceB];
+            EXPECT_TRUE(f[0] == c.massB || f[1] == c.massB || f[2] == c.massB);
+        }
+        EXPECT_EQ(found, expected) << "trial " << trial;
+        EXPECT_LT(stats.exactTests, torusModel->massCount());  // the tree pruned
+        withContacts += !contacts.empty();
+    }
+    EXPECT_GT(withContacts, 5);
+}

@@ -129,6 +129,16 @@ TEST(Scene, UnknownChoiceListsTheOptions) {
         << e;
 }
 
+TEST(Scene, ContactQueryIsAChoice) {
+    EXPECT_EQ(parseScene(kBall, "scene.toml", ".").world.collision.rigidDeformable, RigidDeformableQuery::Faces);  // default
+    const std::string text = withLine("duration = 2.5", "rigid_deformable_query = \"point-shell\"");
+    EXPECT_EQ(parseScene(text, "scene.toml", ".").world.collision.rigidDeformable, RigidDeformableQuery::PointShell);
+    const std::string e = errorOf(withLine("duration = 2.5", "rigid_deformable_query = \"voxels\""));
+    EXPECT_NE(e.find(":6: scene.world, key 'rigid_deformable_query': unknown value 'voxels' (expected one of 'faces', 'point-shell')"),
+              std::string::npos)
+        << e;
+}
+
 TEST(Scene, VectorNeedsThreeNumbers) {
     const std::string e = errorOf(withLine("name = \"ball\"", "velocity = [1, 2]"));
     EXPECT_NE(e.find(":18: part 2, key 'velocity': expected an array of 3 numbers"), std::string::npos) << e;

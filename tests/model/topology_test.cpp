@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "unit_cube.hpp"
+
 #include <algorithm>
 #include <map>
 #include <set>
@@ -117,14 +119,7 @@ void expectMatchesReference(const std::vector<Face>& faces, std::size_t vertexCo
     for (Index f = 0; f < faces.size(); ++f) EXPECT_EQ(toVector(topo.faceNeighborsOf(f)), ref.faceFaces[f]) << "face " << f;
 }
 
-TriMesh cube() {
-    TriMesh mesh;
-    mesh.name = "cube";
-    mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-    mesh.faces = {{0, 3, 2}, {0, 2, 1}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
-                  {3, 7, 6}, {3, 6, 2}, {0, 4, 7}, {0, 7, 3}, {1, 2, 6}, {1, 6, 5}};
-    return mesh;
-}
+TriMesh cube() { return testing::unitCube(); }
 
 TEST(Topology, Cube) {
     const TriMesh mesh = cube();

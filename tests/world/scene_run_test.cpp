@@ -78,8 +78,12 @@ TEST(SceneRun, MoveInterpolatesTheGrabTargetLinearly) {
     EXPECT_TRUE(run.finished());
 }
 
-TEST(SceneRun, DeformableMouthLetsThePushedBallThroughAndRestores) {
-    SceneRun run(exampleScene("ball_torus.toml"));  // diameter 17, pushed with 2,500, elastic rim
+class SceneRunWithQuery : public ::testing::TestWithParam<RigidDeformableQuery> {};
+
+TEST_P(SceneRunWithQuery, DeformableMouthLetsThePushedBallThroughAndRestores) {
+    Scene scene = exampleScene("ball_torus.toml");  // diameter 17, pushed with 2,500, elastic rim
+    scene.world.collision.rigidDeformable = GetParam();
+    SceneRun run(scene);
     std::size_t deformedMost = 0;
     while (!run.finished()) {
         run.step();
@@ -97,8 +101,9 @@ TEST(SceneRun, DeformableMouthLetsThePushedBallThroughAndRestores) {
         ASSERT_EQ(w.part(0).state().positions[m], w.part(0).model().restPositions[m]) << "mass " << m;
 }
 
-TEST(SceneRun, StiffMouthStopsTheBallUnderGravity) {
+TEST_P(SceneRunWithQuery, StiffMouthStopsTheBallUnderGravity) {
     Scene scene = exampleScene("ball_torus.toml");
+    scene.world.collision.rigidDeformable = GetParam();
     scene.actions.clear();  // gravity alone
     scene.duration = 1.5;
     PartModelSettings stiff;
@@ -113,9 +118,14 @@ TEST(SceneRun, StiffMouthStopsTheBallUnderGravity) {
     EXPECT_GT(run.world().body(1).linearVelocity.y(), -0.01);  // not sinking (the anchors push back up)
 }
 
+INSTANTIATE_TEST_SUITE_P(BothQueries, SceneRunWithQuery,
+                         ::testing::Values(RigidDeformableQuery::Faces, RigidDeformableQuery::PointShell),
+                         [](const auto& param) { return param.param == RigidDeformableQuery::Faces ? "Faces" : "PointShell"; });
+
 TEST(SceneRun, WholeRunIsDeterministic) {
-    auto hashOf = [](double startOffset) {
+    auto hashOf = [](double startOffset, RigidDeformableQuery query = RigidDeformableQuery::Faces) {
         Scene scene = exampleScene("ball_torus.toml");
+        scene.world.collision.rigidDeformable = query;
         scene.parts[1].pose.translation.x() += startOffset;
         SceneRun run(scene);
         runFor(run, 0.7);  // through contact, deformation and the snap
@@ -125,4 +135,9 @@ TEST(SceneRun, WholeRunIsDeterministic) {
     EXPECT_EQ(a.first, b.first);
     EXPECT_EQ(a.second, 1u);
     EXPECT_NE(a.first, c.first);  // the hash sees a nanometre
+    // Point-shell contacts fill the distance grid lazily: still the same run twice.
+    const auto d = hashOf(0.0, RigidDeformableQuery::PointShell), e = hashOf(0.0, RigidDeformableQuery::PointShell);
+    EXPECT_EQ(d, e);
+    EXPECT_EQ(d.second, 1u);
+    EXPECT_NE(d.first, a.first);
 }

@@ -1,0 +1,236 @@
+#include "flexfit/distance_field.hpp"
+#include "flexfit/collision.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace flexfit {
+namespace {
+
+// Closest feature of a triangle: corners 0..2, edges 3 + e (edge e joins corners e and e+1),
+// the face 6.
+constexpr int kFaceFeature = 6;
+
+struct ClosestOnTriangle {
+    Vec3 point;
+    int feature;
+};
+
+// Ericson, Real-Time Collision Detection 5.1.5, keeping which Voronoi region held p.
+ClosestOnTriangle closestWithFeature(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+    if (d1 <= 0.0 && d2 <= 0.0) return {a, 0};
+    const Vec3 bp = p - b;
+    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+    if (d3 >= 0.0 && d4 <= d3) return {b, 1};
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return {a + (d1 / (d1 - d3)) * ab, 3};
+    const Vec3 cp = p - c;
+    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+    if (d6 >= 0.0 && d5 <= d6) return {c, 2};
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return {a + (d2 / (d2 - d6)) * ac, 5};
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) return {b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b), 4};
+    const double denom = 1.0 / (va + vb + vc);
+    return {a + ab * (vb * denom) + ac * (vc * denom), kFaceFeature};
+}
+
+double squaredDistance(const Aabb& box, const Vec3& p) {
+    return (box.min - p).cwiseMax(p - box.max).cwiseMax(0.0).squaredNorm();
+}
+
+double angleAt(const Vec3& corner, const Vec3& u, const Vec3& v) {
+    return std::atan2((u - corner).cross(v - corner).norm(), (u - corner).dot(v - corner));
+}
+
+}  // namespace
+
+SignedDistanceField::SignedDistanceField(const TriMesh& mesh, const Topology& topology, double cellSize)
+    : vertices_(mesh.vertices), faces_(mesh.faces) {
+    if (faces_.empty()) throw std::invalid_argument("signed distance field: the mesh has no faces");
+    for (Index count : topology.edgeFaceCount)
+        if (count != 2) throw std::invalid_argument("signed distance field: the mesh '" + mesh.name + "' is not closed and manifold");
+    faceNormal_.resize(faces_.size());
+    vertexNormal_.assign(vertices_.size(), Vec3::Zero());
+    double edgeSum = 0.0;
+    for (std::size_t f = 0; f < faces_.size(); ++f) {
+        const Face& face = faces_[f];
+        const Vec3 &a = vertices_[face[0]], &b = vertices_[face[1]], &c = vertices_[face[2]];
+        faceNormal_[f] = (b - a).cross(c - a).normalized();
+        for (int k = 0; k < 3; ++k) {
+            const Vec3& corner = vertices_[face[k]];
+            vertexNormal_[face[k]] += angleAt(corner, vertices_[face[(k + 1) % 3]], vertices_[face[(k + 2) % 3]]) * faceNormal_[f];
+            edgeSum += (vertices_[face[(k + 1) % 3]] - corner).norm();
+        }
+    }
+    for (Vec3& n : vertexNormal_) n.normalize();
+    // Edge pseudonormal: the sum of the normals of the two faces sharing it.
+    edgeNormal_.resize(faces_.size());
+    for (std::size_t f = 0; f < faces_.size(); ++f)
+        for (int e = 0; e < 3; ++e) {
+            const Index u = faces_[f][std::size_t(e)], v = faces_[f][std::size_t(e + 1) % 3];
+            Vec3 sum = faceNormal_[f];
+            for (Index g : topology.facesOf(u)) {
+                const Face& other = faces_[g];
+                if (g != f && (other[0] == v || other[1] == v || other[2] == v)) sum += faceNormal_[g];
+            }
+            edgeNormal_[f][std::size_t(e)] = sum.normalized();
+        }
+    std::vector<Aabb> leaves(faces_.size());
+    for (std::size_t f = 0; f < faces_.size(); ++f) leaves[f] = faceBox(vertices_, faces_[f]);
+    bvh_.build(leaves);
+
+    setUpGrid(fine_, cellSize > 0.0 ? cellSize : 0.125 * edgeSum / double(3 * faces_.size()), std::size_t(1) << 21);
+    fillBand(fine_, 3);
+    setUpGrid(coarse_, 8.0 * fine_.cell, std::size_t(1) << 15);
+    for (int k = 0; k < coarse_.dims[2]; ++k)
+        for (int j = 0; j < coarse_.dims[1]; ++j)
+            for (int i = 0; i < coarse_.dims[0]; ++i) fill(coarse_, i, j, k);
+}
+
+// The mesh's box grown by two cells, at most about maxNodes nodes.
+void SignedDistanceField::setUpGrid(Grid& grid, double cell, std::size_t maxNodes) const {
+    const Aabb meshBox = Aabb::around(vertices_);
+    for (;;) {
+        grid.box = {meshBox.min - Vec3::Constant(2.0 * cell), meshBox.max + Vec3::Constant(2.0 * cell)};
+        double nodes = 1.0;
+        for (int d = 0; d < 3; ++d) {
+            grid.dims[std::size_t(d)] = int(std::ceil((grid.box.max[d] - grid.box.min[d]) / cell)) + 1;
+            nodes *= grid.dims[std::size_t(d)];
+        }
+        if (nodes <= double(maxNodes)) break;
+        cell *= std::cbrt(nodes / double(maxNodes)) * 1.01;
+    }
+    grid.cell = cell;
+    grid.origin = grid.box.min;
+    for (int d = 0; d < 3; ++d) grid.box.max[d] = grid.origin[d] + cell * (grid.dims[std::size_t(d)] - 1);
+    grid.values.assign(std::size_t(grid.dims[0]) * std::size_t(grid.dims[1]) * std::size_t(grid.dims[2]),
+                       std::numeric_limits<float>::quiet_NaN());
+}
+
+void SignedDistanceField::fillBand(Grid& grid, int cells) const {
+    for (const Face& f : faces_) {
+        const Aabb box = faceBox(vertices_, f);
+        int lo[3], hi[3];
+        for (int d = 0; d < 3; ++d) {
+            lo[d] = std::max(0, int(std::floor((box.min[d] - grid.origin[d]) / grid.cell)) - cells);
+            hi[d] = std::min(grid.dims[std::size_t(d)] - 1, int(std::ceil((box.max[d] - grid.origin[d]) / grid.cell)) + cells);
+        }
+        for (int k = lo[2]; k <= hi[2]; ++k)
+            for (int j = lo[1]; j <= hi[1]; ++j)
+                for (int i = lo[0]; i <= hi[0]; ++i) fill(grid, i, j, k);
+    }
+}
+
+void SignedDistanceField::fill(Grid& grid, int i, int j, int k) const {
+    float& v = grid.node(i, j, k);
+    if (!std::isnan(v)) return;
+    v = float(query(grid.origin + grid.cell * Vec3(i, j, k)).distance);
+    ++grid.filled;
+}
+
+SignedDistanceField::Sample SignedDistanceField::query(const Vec3& p) const {
+    double best = std::numeric_limits<double>::infinity();
+    ClosestOnTriangle closest{p, kFaceFeature};
+    Index bestFace = 0;
+    const auto& nodes = bvh_.nodes();
+    thread_local std::vector<std::int32_t> stack;
+    stack.assign(1, 0);
+    while (!stack.empty()) {
+        const auto& node = nodes[std::size_t(stack.back())];
+        stack.pop_back();
+        if (squaredDistance(node.volume, p) >= best) continue;
+        if (node.isLeaf()) {
+            const Face& f = faces_[node.item];
+            const ClosestOnTriangle c = closestWithFeature(p, vertices_[f[0]], vertices_[f[1]], vertices_[f[2]]);
+            const double d2 = (p - c.point).squaredNorm();
+            if (d2 < best) {
+                best = d2;
+                closest = c;
+                bestFace = node.item;
+            }
+            continue;
+        }
+        const double dl = squaredDistance(nodes[std::size_t(node.left)].volume, p);
+        const double dr = squaredDistance(nodes[std::size_t(node.right)].volume, p);
+        // Nearer child on top of the stack.
+        if (dl < dr) {
+            stack.push_back(node.right);
+            stack.push_back(node.left);
+        } else {
+            stack.push_back(node.left);
+            stack.push_back(node.right);
+        }
+    }
+    const Face& f = faces_[bestFace];
+    const Vec3 pseudo = closest.feature == kFaceFeature ? faceNormal_[bestFace]
+                        : closest.feature >= 3         ? edgeNormal_[bestFace][std::size_t(closest.feature - 3)]
+                                                       : vertexNormal_[f[std::size_t(closest.feature)]];
+    const Vec3 offset = p - closest.point;
+    const double distance = std::sqrt(best);
+    Sample s;
+    s.closest = closest.point;
+    s.face = bestFace;
+    s.distance = offset.dot(pseudo) < 0.0 ? -distance : distance;
+    // Away from the surface the offset gives the normal; on it, the pseudonormal.
+    s.normal = distance > 1e-12 * fine_.cell ? Vec3(offset / s.distance) : pseudo;
+    return s;
+}
+
+SignedDistanceField::Interpolated SignedDistanceField::sample(Grid& grid, const Vec3& p) const {
+    const Vec3 g = (p - grid.origin) / grid.cell;
+    int base[3];
+    double t[3];
+    for (int d = 0; d < 3; ++d) {
+        base[d] = std::clamp(int(std::floor(g[d])), 0, grid.dims[std::size_t(d)] - 2);
+        t[d] = std::clamp(g[d] - base[d], 0.0, 1.0);
+    }
+    const std::size_t sx = 1, sy = std::size_t(grid.dims[0]), sz = sy * std::size_t(grid.dims[1]);
+    const float* c = &grid.node(base[0], base[1], base[2]);
+    // The 8 corners, x fastest; a corner not yet computed is filled first.
+    const std::size_t offset[8] = {0, sx, sy, sx + sy, sz, sz + sx, sz + sy, sz + sx + sy};
+    double v[8];
+    for (int n = 0; n < 8; ++n) {
+        if (std::isnan(c[offset[n]])) fill(grid, base[0] + (n & 1), base[1] + ((n >> 1) & 1), base[2] + ((n >> 2) & 1));
+        v[n] = c[offset[n]];
+    }
+    const double x0 = 1.0 - t[0], y0 = 1.0 - t[1], z0 = 1.0 - t[2];
+    // Along x, then y, then z.
+    const double a00 = x0 * v[0] + t[0] * v[1], a10 = x0 * v[2] + t[0] * v[3];
+    const double a01 = x0 * v[4] + t[0] * v[5], a11 = x0 * v[6] + t[0] * v[7];
+    const double b0 = y0 * a00 + t[1] * a10, b1 = y0 * a01 + t[1] * a11;
+    Interpolated out;
+    out.distance = z0 * b0 + t[2] * b1;
+    const double dx00 = v[1] - v[0], dx10 = v[3] - v[2], dx01 = v[5] - v[4], dx11 = v[7] - v[6];
+    out.gradient.x() = (z0 * (y0 * dx00 + t[1] * dx10) + t[2] * (y0 * dx01 + t[1] * dx11)) / grid.cell;
+    out.gradient.y() = (z0 * (a10 - a00) + t[2] * (a11 - a01)) / grid.cell;
+    out.gradient.z() = (b1 - b0) / grid.cell;
+    return out;
+}
+
+SignedDistanceField::Interpolated SignedDistanceField::sample(const Vec3& p) const { return sample(fine_, p); }
+
+bool SignedDistanceField::clearOf(Grid& grid, const Vec3& centre, double radius, double slack) const {
+    const Vec3 clamped = centre.cwiseMax(grid.box.min).cwiseMin(grid.box.max);
+    const double outside = (centre - clamped).norm();
+    if (outside > radius) return true;  // wholly outside the grid, where nothing is sampled
+    // float node values: relative rounding 6e-8, covered by the tiny extra margin.
+    // Two bounds on how far the sample can fall over the ball: the interpolant's slope
+    // (sqrt(3) per unit), or the exact distance's (1 per unit) plus the sample's error at both
+    // ends (sqrt(3) cells each).
+    const double fall = std::min(std::sqrt(3.0) * (radius + outside), radius + outside + 2.0 * std::sqrt(3.0) * grid.cell);
+    const double reach = fall * (1.0 + 1e-9) + slack + 1e-6 * (grid.box.max - grid.box.min).norm();
+    return sample(grid, clamped).distance > reach;
+}
+
+bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
+    // The fine grid's box lies inside the coarse one's, so "outside the coarse grid" also
+    // means "outside the fine one".
+    if (radius > 2.0 * fine_.cell && clearOf(coarse_, centre, radius, std::sqrt(3.0) * (coarse_.cell + fine_.cell))) return true;
+    return clearOf(fine_, centre, radius, 0.0);
+}
+
+}  // namespace flexfit
