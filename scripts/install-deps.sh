@@ -14,6 +14,10 @@ packages=(
   libtomlplusplus-dev                  # scene files (TOML, with the line of every key)
   libfcl-dev                           # FCL: reference for collision tests and benchmarks
   python3-matplotlib                   # plots of experiment results (/usr/bin/python3)
+  libglfw3-dev libimgui-dev            # viewer: window, input, user interface
+  libgl-dev libegl-dev libgl1-mesa-dri # viewer: OpenGL 3.3, EGL surfaceless, Mesa software rendering
+  libpng-dev                           # viewer: PNG screenshots
+  xvfb xauth                           # viewer tests: a virtual X server
 )
 
 missing=()

@@ -1,0 +1,72 @@
+// flexfit-viewer's application: the session, the renderer, the ImGui panels and the mouse and
+// keyboard. One frame: input -> session.advance(frame time) -> draw parts and overlays ->
+// panels -> optional screenshot. Headless runs use a fixed frame time (1/60 s), so frame N
+// always shows the same simulated instant.
+#pragma once
+
+#include "gl_context.hpp"
+#include "renderer.hpp"
+#include "viewer_core.hpp"
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+
+namespace flexfit::viewer {
+
+struct Overlays {
+    bool zones = true, springs = false, hierarchy = false, partSpheres = false, contacts = true, assembly = true,
+         coupling = true;
+    int hierarchyDepth = 4;
+};
+
+class App {
+public:
+    App(GlContext& context, std::filesystem::path scene, int width, int height, bool interactive);
+    ~App();
+    App(const App&) = delete;
+    App& operator=(const App&) = delete;
+
+    // One frame; `frameSeconds` of wall time advance the simulation.
+    void frame(double frameSeconds);
+    void screenshot(const std::filesystem::path& file);
+    Session& session() { return *session_; }
+    Camera& camera() { return camera_; }
+    Overlays overlays;
+
+private:
+    void load(const std::filesystem::path& scene);
+    void rebuildMeshes();
+    void handleInput();
+    void drawScene();
+    void drawPanels();
+    void drawHud();
+    std::vector<LineVertex> overlayLines() const;
+    void applySettingsAndRestart();
+
+    GlContext& context_;
+    bool interactive_;
+    std::filesystem::path scenePath_;
+    std::unique_ptr<Session> session_;
+    std::unique_ptr<Renderer> renderer_;
+    Camera camera_;
+    std::vector<std::size_t> meshOf_;
+    std::vector<const PartModel*> meshModels_;  // the models the meshes were made from
+    std::vector<SurfaceNormals> normals_;
+    std::vector<bool> dirty_;
+    // Operator state.
+    std::optional<Pick> selection_;
+    bool dragging_ = false;
+    Vec3 dragPoint_ = Vec3::Zero();
+    double forceMagnitude_ = 5.0;
+    // Live settings (applied by restarting the scene).
+    int material_ = 1, restoration_ = 0, contactLevel_ = 3;
+    // Measured rates.
+    double fps_ = 0.0, stepsPerSecond_ = 0.0;
+    std::chrono::steady_clock::time_point rateStart_ = std::chrono::steady_clock::now();
+    std::uint64_t rateSteps_ = 0;
+    int rateFrames_ = 0;
+    std::string message_;
+};
+
+}  // namespace flexfit::viewer
