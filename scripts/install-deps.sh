@@ -15,7 +15,8 @@ packages=(
   libfcl-dev                           # FCL: reference for collision tests and benchmarks
   python3-matplotlib                   # plots of experiment results (/usr/bin/python3)
   libglfw3-dev libimgui-dev            # viewer: window, input, user interface
-  libgl-dev libegl-dev libgl1-mesa-dri # viewer: OpenGL 3.3, EGL surfaceless, Mesa software rendering
+  libgl-dev libegl-dev libegl-mesa0    # viewer: OpenGL 3.3, EGL surfaceless
+  libgl1-mesa-dri                      # viewer: Mesa software rendering (llvmpipe)
   libpng-dev                           # viewer: PNG screenshots
   xvfb xauth                           # viewer tests: a virtual X server
 )

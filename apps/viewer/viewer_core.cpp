@@ -113,11 +113,13 @@ std::optional<double> intersectRayTriangle(const Camera::Ray& ray, const Vec3& a
     const double det = e1.dot(p);
     if (std::abs(det) < 1e-14 * e1.norm() * e2.norm()) return std::nullopt;
     const Vec3 s = ray.origin - a;
+    // A hair of tolerance: a ray through a shared vertex or edge must not slip between faces.
+    constexpr double kSlack = 1e-9;
     const double u = s.dot(p) / det;
-    if (u < 0.0 || u > 1.0) return std::nullopt;
+    if (u < -kSlack || u > 1.0 + kSlack) return std::nullopt;
     const Vec3 q = s.cross(e1);
     const double v = ray.direction.dot(q) / det;
-    if (v < 0.0 || u + v > 1.0) return std::nullopt;
+    if (v < -kSlack || u + v > 1.0 + kSlack) return std::nullopt;
     const double t = e2.dot(q) / det;
     return t > 0.0 ? std::optional<double>(t) : std::nullopt;
 }

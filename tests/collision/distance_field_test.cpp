@@ -13,7 +13,7 @@ using namespace flexfit;
 
 namespace {
 
-using testing::unitCube;
+using flexfit::testing::unitCube;
 
 // Signed distance to the box [0, 1]^3 (negative inside).
 double boxDistance(const Vec3& p) {

@@ -119,7 +119,7 @@ void expectMatchesReference(const std::vector<Face>& faces, std::size_t vertexCo
     for (Index f = 0; f < faces.size(); ++f) EXPECT_EQ(toVector(topo.faceNeighborsOf(f)), ref.faceFaces[f]) << "face " << f;
 }
 
-TriMesh cube() { return testing::unitCube(); }
+TriMesh cube() { return flexfit::testing::unitCube(); }
 
 TEST(Topology, Cube) {
     const TriMesh mesh = cube();
