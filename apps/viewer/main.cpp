@@ -11,6 +11,7 @@
 
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 
@@ -23,6 +24,7 @@ int main(int argc, char** argv) {
     int frames = 0, every = 1, width = 1280, height = 800;
     std::string screenshotFile, recordDir;
     bool egl = false, hidden = false;
+    std::vector<std::string> show;
     cli.add_option("scene", scene, "scene file (TOML)")->required()->check(CLI::ExistingFile);
     cli.add_option("--frames", frames, "render this many frames at 60 Hz of simulated time, then exit (headless)")->check(CLI::NonNegativeNumber);
     cli.add_option("--screenshot", screenshotFile, "after the last frame, save a PNG here");
@@ -32,6 +34,9 @@ int main(int argc, char** argv) {
     cli.add_option("--height", height, "image or window height in pixels")->check(CLI::Range(64, 8192));
     cli.add_flag("--egl", egl, "render with EGL surfaceless (no X server needed; implies headless)");
     cli.add_flag("--hidden", hidden, "headless under an X server (e.g. xvfb-run): an invisible window");
+    cli.add_option("--show", show, "overlays shown at start (default: zones contacts assembly coupling)")
+        ->delimiter(',')
+        ->check(CLI::IsMember({"zones", "springs", "hierarchy", "spheres", "contacts", "assembly", "coupling"}));
     CLI11_PARSE(cli, argc, argv);
 
     const bool headless = frames > 0 || egl || hidden;
@@ -40,6 +45,10 @@ int main(int argc, char** argv) {
         const Backend backend = egl ? Backend::EglSurfaceless : headless ? Backend::HiddenWindow : Backend::Window;
         GlContext context(backend, width, height, "Flexfit viewer - " + scene);
         App app(context, scene, width, height, !headless);
+        if (!show.empty()) {
+            auto on = [&](const char* name) { return std::find(show.begin(), show.end(), name) != show.end(); };
+            app.overlays = Overlays{on("zones"), on("springs"), on("hierarchy"), on("spheres"), on("contacts"), on("assembly"), on("coupling")};
+        }
         if (!recordDir.empty()) std::filesystem::create_directories(recordDir);
         if (headless) {
             for (int f = 1; f <= frames; ++f) {

@@ -196,8 +196,15 @@ void App::drawScene() {
     std::vector<LineVertex> points;
     if (overlays.contacts)
         for (const Contact& c : w.contacts()) points.push_back(lineVertex(c.point, Vec3(1.0, 0.2, 0.9)));
-    if (selection_) points.push_back(lineVertex(w.part(selection_->body).worldPosition(selection_->mass), Vec3(1, 1, 0.2)));
+    std::vector<LineVertex> selected;
+    if (selection_ && forceTarget_ == 0) points.push_back(lineVertex(w.part(selection_->body).worldPosition(selection_->mass), Vec3(1, 1, 0.2)));
+    if (selection_ && forceTarget_ == 1) {
+        const Part& p = w.part(selection_->body);
+        const Face& f = p.model().mesh.faces[selection_->face];
+        for (int k = 0; k < 3; ++k) addSegment(selected, p.worldPosition(f[std::size_t(k)]), p.worldPosition(f[std::size_t(k + 1) % 3]), Vec3(1, 1, 0.2));
+    }
     renderer_->drawPoints(points);
+    renderer_->drawLines(selected, 2.5f);
     glEnable(GL_DEPTH_TEST);
 }
 
@@ -299,7 +306,9 @@ void App::handleInput() {
     if (ImGui::IsKeyDown(GLFW_KEY_DOWN)) direction.y() -= 1;
     if (ImGui::IsKeyDown(GLFW_KEY_PAGE_UP)) direction.z() -= 1;
     if (ImGui::IsKeyDown(GLFW_KEY_PAGE_DOWN)) direction.z() += 1;
-    if (selection_ && direction.squaredNorm() > 0)
+    if (selection_ && direction.squaredNorm() > 0 && forceTarget_ == 1)
+        session_->setFaceForce(selection_->body, selection_->face, forceMagnitude_ * direction.normalized());
+    else if (selection_ && direction.squaredNorm() > 0)
         session_->setMassForce(selection_->body, selection_->mass, forceMagnitude_ * direction.normalized());
     else
         session_->clearMassForce();
@@ -393,6 +402,9 @@ void App::drawPanels() {
             ImGui::Text("selected: part %u, mass %u, face %u", selection_->body, selection_->mass, selection_->face);
         else
             ImGui::TextWrapped("Shift+click: select a mass. Ctrl+drag: grab a part.");
+        ImGui::RadioButton("force on the mass", &forceTarget_, 0);
+        ImGui::SameLine();
+        ImGui::RadioButton("on the face", &forceTarget_, 1);
         float magnitude = float(forceMagnitude_);
         if (ImGui::SliderFloat("force", &magnitude, 0.1f, 100.0f, "%.1f N", ImGuiSliderFlags_Logarithmic)) forceMagnitude_ = magnitude;
         const Coupling& c = session_->world().coupling();

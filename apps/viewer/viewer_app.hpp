@@ -59,6 +59,7 @@ private:
     bool dragging_ = false;
     Vec3 dragPoint_ = Vec3::Zero();
     double forceMagnitude_ = 5.0;
+    int forceTarget_ = 0;  // 0: the selected mass, 1: the selected face
     // Live settings (applied by restarting the scene).
     int material_ = 1, restoration_ = 0, contactLevel_ = 3;
     // Measured rates.

@@ -207,7 +207,8 @@ void Session::reset() {
 }
 
 void Session::stepOnce() {
-    if (massForce_) world().applyMassForce(massForce_->body, massForce_->mass, massForce_->force);
+    if (massForce_ && massForce_->onFace) world().applyFaceForce(massForce_->body, massForce_->index, massForce_->force);
+    if (massForce_ && !massForce_->onFace) world().applyMassForce(massForce_->body, massForce_->index, massForce_->force);
     run_->step();
     ++steps_;
 }
@@ -256,6 +257,7 @@ void Session::release() { world().release(); }
 
 std::optional<BodyId> Session::grabbed() const { return world().grabbed(); }
 
-void Session::setMassForce(BodyId body, Index mass, const Vec3& worldForce) { massForce_ = MassForce{body, mass, worldForce}; }
+void Session::setMassForce(BodyId body, Index mass, const Vec3& worldForce) { massForce_ = MassForce{body, mass, false, worldForce}; }
+void Session::setFaceForce(BodyId body, Index face, const Vec3& worldForce) { massForce_ = MassForce{body, face, true, worldForce}; }
 
 }  // namespace flexfit::viewer

@@ -124,8 +124,10 @@ public:
     void rotateGrabbed(const Vec3& axis, double angle);
     void release();
     std::optional<BodyId> grabbed() const;
-    // Forces on a selected mass, applied at every step until cleared.
+    // A force on a selected mass or face (spread over its 3 masses), applied at every step
+    // until cleared.
     void setMassForce(BodyId body, Index mass, const Vec3& worldForce);
+    void setFaceForce(BodyId body, Index face, const Vec3& worldForce);
     void clearMassForce() { massForce_.reset(); }
 
 private:
@@ -137,7 +139,8 @@ private:
     Vec3 grabOffset_ = Vec3::Zero();  // grabbed point in the body's frame
     struct MassForce {
         BodyId body;
-        Index mass;
+        Index index;  // a mass, or a face when onFace
+        bool onFace;
         Vec3 force;
     };
     std::optional<MassForce> massForce_;

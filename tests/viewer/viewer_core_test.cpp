@@ -155,3 +155,31 @@ TEST(Session, GrabAndDragMoveTheGrabbedPointToTheTarget) {
     session.release();
     EXPECT_FALSE(session.grabbed());
 }
+
+TEST(Session, KeyboardForceOnASelectionActsAsTheWorldsForceEveryStep) {
+    Scene scene = exampleScene("ball_torus.toml");
+    scene.actions.clear();
+    for (bool onFace : {false, true}) {
+        Session session(scene);
+        SceneRun direct(scene);
+        const Vec3 force(0.0, -3.0, 1.0);
+        if (onFace)
+            session.setFaceForce(0, 100, force);
+        else
+            session.setMassForce(0, 100, force);
+        for (int i = 0; i < 150; ++i) {
+            session.singleStep();
+            if (onFace)
+                direct.world().applyFaceForce(0, 100, force);
+            else
+                direct.world().applyMassForce(0, 100, force);
+            direct.step();
+        }
+        EXPECT_FALSE(session.world().part(0).movingMasses().empty());  // the rim deforms under it
+        EXPECT_EQ(session.world().stateHash(), direct.world().stateHash());
+        session.clearMassForce();
+        direct.step();
+        session.singleStep();
+        EXPECT_EQ(session.world().stateHash(), direct.world().stateHash());  // and stops with the key
+    }
+}
