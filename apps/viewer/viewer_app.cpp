@@ -225,10 +225,18 @@ std::vector<LineVertex> App::overlayLines() const {
     if (overlays.hierarchy)
         for (BodyId id = 0; id < w.bodyCount(); ++id) {
             const PartCollider& collider = const_cast<World&>(w).collision().collider(id);
+            const Pose& pose = w.part(id).pose();
+            auto shown = [&](const auto& node) { return node.depth == overlays.hierarchyDepth || (node.isLeaf() && node.depth < overlays.hierarchyDepth); };
             if (const auto* boxes = collider.boxes())
                 for (const auto& node : boxes->nodes())
-                    if (node.depth == overlays.hierarchyDepth || (node.isLeaf() && node.depth < overlays.hierarchyDepth))
-                        addBox(lines, node.volume, w.part(id).pose(), Vec3(0.3, 0.85, 0.95));
+                    if (shown(node)) addBox(lines, node.volume, pose, Vec3(0.3, 0.85, 0.95));
+            if (const auto* spheres = collider.spheres())
+                for (const auto& node : spheres->nodes())
+                    if (shown(node)) {
+                        const Vec3 c = pose.apply(node.volume.centre);
+                        addCircle(lines, c, pose.rotate(Vec3::UnitX()), pose.rotate(Vec3::UnitY()), node.volume.radius, Vec3(0.3, 0.85, 0.95));
+                        addCircle(lines, c, pose.rotate(Vec3::UnitY()), pose.rotate(Vec3::UnitZ()), node.volume.radius, Vec3(0.3, 0.85, 0.95));
+                    }
         }
     if (overlays.partSpheres)
         for (BodyId id = 0; id < w.bodyCount(); ++id) {
