@@ -51,7 +51,8 @@ GlContext::GlContext(Backend backend, int width, int height, const std::string& 
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    // Not forward-compatible (only macOS needs it): lines wider than 1 pixel stay legal, as
+    // in the EGL context, so both draw the same pictures.
     glfwWindowHint(GLFW_VISIBLE, backend == Backend::Window ? GLFW_TRUE : GLFW_FALSE);
     window_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
     if (!window_) {

@@ -96,8 +96,9 @@ App::~App() {
 }
 
 void App::load(const std::filesystem::path& scene) {
+    auto session = std::make_unique<Session>(loadScene(scene));  // throws before anything changes
     scenePath_ = scene;
-    session_ = std::make_unique<Session>(loadScene(scene));
+    session_ = std::move(session);
     selection_.reset();
     rebuildMeshes();
     camera_ = initialCamera(session_->world(), renderer_->width(), renderer_->height());
@@ -124,6 +125,21 @@ void App::rebuildMeshes() {
 
 void App::frame(double frameSeconds) {
     context_.pollEvents();
+    // Scene changes asked for in the last frame happen here, between frames (a bad file leaves
+    // the current scene running and says why in the HUD).
+    if (requestedScene_) {
+        try {
+            load(*requestedScene_);
+            message_.clear();
+        } catch (const std::exception& e) {
+            message_ = e.what();
+        }
+        requestedScene_.reset();
+    }
+    if (restartRequested_) {
+        applySettingsAndRestart();
+        restartRequested_ = false;
+    }
     auto [fw, fh] = context_.framebufferSize();
     if (context_.window() && fw > 0 && fh > 0) {
         renderer_->resize(fw, fh);
@@ -269,7 +285,8 @@ std::vector<LineVertex> App::overlayLines() const {
 void App::handleInput() {
     ImGuiIO& io = ImGui::GetIO();
     World& w = session_->world();
-    const Vec3 mouse(io.MousePos.x, io.MousePos.y, 0.0);
+    // Window points to framebuffer pixels (the camera's units; they differ on HiDPI screens).
+    const Vec3 mouse(io.MousePos.x * io.DisplayFramebufferScale.x, io.MousePos.y * io.DisplayFramebufferScale.y, 0.0);
     if (!io.WantCaptureMouse) {
         if (io.MouseWheel != 0.0f) camera_.zoom(std::pow(0.9, io.MouseWheel));
         if (ImGui::IsMouseClicked(0) && (io.KeyCtrl || io.KeyShift)) {
@@ -280,7 +297,7 @@ void App::handleInput() {
                 dragPoint_ = selection_->point;
             }
         }
-        const ImVec2 delta = io.MouseDelta;
+        const ImVec2 delta(io.MouseDelta.x * io.DisplayFramebufferScale.x, io.MouseDelta.y * io.DisplayFramebufferScale.y);
         if (dragging_ && ImGui::IsMouseDown(0)) {
             if (io.KeyAlt) {  // Ctrl+Alt drag: turn the grabbed part about the view axes
                 const Mat4 v = camera_.view();
@@ -303,8 +320,8 @@ void App::handleInput() {
     if (io.WantCaptureKeyboard) return;
     if (ImGui::IsKeyPressed(GLFW_KEY_SPACE)) session_->paused = !session_->paused;
     if (ImGui::IsKeyPressed(GLFW_KEY_N)) session_->singleStep();
-    if (ImGui::IsKeyPressed(GLFW_KEY_R)) load(scenePath_);
     if (ImGui::IsKeyPressed(GLFW_KEY_F)) camera_ = initialCamera(w, camera_.width, camera_.height);
+    if (ImGui::IsKeyPressed(GLFW_KEY_R)) requestedScene_ = scenePath_;  // loaded at the next frame's start
     if (ImGui::IsKeyPressed(GLFW_KEY_F12)) screenshot("flexfit-screenshot.png");
     // Arrow keys, Page Up / Down: a force along -x/+x, +y/-y, +z/-z on the selected mass.
     Vec3 direction = Vec3::Zero();
@@ -363,25 +380,13 @@ void App::drawPanels() {
         if (path[0] == 0) std::snprintf(path, sizeof path, "%s", scenePath_.c_str());
         ImGui::InputText("##path", path, sizeof path);
         ImGui::SameLine();
-        if (ImGui::Button("Open")) {
-            try {
-                load(path);
-                message_.clear();
-            } catch (const std::exception& e) {
-                message_ = e.what();
-            }
-        }
+        if (ImGui::Button("Open")) requestedScene_ = std::filesystem::path(path);
         std::error_code ec;
         if (ImGui::BeginCombo("examples", scenePath_.filename().c_str())) {
             for (const auto& entry : std::filesystem::directory_iterator(scenePath_.parent_path(), ec))
                 if (entry.path().extension() == ".toml" && ImGui::Selectable(entry.path().filename().c_str())) {
-                    try {
-                        load(entry.path());
-                        std::snprintf(path, sizeof path, "%s", entry.path().c_str());
-                        message_.clear();
-                    } catch (const std::exception& e) {
-                        message_ = e.what();
-                    }
+                    requestedScene_ = entry.path();
+                    std::snprintf(path, sizeof path, "%s", entry.path().c_str());
                 }
             ImGui::EndCombo();
         }
@@ -389,7 +394,7 @@ void App::drawPanels() {
         ImGui::SameLine();
         if (ImGui::Button("Step")) session_->singleStep();
         ImGui::SameLine();
-        if (ImGui::Button("Reset")) load(scenePath_);
+        if (ImGui::Button("Reset")) requestedScene_ = scenePath_;
         ImGui::SameLine();
         if (ImGui::Button("Screenshot")) screenshot("flexfit-screenshot.png");
         float speed = float(session_->speed);
@@ -422,7 +427,7 @@ void App::drawPanels() {
         ImGui::Combo("material", &material_, kMaterials, 3);
         ImGui::Combo("restoration", &restoration_, kRestorations, 3);
         ImGui::SliderInt("contact level", &contactLevel_, 0, 12);
-        if (ImGui::Button("Apply and restart")) applySettingsAndRestart();
+        if (ImGui::Button("Apply and restart")) restartRequested_ = true;
     }
     ImGui::End();
 }

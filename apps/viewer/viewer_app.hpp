@@ -47,6 +47,8 @@ private:
     GlContext& context_;
     bool interactive_;
     std::filesystem::path scenePath_;
+    std::optional<std::filesystem::path> requestedScene_;  // open or reset at the next frame
+    bool restartRequested_ = false;                        // new settings, at the next frame
     std::unique_ptr<Session> session_;
     std::unique_ptr<Renderer> renderer_;
     Camera camera_;

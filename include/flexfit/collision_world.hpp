@@ -32,8 +32,8 @@ enum class BroadPhaseUpdate { Refit, Rebuild };
 
 // How a rigid part and a deformable part are tested. Faces: the two face hierarchies, as for
 // every other pair. PointShell: the deformable part's masses against the rigid part's signed
-// distance field (queryPointShell), built the first time the rigid part meets a deformable
-// one; it needs a closed rigid mesh (open ones keep the face query) and sees only the masses,
+// distance field (queryPointShell), built when the rigid part is added (a haptic loop must
+// not stall at the first contact); it needs a closed rigid mesh (open ones keep the face query) and sees only the masses,
 // so the deformable part should be the finer of the two. Its cost follows the masses near the
 // rigid surface, which is what lets a ball press a 7,300-mass rim at haptic rates.
 enum class RigidDeformableQuery { Faces, PointShell };
@@ -100,7 +100,7 @@ private:
     std::vector<Part*> parts_;
     std::vector<PartCollider> colliders_;
     std::vector<double> stiffness_;
-    std::vector<std::shared_ptr<const SignedDistanceField>> fields_;  // built on first need
+    std::vector<std::shared_ptr<const SignedDistanceField>> fields_;  // rigid closed parts, PointShell
     std::vector<bool> fieldTried_;
     Bvh<Sphere> broadPhase_;
     std::vector<Sphere> partSpheres_;

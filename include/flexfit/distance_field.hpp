@@ -7,8 +7,10 @@
 // first, pruned by box distance) and the sign from the angle-weighted pseudonormal of the
 // closest feature (Baerentzen and Aanaes 2005): face normal, edge normal (sum of its two face
 // normals) or vertex normal (incident face normals weighted by their angles). Exact for a
-// closed, manifold, consistently oriented mesh; such a mesh is required (the constructor
-// throws std::invalid_argument otherwise).
+// closed, manifold, consistently and outward oriented mesh; the constructor throws
+// std::invalid_argument for an edge not shared by exactly two faces, two faces using an edge
+// in the same direction, or a negative enclosed volume. (A vertex where two surface sheets
+// touch passes these checks and may give a wrong sign next to it.)
 //
 // sample(p): trilinear interpolation of the exact signed distances at the nodes of a grid
 // (cell about an eighth of the mesh's mean edge), and its gradient. The narrow phase uses it

@@ -311,6 +311,7 @@ void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField
     const std::span<const Vec3> pb = b.state().positions;
     const Topology& topology = b.model().topology;
     auto sampleMass = [&](Index m) {
+        if (topology.facesOf(m).empty()) return;  // a free vertex: no surface to push
         const Vec3 p = bInA.apply(pb[m]);
         ++stats.candidatePairs;
         if (!fieldA.inGrid(p)) return;

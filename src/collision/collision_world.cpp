@@ -145,7 +145,13 @@ const SignedDistanceField* CollisionWorld::distanceField(std::uint32_t id) {
         const PartModel& model = parts_[id]->model();
         bool closed = true;
         for (Index count : model.topology.edgeFaceCount) closed = closed && count == 2;
-        if (closed) fields_[id] = std::make_shared<SignedDistanceField>(model.mesh, model.topology);
+        if (closed) {
+            try {
+                fields_[id] = std::make_shared<SignedDistanceField>(model.mesh, model.topology);
+            } catch (const std::invalid_argument&) {
+                // Inconsistently oriented: the face query, which needs no inside, serves it.
+            }
+        }
     }
     return fields_[id].get();
 }

@@ -1,6 +1,7 @@
 #include "flexfit/distance_field.hpp"
 #include "flexfit/collision.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -53,6 +54,18 @@ SignedDistanceField::SignedDistanceField(const TriMesh& mesh, const Topology& to
     if (faces_.empty()) throw std::invalid_argument("signed distance field: the mesh has no faces");
     for (Index count : topology.edgeFaceCount)
         if (count != 2) throw std::invalid_argument("signed distance field: the mesh '" + mesh.name + "' is not closed and manifold");
+    // Consistently oriented: each edge used once in each direction by its two faces.
+    std::vector<std::pair<Index, Index>> directed;
+    directed.reserve(3 * faces_.size());
+    for (const Face& f : faces_)
+        for (int k = 0; k < 3; ++k) directed.emplace_back(f[std::size_t(k)], f[std::size_t(k + 1) % 3]);
+    std::sort(directed.begin(), directed.end());
+    if (std::adjacent_find(directed.begin(), directed.end()) != directed.end())
+        throw std::invalid_argument("signed distance field: the faces of '" + mesh.name + "' are not consistently oriented");
+    // Outward: a positive enclosed volume (divergence theorem over the faces).
+    double volume = 0.0;
+    for (const Face& f : faces_) volume += vertices_[f[0]].dot(vertices_[f[1]].cross(vertices_[f[2]])) / 6.0;
+    if (!(volume > 0.0)) throw std::invalid_argument("signed distance field: the mesh '" + mesh.name + "' is inside out (negative volume)");
     faceNormal_.resize(faces_.size());
     vertexNormal_.assign(vertices_.size(), Vec3::Zero());
     double edgeSum = 0.0;
@@ -98,8 +111,9 @@ void SignedDistanceField::setUpGrid(Grid& grid, double cell, std::size_t maxNode
         grid.box = {meshBox.min - Vec3::Constant(2.0 * cell), meshBox.max + Vec3::Constant(2.0 * cell)};
         double nodes = 1.0;
         for (int d = 0; d < 3; ++d) {
-            grid.dims[std::size_t(d)] = int(std::ceil((grid.box.max[d] - grid.box.min[d]) / cell)) + 1;
-            nodes *= grid.dims[std::size_t(d)];
+            const double count = std::ceil((grid.box.max[d] - grid.box.min[d]) / cell) + 1.0;
+            grid.dims[std::size_t(d)] = int(std::min(count, double(maxNodes)));  // the loop grows the cell when too many
+            nodes *= count;
         }
         if (nodes <= double(maxNodes)) break;
         cell *= std::cbrt(nodes / double(maxNodes)) * 1.01;
@@ -185,7 +199,8 @@ SignedDistanceField::Interpolated SignedDistanceField::sample(Grid& grid, const 
     int base[3];
     double t[3];
     for (int d = 0; d < 3; ++d) {
-        base[d] = std::clamp(int(std::floor(g[d])), 0, grid.dims[std::size_t(d)] - 2);
+        // Clamped as a double first: a far or non-finite point must not overflow the int.
+        base[d] = int(std::clamp(std::floor(g[d]), 0.0, double(grid.dims[std::size_t(d)] - 2)));
         t[d] = std::clamp(g[d] - base[d], 0.0, 1.0);
     }
     const std::size_t sx = 1, sy = std::size_t(grid.dims[0]), sz = sy * std::size_t(grid.dims[1]);
