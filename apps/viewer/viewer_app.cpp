@@ -254,12 +254,12 @@ std::vector<LineVertex> App::overlayLines() const {
                         addCircle(lines, c, pose.rotate(Vec3::UnitY()), pose.rotate(Vec3::UnitZ()), node.volume.radius, Vec3(0.3, 0.85, 0.95));
                     }
         }
-    if (overlays.partSpheres)
-        for (BodyId id = 0; id < w.bodyCount(); ++id) {
-            const Sphere s = const_cast<World&>(w).collision().collider(id).worldSphere(w.part(id));
-            addCircle(lines, s.centre, Vec3::UnitX(), Vec3::UnitY(), s.radius, Vec3(0.9, 0.9, 0.9));
-            addCircle(lines, s.centre, Vec3::UnitY(), Vec3::UnitZ(), s.radius, Vec3(0.9, 0.9, 0.9));
-            addCircle(lines, s.centre, Vec3::UnitZ(), Vec3::UnitX(), s.radius, Vec3(0.9, 0.9, 0.9));
+    if (overlays.partSpheres)  // the broad phase's hierarchy: part spheres (white), their groups (grey)
+        for (const auto& node : const_cast<World&>(w).collision().broadPhaseTree().nodes()) {
+            const Vec3 colour = node.isLeaf() ? Vec3(0.9, 0.9, 0.9) : Vec3(0.55, 0.55, 0.6);
+            addCircle(lines, node.volume.centre, Vec3::UnitX(), Vec3::UnitY(), node.volume.radius, colour);
+            addCircle(lines, node.volume.centre, Vec3::UnitY(), Vec3::UnitZ(), node.volume.radius, colour);
+            addCircle(lines, node.volume.centre, Vec3::UnitZ(), Vec3::UnitX(), node.volume.radius, colour);
         }
     if (overlays.contacts)
         for (const Contact& c : w.contacts()) addSegment(lines, c.point, c.point + scale * c.normal, Vec3(1.0, 0.2, 0.9));
@@ -405,7 +405,7 @@ void App::drawPanels() {
         ImGui::Checkbox("springs by activity", &overlays.springs);
         ImGui::Checkbox("face hierarchy", &overlays.hierarchy);
         if (overlays.hierarchy) ImGui::SliderInt("depth", &overlays.hierarchyDepth, 0, 16);
-        ImGui::Checkbox("part spheres", &overlays.partSpheres);
+        ImGui::Checkbox("part hierarchy (spheres)", &overlays.partSpheres);
         ImGui::Checkbox("contacts", &overlays.contacts);
         ImGui::Checkbox("assembly vectors, areas", &overlays.assembly);
         ImGui::Checkbox("coupling force", &overlays.coupling);

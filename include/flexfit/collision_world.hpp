@@ -84,6 +84,8 @@ public:
     // projection only needs the others).
     const std::vector<Contact>& contactsOf(std::uint32_t id, bool rigidPartnersOnly = false);
     const std::vector<Contact>& contacts() const { return contacts_; }
+    // The broad phase's hierarchy of part spheres (world frame), as of the last update.
+    const Bvh<Sphere>& broadPhaseTree() const { return broadPhase_; }
     const QueryStats& stats() const { return stats_; }  // of the last findContacts()
 
     ResponseStats respond(std::span<const Contact> contacts);
