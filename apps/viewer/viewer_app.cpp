@@ -7,6 +7,7 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -15,6 +16,7 @@ namespace {
 
 const char* kMaterials[] = {"rigid", "elastic", "superelastic"};
 const char* kRestorations[] = {"anchor springs", "constraint", "none"};
+const RestorationMethod kMethods[] = {RestorationMethod::AnchorSprings, RestorationMethod::Constraint, RestorationMethod::None};
 
 void addSegment(std::vector<LineVertex>& out, const Vec3& a, const Vec3& b, const Vec3& colour) {
     out.push_back(lineVertex(a, colour));
@@ -102,7 +104,12 @@ void App::load(const std::filesystem::path& scene) {
     selection_.reset();
     rebuildMeshes();
     camera_ = initialCamera(session_->world(), renderer_->width(), renderer_->height());
-    if (!session_->scene().parts.empty()) contactLevel_ = session_->scene().parts[0].part.zones.contactLevel;
+    for (const ScenePart& part : session_->scene().parts)
+        if (part.part.mode != PartMode::Rigid) {  // the panel starts from the first deformable part
+            contactLevel_ = part.part.zones.contactLevel;
+            restoration_ = int(std::find(std::begin(kMethods), std::end(kMethods), part.part.simulation.restoration.method) - std::begin(kMethods));
+            break;
+        }
 }
 
 void App::rebuildMeshes() {
@@ -423,26 +430,45 @@ void App::drawPanels() {
         const Coupling& c = session_->world().coupling();
         if (c.active) ImGui::Text("coupling |F| %.1f N  |T| %.1f N m", c.force.norm(), c.torque.norm());
     }
-    if (ImGui::CollapsingHeader("Deformable parts (restarts)")) {
+    if (ImGui::CollapsingHeader("Deformable parts")) {
+        // Restoration and contact level change the running world; the material (the model's
+        // spring constants, immutable) restarts the scene.
+        bool live = ImGui::Combo("restoration", &restoration_, kRestorations, 3);
+        live |= ImGui::SliderInt("contact level", &contactLevel_, 0, 12);
+        if (live) applyLiveSettings();
         ImGui::Combo("material", &material_, kMaterials, 3);
-        ImGui::Combo("restoration", &restoration_, kRestorations, 3);
-        ImGui::SliderInt("contact level", &contactLevel_, 0, 12);
-        if (ImGui::Button("Apply and restart")) restartRequested_ = true;
+        ImGui::SameLine();
+        if (ImGui::Button("restart")) restartRequested_ = true;
     }
     ImGui::End();
+}
+
+void App::applyLiveSettings() {
+    World& w = session_->world();
+    for (BodyId id = 0; id < w.bodyCount(); ++id) {
+        if (w.part(id).mode() == PartMode::Rigid) continue;
+        PartSettings settings = w.part(id).settings();
+        settings.simulation.restoration.method = kMethods[restoration_];
+        settings.zones.contactLevel = contactLevel_;
+        try {
+            w.setPartSettings(id, settings);
+            message_ = std::string("now: ") + kRestorations[restoration_] + ", contact level " + std::to_string(contactLevel_);
+        } catch (const std::exception& e) {
+            message_ = e.what();
+        }
+    }
 }
 
 void App::applySettingsAndRestart() {
     Scene& scene = session_->editableScene();
     const Material materials[] = {Material::rigid(), Material::elastic(), Material::superelastic()};
-    const RestorationMethod methods[] = {RestorationMethod::AnchorSprings, RestorationMethod::Constraint, RestorationMethod::None};
     for (ScenePart& part : scene.parts) {
         if (part.part.mode == PartMode::Rigid) continue;
         PartModelSettings model;
         model.material = materials[material_];
         model.vertexMasses = part.model->mass;
         part.model = buildPartModel(part.model->mesh, model);
-        part.part.simulation.restoration.method = methods[restoration_];
+        part.part.simulation.restoration.method = kMethods[restoration_];
         part.part.zones.contactLevel = contactLevel_;
     }
     session_->reset();

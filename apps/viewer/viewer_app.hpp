@@ -43,6 +43,7 @@ private:
     void drawHud();
     std::vector<LineVertex> overlayLines() const;
     void applySettingsAndRestart();
+    void applyLiveSettings();
 
     GlContext& context_;
     bool interactive_;
@@ -62,7 +63,7 @@ private:
     Vec3 dragPoint_ = Vec3::Zero();
     double forceMagnitude_ = 5.0;
     int forceTarget_ = 0;  // 0: the selected mass, 1: the selected face
-    // Live settings (applied by restarting the scene).
+    // Settings of the deformable parts: restoration and contact level live, material by restart.
     int material_ = 1, restoration_ = 0, contactLevel_ = 3;
     // Measured rates.
     double fps_ = 0.0, stepsPerSecond_ = 0.0;

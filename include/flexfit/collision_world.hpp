@@ -90,6 +90,8 @@ public:
 
     ResponseStats respond(std::span<const Contact> contacts);
     double effectiveStiffness(std::uint32_t id) const { return stiffness_[id]; }
+    // After a part's settings changed (its restoration adds to the effective stiffness).
+    void refreshStiffness(std::uint32_t id);
 
 private:
     void updateBroadPhase();

@@ -78,6 +78,10 @@ public:
     const std::shared_ptr<const PartModel>& sharedModel() const { return model_; }
     PartMode mode() const { return settings_.mode; }
     const PartSettings& settings() const { return settings_; }
+    // Live changes (restoration method and constants, damping, zone levels and thresholds):
+    // the next step uses them; open zones keep their level. The mode cannot change (throws
+    // InputError, as for invalid settings, and the part keeps its settings).
+    void setSettings(const PartSettings& settings);
 
     // --- Pose (O(1)) ---
     const Pose& pose() const { return pose_; }

@@ -128,6 +128,9 @@ public:
     BodyId add(std::shared_ptr<const PartModel> model, const PartSettings& part, const BodySettings& body, const Pose& pose);
 
     std::size_t bodyCount() const { return parts_.size(); }
+    // Changes a part's settings while the world runs (Part::setSettings; the world's time step
+    // and its no-gravity rule for zone masses are kept; the contact stiffness follows).
+    void setPartSettings(BodyId id, const PartSettings& settings);
     Part& part(BodyId id) { return *parts_[id]; }
     const Part& part(BodyId id) const { return *parts_[id]; }
     const RigidBody& body(BodyId id) const { return bodies_[id]; }

@@ -44,6 +44,8 @@ std::uint32_t CollisionWorld::add(Part& part, BoundingVolumeKind kind) {
     return std::uint32_t(parts_.size() - 1);
 }
 
+void CollisionWorld::refreshStiffness(std::uint32_t id) { stiffness_[id] = effectivePartStiffness(*parts_[id]); }
+
 void CollisionWorld::setExactTest(ExactTest test) {
     if (test == settings_.exactTest) return;
     settings_.exactTest = test;

@@ -54,6 +54,13 @@ Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
     }
 }
 
+void Part::setSettings(const PartSettings& settings) {
+    if (settings.mode != settings_.mode) throw InputError("part settings", 0, "the mode of a part cannot change");
+    validateSettings(settings.simulation);
+    checkZoneSettings(settings.zones);
+    settings_ = settings;
+}
+
 // --- Pose ---
 
 void Part::setPose(const Pose& pose) {

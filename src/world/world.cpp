@@ -104,6 +104,15 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
     return BodyId(parts_.size() - 1);
 }
 
+void World::setPartSettings(BodyId id, const PartSettings& settings) {
+    if (id >= parts_.size()) throw InputError(kWorldSource, 0, "settings: no body " + std::to_string(id));
+    PartSettings ps = settings;
+    ps.simulation.timeStep = settings_.timeStep;
+    ps.simulation.gravity = Vec3::Zero();
+    parts_[id]->setSettings(ps);
+    collision_.refreshStiffness(std::uint32_t(id));
+}
+
 void World::applyForce(BodyId id, const Vec3& worldForce) {
     if (bodies_[id].motion == MotionType::Dynamic) bodies_[id].force += worldForce;
 }

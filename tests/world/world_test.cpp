@@ -174,3 +174,36 @@ TEST(World, DeformableRimStopsAWeakPushAndYieldsToAStrongOne) {
     EXPECT_LT(passed, -20.0);
     EXPECT_GT(deformedSoft, deformedStiff / 2);
 }
+
+TEST(World, PartSettingsChangeWhileRunning) {
+    World world;
+    PartSettings rim;
+    rim.simulation.restoration = {RestorationMethod::AnchorSprings, 10.0, 6.0, 1e-3};
+    rim.zones.contactLevel = 2;
+    const BodyId torus = world.add(buildPartModel(makeTorus1()), rim, BodySettings{}, Pose{});
+    const double before = world.collision().effectiveStiffness(torus);
+    // Stiffer anchors and deeper contact zones, live: the contact stiffness follows (mean spring
+    // k + k_a), new zones take the new level, the world's step and no-gravity rule stay.
+    PartSettings changed = world.part(torus).settings();
+    changed.simulation.restoration.anchorStiffness = 50.0;
+    changed.simulation.timeStep = 0.5;         // ignored: the world's step rules
+    changed.simulation.gravity = Vec3(0, -9.81, 0);  // ignored: zone masses feel no gravity
+    changed.zones.contactLevel = 4;
+    world.setPartSettings(torus, changed);
+    EXPECT_NEAR(world.collision().effectiveStiffness(torus) - before, 40.0, 1e-12);
+    EXPECT_EQ(world.part(torus).settings().simulation.timeStep, world.settings().timeStep);
+    EXPECT_EQ(world.part(torus).settings().simulation.gravity, Vec3::Zero());
+    world.part(torus).touchFace(0);
+    std::vector<int> depths;
+    world.part(torus).zoneDepths(depths);
+    EXPECT_EQ(*std::max_element(depths.begin(), depths.end()), 3);  // level 4: depths 0..3
+    // A mode change or invalid settings are refused and change nothing.
+    PartSettings rigid = changed;
+    rigid.mode = PartMode::Rigid;
+    EXPECT_THROW(world.setPartSettings(torus, rigid), InputError);
+    PartSettings bad = changed;
+    bad.simulation.restoration.anchorStiffness = -1.0;
+    EXPECT_THROW(world.setPartSettings(torus, bad), InputError);
+    EXPECT_EQ(world.part(torus).settings().simulation.restoration.anchorStiffness, 50.0);
+    EXPECT_THROW(world.setPartSettings(7, changed), InputError);
+}
