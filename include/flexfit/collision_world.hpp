@@ -98,14 +98,13 @@ private:
     bool pressesFirst(std::uint32_t a, std::uint32_t b) const;
     // Contacts of the pair (a presses b) appended to `out`, by the query the settings choose.
     void queryCandidates(std::uint32_t a, std::uint32_t b, std::vector<Contact>& out, QueryStats& stats);
-    const SignedDistanceField* distanceField(std::uint32_t id);  // nullptr: open mesh
+    static std::shared_ptr<const SignedDistanceField> buildDistanceField(const Part& part);  // nullptr: no inside
 
     CollisionSettings settings_;
     std::vector<Part*> parts_;
     std::vector<PartCollider> colliders_;
     std::vector<double> stiffness_;
-    std::vector<std::shared_ptr<const SignedDistanceField>> fields_;  // rigid closed parts, PointShell
-    std::vector<bool> fieldTried_;
+    std::vector<std::shared_ptr<const SignedDistanceField>> fields_;  // rigid closed parts, PointShell; else null
     Bvh<Sphere> broadPhase_;
     std::vector<Sphere> partSpheres_;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <stdexcept>
 
 namespace flexfit {
 namespace {
@@ -32,10 +33,9 @@ std::uint32_t CollisionWorld::add(Part& part, BoundingVolumeKind kind) {
     parts_.push_back(&part);
     colliders_.emplace_back(part, kind, settings_.exactTest);
     stiffness_.push_back(effectivePartStiffness(part));
-    fields_.emplace_back();
-    fieldTried_.push_back(false);
     // Built now rather than at the first contact, where it would stall a haptic loop.
-    if (settings_.rigidDeformable == RigidDeformableQuery::PointShell && !deformable(part)) distanceField(std::uint32_t(parts_.size() - 1));
+    const bool pointShell = settings_.rigidDeformable == RigidDeformableQuery::PointShell && !deformable(part);
+    fields_.push_back(pointShell ? buildDistanceField(part) : nullptr);
     pushStamp_.emplace_back();
     pushSlot_.emplace_back();
     part.clearChangedMasses();
@@ -136,26 +136,17 @@ const std::vector<Contact>& CollisionWorld::narrowPhase() {
 
 void CollisionWorld::queryCandidates(std::uint32_t a, std::uint32_t b, std::vector<Contact>& out, QueryStats& stats) {
     if (settings_.rigidDeformable == RigidDeformableQuery::PointShell && !deformable(*parts_[a]) && deformable(*parts_[b]))
-        if (const SignedDistanceField* field = distanceField(a))
+        if (const SignedDistanceField* field = fields_[a].get())
             return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(*parts_[b]), out, stats);
     queryPair(a, *parts_[a], collider(a), b, *parts_[b], collider(b), settings_.exactTest, out, stats);
 }
 
-const SignedDistanceField* CollisionWorld::distanceField(std::uint32_t id) {
-    if (!fieldTried_[id]) {
-        fieldTried_[id] = true;
-        const PartModel& model = parts_[id]->model();
-        bool closed = true;
-        for (Index count : model.topology.edgeFaceCount) closed = closed && count == 2;
-        if (closed) {
-            try {
-                fields_[id] = std::make_shared<SignedDistanceField>(model.mesh, model.topology);
-            } catch (const std::invalid_argument&) {
-                // Inconsistently oriented: the face query, which needs no inside, serves it.
-            }
-        }
+std::shared_ptr<const SignedDistanceField> CollisionWorld::buildDistanceField(const Part& part) {
+    try {
+        return std::make_shared<SignedDistanceField>(part.model().mesh, part.model().topology);
+    } catch (const std::invalid_argument&) {
+        return nullptr;  // open or inconsistently oriented: the face query, which needs no inside, serves it
     }
-    return fields_[id].get();
 }
 
 ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
