@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 
 namespace flexfit::cli {
 namespace {
@@ -77,6 +78,21 @@ void writeTextFile(const std::filesystem::path& path, const std::string& text) {
     if (!file) throw InputError(path.string(), 0, "cannot open the file for writing");
     file << text;
     if (!file) throw InputError(path.string(), 0, "write failed");
+}
+
+void writePartsObj(const std::filesystem::path& path, const std::string& header, const std::vector<NamedPart>& parts) {
+    std::ostringstream obj;
+    obj << "# " << header << "\n";
+    std::size_t base = 1;
+    std::vector<Vec3> world;
+    for (const NamedPart& named : parts) {
+        obj << "o " << named.name << "\n";
+        named.part->worldPositions(world);
+        for (const Vec3& v : world) obj << fmt::format("v {:.9g} {:.9g} {:.9g}\n", v.x(), v.y(), v.z());
+        for (const Face& f : named.part->model().mesh.faces) obj << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
+        base += world.size();
+    }
+    writeTextFile(path, obj.str());
 }
 
 void makeDirectory(const std::filesystem::path& dir) {

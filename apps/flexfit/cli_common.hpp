@@ -24,6 +24,14 @@ MeshReadResult loadMesh(const std::filesystem::path& path, double weldTolerance 
 
 // Writes `text` to `path`; throws InputError when it cannot.
 void writeTextFile(const std::filesystem::path& path, const std::string& text);
+// One object of a multi-part OBJ frame.
+struct NamedPart {
+    std::string name;
+    const Part* part = nullptr;
+};
+// Writes the parts, in world coordinates, as one OBJ file with an "o NAME" object each and a
+// "# header" first line (for Blender or ParaView); throws InputError when it cannot.
+void writePartsObj(const std::filesystem::path& path, const std::string& header, const std::vector<NamedPart>& parts);
 // Creates the directory (and parents); throws InputError when it cannot.
 void makeDirectory(const std::filesystem::path& dir);
 

@@ -30,18 +30,8 @@ constexpr double kMajor = 10.0, kMinor = 2.5;
 double torusDistance(const Vec3& p) { return std::hypot(std::hypot(p.x(), p.z()) - kMajor, p.y()) - kMinor; }
 
 void writeFrame(const std::filesystem::path& path, const Part& yellow, const Part& blue) {
-    std::ostringstream obj;
-    obj << "# flexfit experiment contact: rigid (yellow) and rigid-deformable (blue) torus\n";
-    std::size_t base = 1;
-    for (const Part* part : {&yellow, &blue}) {
-        obj << "o " << (part == &yellow ? "rigid_yellow" : "deformable_blue") << "\n";
-        std::vector<Vec3> world;
-        part->worldPositions(world);
-        for (const Vec3& v : world) obj << fmt::format("v {:.9g} {:.9g} {:.9g}\n", v.x(), v.y(), v.z());
-        for (const Face& f : part->model().mesh.faces) obj << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
-        base += world.size();
-    }
-    writeTextFile(path, obj.str());
+    writePartsObj(path, "flexfit experiment contact: rigid (yellow) and rigid-deformable (blue) torus",
+                  {{"rigid_yellow", &yellow}, {"deformable_blue", &blue}});
 }
 
 void run(const ContactOptions& opt) {

@@ -70,18 +70,9 @@ std::string csvRow(const Scene& scene, const World& w) {
 }
 
 void writeObjFrame(const std::filesystem::path& path, const World& w, const Scene& scene) {
-    std::ostringstream obj;
-    obj << fmt::format("# flexfit run {} t={:.6f}\n", scene.source, w.time());
-    std::size_t base = 1;
-    std::vector<Vec3> positions;
-    for (BodyId id = 0; id < w.bodyCount(); ++id) {
-        obj << "o " << scene.parts[id].name << "\n";
-        w.part(id).worldPositions(positions);
-        for (const Vec3& v : positions) obj << fmt::format("v {:.9g} {:.9g} {:.9g}\n", v.x(), v.y(), v.z());
-        for (const Face& f : w.part(id).model().mesh.faces) obj << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
-        base += positions.size();
-    }
-    writeTextFile(path, obj.str());
+    std::vector<NamedPart> parts;
+    for (BodyId id = 0; id < w.bodyCount(); ++id) parts.push_back({scene.parts[id].name, &w.part(id)});
+    writePartsObj(path, fmt::format("flexfit run {} t={:.6f}", scene.source, w.time()), parts);
 }
 
 std::string poseJson(const Pose& p) {

@@ -1,5 +1,7 @@
 #include "flexfit/world.hpp"
 
+#include "core/fnv1a.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <limits>
@@ -336,26 +338,22 @@ void World::assemble() {
 }
 
 std::uint64_t World::stateHash() const {
-    std::uint64_t h = 14695981039346656037ull;
-    auto mix = [&h](const void* data, std::size_t bytes) {
-        const auto* p = static_cast<const unsigned char*>(data);
-        for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
-    };
-    mix(&time_, sizeof time_);
+    detail::Fnv1a h;
+    h.mix(&time_, sizeof time_);
     for (BodyId id = 0; id < parts_.size(); ++id) {
         const Pose& pose = parts_[id]->pose();
-        mix(pose.rotation.coeffs().data(), 4 * sizeof(double));
-        mix(pose.translation.data(), 3 * sizeof(double));
-        mix(bodies_[id].linearVelocity.data(), 3 * sizeof(double));
-        mix(bodies_[id].angularVelocity.data(), 3 * sizeof(double));
+        h.mix(pose.rotation.coeffs().data(), 4 * sizeof(double));
+        h.mix(pose.translation.data(), 3 * sizeof(double));
+        h.mix(bodies_[id].linearVelocity.data(), 3 * sizeof(double));
+        h.mix(bodies_[id].angularVelocity.data(), 3 * sizeof(double));
         const std::uint64_t part = flexfit::stateHash(parts_[id]->state());
-        mix(&part, sizeof part);
+        h.mix(&part, sizeof part);
     }
     for (const AssemblyEvent& e : events_) {
-        mix(e.rule.data(), e.rule.size());
-        mix(&e.time, sizeof e.time);
+        h.mix(e.rule.data(), e.rule.size());
+        h.mix(&e.time, sizeof e.time);
     }
-    return h;
+    return h.value();
 }
 
 double World::minimumThickness() const {
