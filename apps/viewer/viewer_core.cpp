@@ -165,11 +165,10 @@ std::vector<Vec3> SurfaceNormals::computeAll(const Part& part) {
     return n;
 }
 
-SurfaceNormals::SurfaceNormals(const Part& part) : normals_(computeAll(part)), mark_(part.model().massCount(), 0u) {}
+SurfaceNormals::SurfaceNormals(const Part& part) : normals_(computeAll(part)), recomputedMarks_(part.model().massCount()) {}
 
 void SurfaceNormals::recompute(const Part& part, Index vertex) {
-    if (mark_[vertex] == epoch_) return;
-    mark_[vertex] = epoch_;
+    if (!recomputedMarks_.insert(vertex)) return;
     Vec3 sum = Vec3::Zero();
     for (Index f : part.model().topology.facesOf(vertex)) sum += faceNormalTimesTwoArea(part.state().positions, part.model().mesh.faces[f]);
     normals_[vertex] = sum.norm() > 0.0 ? Vec3(sum.normalized()) : Vec3(Vec3::UnitY());
@@ -180,10 +179,7 @@ bool SurfaceNormals::update(const Part& part) {
     recomputed_ = 0;
     const auto moving = part.movingMasses();
     if (moving.empty() && previouslyMoving_.empty()) return false;
-    if (++epoch_ == 0) {
-        std::fill(mark_.begin(), mark_.end(), 0u);
-        epoch_ = 1;
-    }
+    recomputedMarks_.clear();
     // A vertex's normal depends on its own position and its neighbours'.
     auto around = [&](Index m) {
         recompute(part, m);

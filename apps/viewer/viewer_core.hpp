@@ -17,6 +17,7 @@
 // keyboard add operator actions on top (grab and drag, forces on selected masses).
 #pragma once
 
+#include "flexfit/epoch_marks.hpp"
 #include "flexfit/scene.hpp"
 
 #include <Eigen/Geometry>
@@ -95,8 +96,7 @@ private:
     void recompute(const Part& part, Index vertex);
     std::vector<Vec3> normals_;
     std::vector<Index> previouslyMoving_;
-    std::vector<std::uint32_t> mark_;
-    std::uint32_t epoch_ = 0;
+    EpochMarks recomputedMarks_;  // (V) this update
     std::size_t recomputed_ = 0;
 };
 

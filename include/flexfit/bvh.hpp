@@ -12,6 +12,7 @@
 #pragma once
 
 #include "flexfit/bounding_volume.hpp"
+#include "flexfit/epoch_marks.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -51,26 +52,21 @@ public:
         std::vector<Index> items(leafVolumes.size());
         std::iota(items.begin(), items.end(), Index(0));
         buildNode(leafVolumes, items, 0, items.size(), -1, 0);
-        mark_.assign(nodes_.size(), 0);
+        dirtyMarks_.reset(nodes_.size());
     }
 
     // Leaves of `items` get new volumes from leafVolume(item); their ancestors are refitted.
     template <class LeafVolume>
     void refit(std::span<const Index> items, LeafVolume leafVolume) {
         if (nodes_.empty()) return;
-        if (++epoch_ == 0) {
-            std::fill(mark_.begin(), mark_.end(), 0u);
-            epoch_ = 1;
-        }
+        dirtyMarks_.clear();
         dirty_.clear();
         for (Index item : items) {
             std::int32_t n = std::int32_t(leafOf_[item]);
             nodes_[std::size_t(n)].volume = leafVolume(item);
             ++refitNodes_;
-            for (n = nodes_[std::size_t(n)].parent; n >= 0 && mark_[std::size_t(n)] != epoch_; n = nodes_[std::size_t(n)].parent) {
-                mark_[std::size_t(n)] = epoch_;
+            for (n = nodes_[std::size_t(n)].parent; n >= 0 && dirtyMarks_.insert(std::size_t(n)); n = nodes_[std::size_t(n)].parent)
                 dirty_.push_back(n);
-            }
         }
         // Children come after their parent in the node array: descending index is bottom-up.
         // Many dirty nodes: one backward scan of the marks beats sorting them.
@@ -80,7 +76,7 @@ public:
         };
         if (dirty_.size() * 16 > nodes_.size()) {
             for (std::size_t n = nodes_.size(); n-- > 0;)
-                if (mark_[n] == epoch_) merge(n);
+                if (dirtyMarks_.contains(n)) merge(n);
         } else {
             std::sort(dirty_.begin(), dirty_.end(), std::greater<>());
             for (std::int32_t n : dirty_) merge(std::size_t(n));
@@ -146,9 +142,8 @@ private:
 
     std::vector<Node> nodes_;
     std::vector<Index> leafOf_;          // item -> leaf node
-    std::vector<std::uint32_t> mark_;    // (nodes) refit epoch marks
+    EpochMarks dirtyMarks_;              // (nodes) refit
     std::vector<std::int32_t> dirty_;    // scratch
-    std::uint32_t epoch_ = 0;
     std::size_t refitNodes_ = 0;
 };
 

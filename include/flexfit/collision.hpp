@@ -20,6 +20,7 @@
 #include <limits>
 
 #include "flexfit/bvh.hpp"
+#include "flexfit/epoch_marks.hpp"
 #include "flexfit/part.hpp"
 #include "flexfit/triangle_queries.hpp"
 
@@ -97,12 +98,11 @@ private:
     std::variant<Bvh<Sphere>, Bvh<Aabb>> bvh_;
     Sphere restSphere_;
     double maxDisplacement_ = 0.0;
-    std::vector<std::uint32_t> faceMark_;  // (F) refit epochs
+    EpochMarks changedFaceMarks_;          // (F) refit
     std::vector<Index> changedFaces_;      // scratch
     std::vector<Index> pending_;           // changed masses not yet refitted
     std::vector<bool> isPending_;          // (V)
     Bvh<Aabb> restPoints_;
-    std::uint32_t epoch_ = 0;
 };
 
 // Leaf volumes of a face from part-frame positions.

@@ -23,6 +23,7 @@
 
 #include "flexfit/collision.hpp"
 #include "flexfit/distance_field.hpp"
+#include "flexfit/epoch_marks.hpp"
 
 #include <memory>
 
@@ -110,12 +111,11 @@ private:
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;
     std::vector<Contact> contacts_;
     std::vector<Contact> partContacts_;  // contactsOf()
-    // respond(): (part << 32 | mass, deepest displacement), and per part and mass the epoch of
-    // its last push and its slot in pushes_.
+    // respond(): (part << 32 | mass, deepest displacement), and per part the masses pushed in
+    // this call and each one's slot in pushes_.
     std::vector<std::pair<std::uint64_t, Vec3>> pushes_;
-    std::vector<std::vector<std::uint32_t>> pushStamp_;
+    std::vector<EpochMarks> pushedMarks_;
     std::vector<std::vector<Index>> pushSlot_;
-    std::uint32_t pushEpoch_ = 0;
     QueryStats stats_;
 };
 

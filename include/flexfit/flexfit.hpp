@@ -6,6 +6,7 @@
 #include "flexfit/collision_world.hpp"
 #include "flexfit/core.hpp"
 #include "flexfit/distance_field.hpp"
+#include "flexfit/epoch_marks.hpp"
 #include "flexfit/generators.hpp"
 #include "flexfit/mesh.hpp"
 #include "flexfit/mesh_io.hpp"

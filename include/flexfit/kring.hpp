@@ -5,6 +5,7 @@
 // what it visits, whatever the mesh size.
 #pragma once
 
+#include "flexfit/epoch_marks.hpp"
 #include "flexfit/topology.hpp"
 
 #include <cstdint>
@@ -28,8 +29,7 @@ public:
     std::size_t lastVisited() const { return lastVisited_; }  // masses touched by the last query
 
 private:
-    std::vector<std::uint32_t> mark_;  // (V) epoch at which a mass was last visited
-    std::uint32_t epoch_ = 0;
+    EpochMarks visited_;  // (V)
     std::size_t lastVisited_ = 0;
 };
 

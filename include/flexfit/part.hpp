@@ -31,6 +31,7 @@
 // (assembly stage); gravity here acts on moving masses only, in the part frame.
 #pragma once
 
+#include "flexfit/epoch_marks.hpp"
 #include "flexfit/kring.hpp"
 #include "flexfit/pose.hpp"
 #include "flexfit/simulation.hpp"
@@ -168,8 +169,7 @@ private:
     std::vector<Index> computedSlot_;         // (E) position in computed_, or kAbsent
     std::vector<std::uint64_t> lastLoadStep_; // (V) step of the last force on each mass
     std::vector<Index> changed_;              // masses changed since clearChangedMasses()
-    std::vector<std::uint32_t> changedMark_;  // (V) epoch at which a mass was listed
-    std::uint32_t changeEpoch_ = 1;
+    EpochMarks changedMarks_;  // (V) masses in changed_
 
     void markChanged(Index mass);
 };

@@ -45,6 +45,7 @@
 
 #include "flexfit/assembly.hpp"
 #include "flexfit/collision_world.hpp"
+#include "flexfit/epoch_marks.hpp"
 #include "flexfit/mass_properties.hpp"
 
 #include <array>
@@ -196,9 +197,8 @@ private:
     void assemble();
     void applyDeformableReactions(std::span<const Contact> contacts);
     std::vector<std::tuple<BodyId, BodyId, Index>> reactionMasses_;  // scratch: (body, part, mass)
-    // Per part and mass: the epoch it was last counted in, and for which body.
-    std::vector<std::pair<std::vector<std::uint32_t>, std::vector<BodyId>>> reactionStamp_;
-    std::uint32_t reactionEpoch_ = 0;
+    // Per part: the masses counted in this step, and for which body each was last counted.
+    std::vector<std::pair<EpochMarks, std::vector<BodyId>>> reactionMarks_;
     bool touching(BodyId a, BodyId b) const;
 
     struct RuleState {

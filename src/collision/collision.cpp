@@ -96,7 +96,7 @@ Aabb faceSphereBox(std::span<const Vec3> positions, const Face& face) {
 PartCollider::PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest test) : kind_(kind), test_(test) {
     if (kind == BoundingVolumeKind::Aabb) bvh_.emplace<Bvh<Aabb>>();
     restSphere_ = Sphere::around(part.model().restPositions);
-    faceMark_.assign(part.model().faceCount(), 0);
+    changedFaceMarks_.reset(part.model().faceCount());
     const auto& rest = part.model().restPositions;
     restPlanes_.reserve(part.model().faceCount());
     for (const Face& f : part.model().mesh.faces) {
@@ -122,17 +122,11 @@ void PartCollider::rebuild(const Part& part) {
 
 void PartCollider::refit(const Part& part, std::span<const Index> changedMasses) {
     const PartModel& model = part.model();
-    if (++epoch_ == 0) {
-        std::fill(faceMark_.begin(), faceMark_.end(), 0u);
-        epoch_ = 1;
-    }
+    changedFaceMarks_.clear();
     changedFaces_.clear();
     for (Index m : changedMasses)
         for (Index f : model.topology.facesOf(m))
-            if (faceMark_[f] != epoch_) {
-                faceMark_[f] = epoch_;
-                changedFaces_.push_back(f);
-            }
+            if (changedFaceMarks_.insert(f)) changedFaces_.push_back(f);
     const std::span<const Vec3> positions = part.state().positions;
     std::visit(
         [&](auto& bvh) {
@@ -191,14 +185,9 @@ std::size_t PartCollider::refitNodeCount() const {
 class RestPlaneFilter {
 public:
     RestPlaneFilter(const Part& a, const PartCollider& colliderA, const RelativePose& bInA) : a_(a), collider_(colliderA), bInA_(bInA) {
-        if (++epoch_ == 0) {
-            std::fill(stamp_.begin(), stamp_.end(), 0u);
-            epoch_ = 1;
-        }
-        if (stamp_.size() < a.model().faceCount()) {
-            stamp_.resize(a.model().faceCount(), 0u);
-            planesInB_.resize(a.model().faceCount());
-        }
+        movedPlanes_.clear();
+        movedPlanes_.growTo(a.model().faceCount());
+        if (planesInB_.size() < a.model().faceCount()) planesInB_.resize(a.model().faceCount());
     }
     bool separated(Index fa, std::span<const Vec3> pb, const Face& fb) {
         if (!atRest(fa)) return false;
@@ -245,8 +234,7 @@ private:
     }
     // n.(R x + t) = d  <=>  (R^T n).x = d - n.t
     const std::array<Eigen::Vector4d, 4>& planesInB(Index fa) {
-        if (stamp_[fa] != epoch_) {
-            stamp_[fa] = epoch_;
+        if (movedPlanes_.insert(fa)) {
             const auto& planes = collider_.restPlanes(fa);
             for (std::size_t k = 0; k < planes.size(); ++k) {
                 const Vec3 n = planes[k].head<3>();
@@ -259,12 +247,10 @@ private:
     const PartCollider& collider_;
     const RelativePose& bInA_;
     static thread_local std::vector<std::array<Eigen::Vector4d, 4>> planesInB_;
-    static thread_local std::vector<std::uint32_t> stamp_;
-    static thread_local std::uint32_t epoch_;
+    static thread_local EpochMarks movedPlanes_;  // faces whose planes are in planesInB_ for this query
 };
 thread_local std::vector<std::array<Eigen::Vector4d, 4>> RestPlaneFilter::planesInB_;
-thread_local std::vector<std::uint32_t> RestPlaneFilter::stamp_;
-thread_local std::uint32_t RestPlaneFilter::epoch_ = 0;
+thread_local EpochMarks RestPlaneFilter::movedPlanes_;
 
 void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
                const PartCollider& colliderB, ExactTest test, std::vector<Contact>& contacts, QueryStats& stats,

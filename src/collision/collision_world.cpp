@@ -36,7 +36,7 @@ std::uint32_t CollisionWorld::add(Part& part, BoundingVolumeKind kind) {
     // Built now rather than at the first contact, where it would stall a haptic loop.
     const bool pointShell = settings_.rigidDeformable == RigidDeformableQuery::PointShell && !deformable(part);
     fields_.push_back(pointShell ? buildDistanceField(part) : nullptr);
-    pushStamp_.emplace_back();
+    pushedMarks_.emplace_back();
     pushSlot_.emplace_back();
     part.clearChangedMasses();
     partSpheres_.push_back(colliders_.back().worldSphere(part));
@@ -153,25 +153,21 @@ ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
     ResponseStats stats;
     // The deepest push of each (part, mass), kept in a slot per mass in first-contact order
     // (deterministic; each mass then moves once, independently of the others).
-    if (++pushEpoch_ == 0) {
-        for (auto& stamps : pushStamp_) std::fill(stamps.begin(), stamps.end(), 0u);
-        pushEpoch_ = 1;
-    }
+    for (EpochMarks& pushed : pushedMarks_) pushed.clear();
     pushes_.clear();
     // Pushes the face's masses, or only `mass` when the contact has one (point shell).
     auto pushFace = [&](std::uint32_t id, Index face, Index mass, const Vec3& displacement) {
         Part& part = *parts_[id];
         part.touchFace(face);
-        auto& stamps = pushStamp_[id];
+        EpochMarks& pushed = pushedMarks_[id];
         auto& slots = pushSlot_[id];
-        if (stamps.empty()) {
-            stamps.assign(part.model().massCount(), 0u);
+        if (pushed.size() == 0) {
+            pushed.reset(part.model().massCount());
             slots.assign(part.model().massCount(), 0u);
         }
         const Face& masses = part.model().mesh.faces[face];
         for (Index m : mass == kNoMass ? std::span<const Index>(masses) : std::span<const Index>(&mass, 1)) {
-            if (stamps[m] != pushEpoch_) {
-                stamps[m] = pushEpoch_;
+            if (pushed.insert(m)) {
                 slots[m] = Index(pushes_.size());
                 pushes_.push_back({(std::uint64_t(id) << 32) | m, displacement});
             } else if (displacement.squaredNorm() > pushes_[slots[m]].second.squaredNorm()) {

@@ -42,7 +42,7 @@ Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
       springEnds_(model_->springCount(), 0),
       computedSlot_(model_->springCount(), kAbsent),
       lastLoadStep_(model_->massCount(), kNeverLoaded),
-      changedMark_(model_->massCount(), 0) {
+      changedMarks_(model_->massCount()) {
     validateSettings(settings_.simulation);
     checkZoneSettings(settings_.zones);
     if (settings_.mode == PartMode::FullDeformable) {
@@ -117,17 +117,12 @@ void Part::removeMoving(Index mass) {
 }
 
 void Part::markChanged(Index mass) {
-    if (changedMark_[mass] == changeEpoch_) return;
-    changedMark_[mass] = changeEpoch_;
-    changed_.push_back(mass);
+    if (changedMarks_.insert(mass)) changed_.push_back(mass);
 }
 
 void Part::clearChangedMasses() {
     changed_.clear();
-    if (++changeEpoch_ == 0) {
-        std::fill(changedMark_.begin(), changedMark_.end(), 0u);
-        changeEpoch_ = 1;
-    }
+    changedMarks_.clear();
 }
 
 void Part::cover(std::span<const RingMember> members) {

@@ -102,7 +102,7 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
     parts_.push_back(std::move(part));
     bodies_.push_back(body);
     kinematicTargets_.emplace_back();
-    reactionStamp_.emplace_back();
+    reactionMarks_.emplace_back();
     return BodyId(parts_.size() - 1);
 }
 
@@ -264,25 +264,21 @@ void World::operatorInput() {
 // step. A weak push is stopped by a stiff rim; a strong one deforms it and passes.
 void World::applyDeformableReactions(std::span<const Contact> contacts) {
     // Each (body, contacted mass) once, in first-contact order (deterministic).
-    if (++reactionEpoch_ == 0) {
-        for (auto& marks : reactionStamp_) std::fill(marks.first.begin(), marks.first.end(), 0u);
-        reactionEpoch_ = 1;
-    }
+    for (auto& marks : reactionMarks_) marks.first.clear();
     reactionMasses_.clear();
     for (const Contact& c : contacts)
         for (const auto& [body, part, face, mass] :
              {std::tuple{c.partA, c.partB, c.faceB, c.massB}, std::tuple{c.partB, c.partA, c.faceA, kNoMass}}) {
             if (bodies_[body].motion != MotionType::Dynamic || parts_[part]->mode() == PartMode::Rigid) continue;
-            auto& [stamps, owners] = reactionStamp_[part];
-            if (stamps.empty()) {
-                stamps.assign(parts_[part]->model().massCount(), 0u);
+            auto& [counted, owners] = reactionMarks_[part];
+            if (counted.size() == 0) {
+                counted.reset(parts_[part]->model().massCount());
                 owners.assign(parts_[part]->model().massCount(), 0u);
             }
             // Contacts come grouped by pair, so a mass pressed by two bodies counts once for each.
             const Face& masses = parts_[part]->model().mesh.faces[face];
             for (Index m : mass == kNoMass ? std::span<const Index>(masses) : std::span<const Index>(&mass, 1))
-                if (stamps[m] != reactionEpoch_ || owners[m] != body) {
-                    stamps[m] = reactionEpoch_;
+                if (counted.insert(m) || owners[m] != body) {
                     owners[m] = body;
                     reactionMasses_.push_back({body, part, m});
                 }
