@@ -11,9 +11,7 @@
 namespace flexfit::viewer {
 namespace {
 
-void startEgl(int width, int height, void*& displayOut, void*& contextOut) {
-    (void)width;
-    (void)height;
+void startEgl(void*& displayOut, void*& contextOut) {
     auto getPlatformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
     if (!getPlatformDisplay) throw std::runtime_error("EGL: eglGetPlatformDisplayEXT is not available");
     EGLDisplay display = getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
@@ -42,9 +40,9 @@ void startEgl(int width, int height, void*& displayOut, void*& contextOut) {
 }  // namespace
 
 GlContext::GlContext(Backend backend, int width, int height, const std::string& title)
-    : backend_(backend), width_(width), height_(height) {
+    : width_(width), height_(height) {
     if (backend == Backend::EglSurfaceless) {
-        startEgl(width, height, eglDisplay_, eglContext_);
+        startEgl(eglDisplay_, eglContext_);
         return;
     }
     if (!glfwInit()) throw std::runtime_error("GLFW: cannot start (is there an X display? DISPLAY is unset or unreachable)");

@@ -20,7 +20,6 @@ public:
     GlContext(const GlContext&) = delete;
     GlContext& operator=(const GlContext&) = delete;
 
-    Backend backend() const { return backend_; }
     GLFWwindow* window() const { return window_; }  // nullptr with EGL
     bool shouldClose() const;
     void swapBuffers();
@@ -29,7 +28,6 @@ public:
     std::string renderer() const;  // GL_RENDERER, e.g. "llvmpipe"
 
 private:
-    Backend backend_;
     int width_, height_;
     GLFWwindow* window_ = nullptr;
     void* eglDisplay_ = nullptr;

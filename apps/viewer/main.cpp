@@ -9,7 +9,6 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
-#include <GLFW/glfw3.h>
 
 #include <algorithm>
 #include <chrono>

@@ -102,6 +102,7 @@ std::vector<float> packed(const std::vector<Vec3>& v) {
 Renderer::Renderer() {
     meshProgram_ = link(kMeshVertex, kMeshFragment);
     lineProgram_ = link(kLineVertex, kLineFragment);
+    meshModelUniform_ = glGetUniformLocation(meshProgram_, "model");
     glGenVertexArrays(1, &lineVao_);
     glGenBuffers(1, &lineVbo_);
     glBindVertexArray(lineVao_);
@@ -114,11 +115,7 @@ Renderer::Renderer() {
 }
 
 Renderer::~Renderer() {
-    for (Mesh& m : meshes_) {
-        const GLuint buffers[] = {m.positions, m.normals, m.colours, m.indices};
-        glDeleteBuffers(4, buffers);
-        glDeleteVertexArrays(1, &m.vao);
-    }
+    clearParts();
     glDeleteBuffers(1, &lineVbo_);
     glDeleteVertexArrays(1, &lineVao_);
     glDeleteProgram(meshProgram_);
@@ -147,6 +144,15 @@ void Renderer::resize(int width, int height) {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colourBuffer_);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depthBuffer_);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) throw std::runtime_error("viewer: offscreen framebuffer incomplete");
+}
+
+void Renderer::clearParts() {
+    for (Mesh& m : meshes_) {
+        const GLuint buffers[] = {m.positions, m.normals, m.colours, m.indices};
+        glDeleteBuffers(4, buffers);
+        glDeleteVertexArrays(1, &m.vao);
+    }
+    meshes_.clear();
 }
 
 std::size_t Renderer::addPart(const Part& part) {
@@ -193,16 +199,20 @@ void Renderer::begin(const Camera& camera, const Vec3& background) {
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
-    viewProjection_ = toFloats(camera.projection() * camera.view());
-    eye_ = camera.eye();
+    // Per frame: the camera, in both programs (uniforms stay with their program).
+    const std::array<float, 16> viewProjection = toFloats(camera.projection() * camera.view());
+    const Vec3 eye = camera.eye();
+    glUseProgram(meshProgram_);
+    glUniformMatrix4fv(glGetUniformLocation(meshProgram_, "viewProjection"), 1, GL_FALSE, viewProjection.data());
+    glUniform3f(glGetUniformLocation(meshProgram_, "eye"), float(eye.x()), float(eye.y()), float(eye.z()));
+    glUseProgram(lineProgram_);
+    glUniformMatrix4fv(glGetUniformLocation(lineProgram_, "viewProjection"), 1, GL_FALSE, viewProjection.data());
 }
 
 void Renderer::drawPart(std::size_t mesh, const Pose& pose) {
     glUseProgram(meshProgram_);
-    glUniformMatrix4fv(glGetUniformLocation(meshProgram_, "viewProjection"), 1, GL_FALSE, viewProjection_.data());
     const std::array<float, 16> model = toFloats(pose.matrix());
-    glUniformMatrix4fv(glGetUniformLocation(meshProgram_, "model"), 1, GL_FALSE, model.data());
-    glUniform3f(glGetUniformLocation(meshProgram_, "eye"), float(eye_.x()), float(eye_.y()), float(eye_.z()));
+    glUniformMatrix4fv(meshModelUniform_, 1, GL_FALSE, model.data());
     glBindVertexArray(meshes_[mesh].vao);
     glDrawElements(GL_TRIANGLES, meshes_[mesh].indexCount, GL_UNSIGNED_INT, nullptr);
     glBindVertexArray(0);
@@ -211,7 +221,6 @@ void Renderer::drawPart(std::size_t mesh, const Pose& pose) {
 void Renderer::drawBatch(const std::vector<LineVertex>& vertices, unsigned mode) {
     if (vertices.empty()) return;
     glUseProgram(lineProgram_);
-    glUniformMatrix4fv(glGetUniformLocation(lineProgram_, "viewProjection"), 1, GL_FALSE, viewProjection_.data());
     glBindVertexArray(lineVao_);
     glBindBuffer(GL_ARRAY_BUFFER, lineVbo_);
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(LineVertex)), vertices.data(), GL_STREAM_DRAW);

@@ -30,8 +30,10 @@ public:
     int width() const { return width_; }
     int height() const { return height_; }
 
-    // Part buffers: addPart once, then upload() when the shape or colours change.
+    // Part buffers: addPart once, then upload() when the shape or colours change. clearParts()
+    // drops them all (a new scene); indices restart at 0.
     std::size_t addPart(const Part& part);
+    void clearParts();
     void upload(std::size_t mesh, const Part& part, const std::vector<Vec3>& normals, const std::vector<Vec3>& colours);
 
     void begin(const Camera& camera, const Vec3& background);
@@ -54,8 +56,7 @@ private:
     unsigned lineVao_ = 0, lineVbo_ = 0;
     unsigned framebuffer_ = 0, colourBuffer_ = 0, depthBuffer_ = 0;
     int width_ = 0, height_ = 0;
-    std::array<float, 16> viewProjection_{};
-    Vec3 eye_ = Vec3::Zero();
+    int meshModelUniform_ = -1;
 };
 
 }  // namespace flexfit::viewer

@@ -113,18 +113,10 @@ void App::load(const std::filesystem::path& scene) {
 }
 
 void App::rebuildMeshes() {
-    // Buffers are created once per load; a reset keeps the same models.
+    // One mesh per body, in body order (mesh index = body id).
     const World& w = session_->world();
-    std::vector<const PartModel*> models;
-    for (BodyId id = 0; id < w.bodyCount(); ++id) models.push_back(&w.part(id).model());
-    if (models != meshModels_) {
-        const int width = renderer_->width(), height = renderer_->height();
-        renderer_ = std::make_unique<Renderer>();
-        renderer_->resize(width, height);
-        meshOf_.clear();
-        for (BodyId id = 0; id < w.bodyCount(); ++id) meshOf_.push_back(renderer_->addPart(w.part(id)));
-        meshModels_ = models;
-    }
+    renderer_->clearParts();
+    for (BodyId id = 0; id < w.bodyCount(); ++id) renderer_->addPart(w.part(id));
     normals_.clear();
     for (BodyId id = 0; id < w.bodyCount(); ++id) normals_.emplace_back(w.part(id));
     dirty_.assign(w.bodyCount(), true);
@@ -198,7 +190,7 @@ void App::drawScene() {
         const Part& part = w.part(id);
         const bool changed = normals_[id].update(part);
         if (!changed && !dirty_[id]) {
-            renderer_->drawPart(meshOf_[id], part.pose());
+            renderer_->drawPart(id, part.pose());
             continue;
         }
         const Vec3 base = partColour(part, w.body(id).motion);
@@ -210,9 +202,9 @@ void App::drawScene() {
             for (std::size_t m = 0; m < depths.size(); ++m)
                 if (depths[m] >= 0) colours[m] = zoneColour(depths[m], deepest);
         }
-        renderer_->upload(meshOf_[id], part, normals_[id].normals(), colours);
-        dirty_[id] = !part.movingMasses().empty();  // keep refreshing colours while zones live
-        renderer_->drawPart(meshOf_[id], part.pose());
+        renderer_->upload(id, part, normals_[id].normals(), colours);
+        dirty_[id] = false;  // while masses move (and the frame after), update() reports the change
+        renderer_->drawPart(id, part.pose());
     }
     glDisable(GL_DEPTH_TEST);  // overlays stay visible through the parts
     renderer_->drawLines(overlayLines());
@@ -231,8 +223,8 @@ void App::drawScene() {
     glEnable(GL_DEPTH_TEST);
 }
 
-std::vector<LineVertex> App::overlayLines() const {
-    const World& w = session_->world();
+std::vector<LineVertex> App::overlayLines() {
+    World& w = session_->world();  // the colliders refit lazily when asked for
     std::vector<LineVertex> lines;
     const double scale = camera_.distance * 0.02;
     if (overlays.springs)
@@ -247,7 +239,7 @@ std::vector<LineVertex> App::overlayLines() const {
         }
     if (overlays.hierarchy)
         for (BodyId id = 0; id < w.bodyCount(); ++id) {
-            const PartCollider& collider = const_cast<World&>(w).collision().collider(id);
+            const PartCollider& collider = w.collision().collider(id);
             const Pose& pose = w.part(id).pose();
             auto shown = [&](const auto& node) { return node.depth == overlays.hierarchyDepth || (node.isLeaf() && node.depth < overlays.hierarchyDepth); };
             if (const auto* boxes = collider.boxes())
@@ -262,7 +254,7 @@ std::vector<LineVertex> App::overlayLines() const {
                     }
         }
     if (overlays.partSpheres)  // the broad phase's hierarchy: part spheres (white), their groups (grey)
-        for (const auto& node : const_cast<World&>(w).collision().broadPhaseTree().nodes()) {
+        for (const auto& node : w.collision().broadPhaseTree().nodes()) {
             const Vec3 colour = node.isLeaf() ? Vec3(0.9, 0.9, 0.9) : Vec3(0.55, 0.55, 0.6);
             addCircle(lines, node.volume.centre, Vec3::UnitX(), Vec3::UnitY(), node.volume.radius, colour);
             addCircle(lines, node.volume.centre, Vec3::UnitY(), Vec3::UnitZ(), node.volume.radius, colour);

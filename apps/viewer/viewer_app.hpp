@@ -31,7 +31,6 @@ public:
     void frame(double frameSeconds);
     void screenshot(const std::filesystem::path& file);
     Session& session() { return *session_; }
-    Camera& camera() { return camera_; }
     Overlays overlays;
 
 private:
@@ -41,7 +40,7 @@ private:
     void drawScene();
     void drawPanels();
     void drawHud();
-    std::vector<LineVertex> overlayLines() const;
+    std::vector<LineVertex> overlayLines();  // non-const: asking for a collider refits it
     void applySettingsAndRestart();
     void applyLiveSettings();
 
@@ -53,8 +52,6 @@ private:
     std::unique_ptr<Session> session_;
     std::unique_ptr<Renderer> renderer_;
     Camera camera_;
-    std::vector<std::size_t> meshOf_;
-    std::vector<const PartModel*> meshModels_;  // the models the meshes were made from
     std::vector<SurfaceNormals> normals_;
     std::vector<bool> dirty_;
     // Operator state.

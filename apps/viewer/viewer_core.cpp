@@ -165,28 +165,24 @@ std::vector<Vec3> SurfaceNormals::computeAll(const Part& part) {
     return n;
 }
 
-SurfaceNormals::SurfaceNormals(const Part& part) : normals_(computeAll(part)), recomputedMarks_(part.model().massCount()) {}
-
-void SurfaceNormals::recompute(const Part& part, Index vertex) {
-    if (!recomputedMarks_.insert(vertex)) return;
-    Vec3 sum = Vec3::Zero();
-    for (Index f : part.model().topology.facesOf(vertex)) sum += faceNormalTimesTwoArea(part.state().positions, part.model().mesh.faces[f]);
-    normals_[vertex] = sum.norm() > 0.0 ? Vec3(sum.normalized()) : Vec3(Vec3::UnitY());
-    ++recomputed_;
-}
+SurfaceNormals::SurfaceNormals(const Part& part) : normals_(computeAll(part)), ring_(part.model().massCount()) {}
 
 bool SurfaceNormals::update(const Part& part) {
     recomputed_ = 0;
     const auto moving = part.movingMasses();
     if (moving.empty() && previouslyMoving_.empty()) return false;
-    recomputedMarks_.clear();
-    // A vertex's normal depends on its own position and its neighbours'.
-    auto around = [&](Index m) {
-        recompute(part, m);
-        for (Index v : part.model().topology.neighborsOf(m)) recompute(part, v);
-    };
-    for (Index m : moving) around(m);
-    for (Index m : previouslyMoving_) around(m);
+    // A vertex's normal depends on its own position and its neighbours': the 1-ring of the
+    // masses that move or have just stopped, each vertex once.
+    seeds_.assign(moving.begin(), moving.end());
+    seeds_.insert(seeds_.end(), previouslyMoving_.begin(), previouslyMoving_.end());
+    ring_.collect(part.model().topology, seeds_, 1, members_);
+    const auto& faces = part.model().mesh.faces;
+    for (const RingMember& member : members_) {
+        Vec3 sum = Vec3::Zero();
+        for (Index f : part.model().topology.facesOf(member.mass)) sum += faceNormalTimesTwoArea(part.state().positions, faces[f]);
+        normals_[member.mass] = sum.norm() > 0.0 ? Vec3(sum.normalized()) : Vec3(Vec3::UnitY());
+    }
+    recomputed_ = members_.size();
     previouslyMoving_.assign(moving.begin(), moving.end());
     return true;
 }
@@ -202,7 +198,7 @@ void Session::reset() {
     massForce_.reset();
 }
 
-void Session::stepOnce() {
+void Session::singleStep() {
     if (massForce_ && massForce_->onFace) world().applyFaceForce(massForce_->body, massForce_->index, massForce_->force);
     if (massForce_ && !massForce_->onFace) world().applyMassForce(massForce_->body, massForce_->index, massForce_->force);
     run_->step();
@@ -215,14 +211,12 @@ void Session::advance(double wallSeconds) {
     owed_ += wallSeconds * speed;
     int taken = 0;
     while (owed_ >= h * (1.0 - 1e-9) && taken < maxStepsPerFrame) {
-        stepOnce();
+        singleStep();
         owed_ -= h;
         ++taken;
     }
     if (taken == maxStepsPerFrame) owed_ = 0.0;  // behind real time: drop the debt, do not spiral
 }
-
-void Session::singleStep() { stepOnce(); }
 
 void Session::grab(BodyId body, const Vec3& worldPoint) {
     World& w = world();

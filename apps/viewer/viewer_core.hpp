@@ -17,7 +17,7 @@
 // keyboard add operator actions on top (grab and drag, forces on selected masses).
 #pragma once
 
-#include "flexfit/epoch_marks.hpp"
+#include "flexfit/kring.hpp"
 #include "flexfit/scene.hpp"
 
 #include <Eigen/Geometry>
@@ -93,10 +93,11 @@ public:
     static std::vector<Vec3> computeAll(const Part& part);
 
 private:
-    void recompute(const Part& part, Index vertex);
     std::vector<Vec3> normals_;
     std::vector<Index> previouslyMoving_;
-    EpochMarks recomputedMarks_;  // (V) this update
+    KRingWalker ring_;                 // the 1-ring of the seeds
+    std::vector<Index> seeds_;         // scratch: moving and previously moving masses
+    std::vector<RingMember> members_;  // scratch
     std::size_t recomputed_ = 0;
 };
 
@@ -105,7 +106,7 @@ public:
     explicit Session(Scene scene);
 
     void advance(double wallSeconds);  // nothing while paused
-    void singleStep();
+    void singleStep();                 // one step, with the selected force (also while paused)
     void reset();                      // the scene from its start, same settings
     bool paused = false;
     int maxStepsPerFrame = 200;
@@ -116,7 +117,6 @@ public:
     const Scene& scene() const { return scene_; }
     Scene& editableScene() { return scene_; }  // changes take effect at the next reset()
     std::uint64_t steps() const { return steps_; }
-    bool finished() const { return run_->finished(); }
 
     // Operator: grab a body at a world point, drag the grab target, release.
     void grab(BodyId body, const Vec3& worldPoint);
@@ -131,7 +131,6 @@ public:
     void clearMassForce() { massForce_.reset(); }
 
 private:
-    void stepOnce();
     Scene scene_;
     std::unique_ptr<SceneRun> run_;
     double owed_ = 0.0;

@@ -18,6 +18,7 @@
 
 #include <array>
 #include <limits>
+#include <span>
 
 #include "flexfit/bvh.hpp"
 #include "flexfit/epoch_marks.hpp"
@@ -44,6 +45,12 @@ struct Contact {
     Index massB = kNoMass;
 };
 
+// The masses a contact presses on one side: the face's three, or `mass` alone when it is not
+// kNoMass (a point-shell contact's massB). The span refers to `mass`, which must outlive it.
+inline std::span<const Index> pressedMasses(const Face& face, const Index& mass) {
+    return mass == kNoMass ? std::span<const Index>(face) : std::span<const Index>(&mass, 1);
+}
+
 struct QueryStats {
     std::size_t volumeTests = 0;     // bounding-volume overlap tests (nodes visited in pairs)
     std::size_t candidatePairs = 0;  // leaf pairs whose volumes overlap
@@ -63,14 +70,12 @@ public:
     ExactTest exactTest() const { return test_; }
     // Rebuilds the hierarchy from the part's current (part-frame) positions.
     void rebuild(const Part& part);
-    // Refits the faces around `changedMasses` (positions read from the part).
+    // Refits the faces around `changedMasses` (positions read from the part), and the bound.
     void refit(const Part& part, std::span<const Index> changedMasses);
-    // Lazy refit: notePending() remembers changed masses (and updates the bounding sphere),
-    // refitPending() refits them all at once when a face query needs the hierarchy. A part met
-    // only by point-shell queries never pays for refits.
-    void notePending(const Part& part, std::span<const Index> changedMasses);
-    void refitPending(const Part& part);
-    bool hasPending() const { return !pending_.empty(); }
+    // The bounding sphere's growth: the largest displacement of a moving mass from rest
+    // (O(moving)). Refits leave the hierarchy to the callers that need it (CollisionWorld
+    // refits lazily, so a part met only by point-shell queries never pays for them).
+    void updateDisplacementBound(const Part& part);
     // Masses at their rest positions in a hierarchy of points, built on first use (point-shell
     // queries: the masses at rest never move, so this tree never needs a refit).
     const Bvh<Aabb>& restPointTree(const Part& part);
@@ -100,8 +105,6 @@ private:
     double maxDisplacement_ = 0.0;
     EpochMarks changedFaceMarks_;          // (F) refit
     std::vector<Index> changedFaces_;      // scratch
-    std::vector<Index> pending_;           // changed masses not yet refitted
-    std::vector<bool> isPending_;          // (V)
     Bvh<Aabb> restPoints_;
 };
 

@@ -67,8 +67,8 @@ public:
     // Switches the exact test; the face hierarchies are rebuilt for it.
     void setExactTest(ExactTest test);
 
-    // Notes each part's changed masses for its hierarchy's next refit (and clears the part's
-    // change list), then updates the broad phase.
+    // Updates each part's bounding sphere, then the broad phase. Face hierarchies are refitted
+    // lazily, from the part's change list, when collider() is asked for them.
     void update();
     // Broad-phase candidate pairs (a < b), from the last update.
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& candidatePairs() const { return pairs_; }
@@ -76,8 +76,8 @@ public:
     const std::vector<Contact>& findContacts();
     // The narrow phase alone, over the candidate pairs of the last update.
     const std::vector<Contact>& narrowPhase();
-    // Notes every part's changed masses and updates its bounding sphere (the first half of update()).
-    void refitChanged();
+    // Updates every part's bounding sphere (the first half of update()).
+    void updateBounds();
     // The contacts of one part with every part whose sphere touches its own, without updating
     // the broad-phase tree or querying other pairs: for a body moving in sub-steps while the
     // others wait. Same pairs and order as update() + narrowPhase() restricted to that part;
@@ -99,7 +99,6 @@ private:
     bool pressesFirst(std::uint32_t a, std::uint32_t b) const;
     // Contacts of the pair (a presses b) appended to `out`, by the query the settings choose.
     void queryCandidates(std::uint32_t a, std::uint32_t b, std::vector<Contact>& out, QueryStats& stats);
-    static std::shared_ptr<const SignedDistanceField> buildDistanceField(const Part& part);  // nullptr: no inside
 
     CollisionSettings settings_;
     std::vector<Part*> parts_;

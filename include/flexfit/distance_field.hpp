@@ -49,7 +49,6 @@ public:
         double distance = 0.0;       // negative inside
         Vec3 closest = Vec3::Zero(); // closest point on the mesh
         Vec3 normal = Vec3::UnitY(); // unit, outward at the closest point: p = closest + distance * normal
-        Index face = 0;              // face holding the closest point
     };
 
     // cellSize <= 0 picks an eighth of the mean edge length.
@@ -70,18 +69,14 @@ public:
     // True when no point within `radius` of `centre` samples a distance <= 0.
     bool clearOf(const Vec3& centre, double radius) const;
     double cellSize() const { return fine_.cell; }
-    std::size_t filledNodes() const { return fine_.filled + coarse_.filled; }
-    std::size_t nodeCount() const { return fine_.values.size() + coarse_.values.size(); }
 
 private:
-    // Node (i, j, k) at origin + cell (i, j, k); values NaN until computed.
+    // Node (i, j, k) at box.min + cell (i, j, k); values NaN until computed.
     struct Grid {
-        Vec3 origin = Vec3::Zero();
         double cell = 1.0;
         std::array<int, 3> dims{0, 0, 0};
         Aabb box;
         std::vector<float> values;
-        std::size_t filled = 0;
         float& node(int i, int j, int k) {
             return values[(std::size_t(k) * std::size_t(dims[1]) + std::size_t(j)) * std::size_t(dims[0]) + std::size_t(i)];
         }

@@ -14,6 +14,7 @@
 
 #include "flexfit/core.hpp"
 
+#include <cstdint>
 #include <optional>
 
 namespace flexfit {
@@ -22,8 +23,12 @@ struct Triangle {
     Vec3 a, b, c;
 };
 
-// Closest point of the (closed) triangle to p.
-Vec3 closestPointOnTriangle(const Vec3& p, const Triangle& t);
+// The Voronoi region of a triangle that holds a closest point: a corner, an edge (EdgeAB joins
+// a and b, EdgeBC b and c, EdgeCA c and a) or the interior of the face.
+enum class TriangleFeature : std::uint8_t { CornerA, CornerB, CornerC, EdgeAB, EdgeBC, EdgeCA, Interior };
+
+// Closest point of the (closed) triangle to p; `feature`, when given, receives its region.
+Vec3 closestPointOnTriangle(const Vec3& p, const Triangle& t, TriangleFeature* feature = nullptr);
 
 struct TriangleContact {
     Vec3 point;   // on the intersection

@@ -196,6 +196,8 @@ private:
     double minimumThickness() const;
     void assemble();
     void applyDeformableReactions(std::span<const Contact> contacts);
+    // A part's settings as the world runs them: its time step, no gravity on zone masses.
+    PartSettings inWorld(PartSettings settings) const;
     std::vector<std::tuple<BodyId, BodyId, Index>> reactionMasses_;  // scratch: (body, part, mass)
     // Per part: the masses counted in this step, and for which body each was last counted.
     std::vector<std::pair<EpochMarks, std::vector<BodyId>>> reactionMarks_;

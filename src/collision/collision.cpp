@@ -115,6 +115,10 @@ PartCollider::PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest 
 
 void PartCollider::rebuild(const Part& part) {
     std::visit([&](auto& bvh) { buildHierarchy(bvh, part, test_); }, bvh_);
+    updateDisplacementBound(part);
+}
+
+void PartCollider::updateDisplacementBound(const Part& part) {
     maxDisplacement_ = 0.0;
     for (Index m : part.movingMasses())
         maxDisplacement_ = std::max(maxDisplacement_, (part.state().positions[m] - part.model().restPositions[m]).norm());
@@ -134,28 +138,7 @@ void PartCollider::refit(const Part& part, std::span<const Index> changedMasses)
             bvh.refit(changedFaces_, [&](Index f) { return leafVolume((const BV*)nullptr, positions, model.mesh.faces[f], test_); });
         },
         bvh_);
-    maxDisplacement_ = 0.0;
-    for (Index m : part.movingMasses())
-        maxDisplacement_ = std::max(maxDisplacement_, (positions[m] - model.restPositions[m]).norm());
-}
-
-void PartCollider::notePending(const Part& part, std::span<const Index> changedMasses) {
-    if (isPending_.empty()) isPending_.assign(part.model().massCount(), false);
-    for (Index m : changedMasses)
-        if (!isPending_[m]) {
-            isPending_[m] = true;
-            pending_.push_back(m);
-        }
-    maxDisplacement_ = 0.0;
-    for (Index m : part.movingMasses())
-        maxDisplacement_ = std::max(maxDisplacement_, (part.state().positions[m] - part.model().restPositions[m]).norm());
-}
-
-void PartCollider::refitPending(const Part& part) {
-    if (pending_.empty()) return;
-    refit(part, pending_);
-    for (Index m : pending_) isPending_[m] = false;
-    pending_.clear();
+    updateDisplacementBound(part);
 }
 
 const Bvh<Aabb>& PartCollider::restPointTree(const Part& part) {

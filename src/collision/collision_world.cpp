@@ -23,6 +23,16 @@ double effectivePartStiffness(const Part& part) {
 
 bool deformable(const Part& p) { return p.mode() != PartMode::Rigid; }
 
+// nullptr for a mesh with no inside (open, inconsistently oriented, inside out): the face
+// query, which needs none, serves it.
+std::shared_ptr<const SignedDistanceField> buildDistanceField(const Part& part) {
+    try {
+        return std::make_shared<SignedDistanceField>(part.model().mesh, part.model().topology);
+    } catch (const std::invalid_argument&) {
+        return nullptr;
+    }
+}
+
 }  // namespace
 
 const char* toString(RigidDeformableQuery query) { return query == RigidDeformableQuery::PointShell ? "point-shell" : "faces"; }
@@ -33,9 +43,11 @@ std::uint32_t CollisionWorld::add(Part& part, BoundingVolumeKind kind) {
     parts_.push_back(&part);
     colliders_.emplace_back(part, kind, settings_.exactTest);
     stiffness_.push_back(effectivePartStiffness(part));
-    // Built now rather than at the first contact, where it would stall a haptic loop.
-    const bool pointShell = settings_.rigidDeformable == RigidDeformableQuery::PointShell && !deformable(part);
-    fields_.push_back(pointShell ? buildDistanceField(part) : nullptr);
+    // Fields and rest-point trees are built now rather than at the first contact, where they
+    // would stall a haptic loop.
+    const bool pointShell = settings_.rigidDeformable == RigidDeformableQuery::PointShell;
+    fields_.push_back(pointShell && !deformable(part) ? buildDistanceField(part) : nullptr);
+    if (pointShell && deformable(part)) colliders_.back().restPointTree(part);
     pushedMarks_.emplace_back();
     pushSlot_.emplace_back();
     part.clearChangedMasses();
@@ -53,26 +65,28 @@ void CollisionWorld::setExactTest(ExactTest test) {
 }
 
 void CollisionWorld::update() {
-    refitChanged();
+    updateBounds();
     updateBroadPhase();
 }
 
-void CollisionWorld::refitChanged() {
+void CollisionWorld::updateBounds() {
     for (std::size_t i = 0; i < parts_.size(); ++i) {
-        Part& part = *parts_[i];
-        if (!part.changedMasses().empty()) colliders_[i].notePending(part, part.changedMasses());
-        part.clearChangedMasses();
-        partSpheres_[i] = colliders_[i].worldSphere(part);
+        colliders_[i].updateDisplacementBound(*parts_[i]);
+        partSpheres_[i] = colliders_[i].worldSphere(*parts_[i]);
     }
 }
 
 const PartCollider& CollisionWorld::collider(std::uint32_t id) {
-    colliders_[id].refitPending(*parts_[id]);
+    Part& part = *parts_[id];
+    if (!part.changedMasses().empty()) {
+        colliders_[id].refit(part, part.changedMasses());
+        part.clearChangedMasses();
+    }
     return colliders_[id];
 }
 
 const std::vector<Contact>& CollisionWorld::contactsOf(std::uint32_t id, bool rigidPartnersOnly) {
-    refitChanged();
+    updateBounds();
     partContacts_.clear();
     const RelativePose identity;
     // Other parts in ascending id: the same pairs, in the same order, as the broad phase gives.
@@ -135,19 +149,13 @@ const std::vector<Contact>& CollisionWorld::narrowPhase() {
 }
 
 void CollisionWorld::queryCandidates(std::uint32_t a, std::uint32_t b, std::vector<Contact>& out, QueryStats& stats) {
-    if (settings_.rigidDeformable == RigidDeformableQuery::PointShell && !deformable(*parts_[a]) && deformable(*parts_[b]))
-        if (const SignedDistanceField* field = fields_[a].get())
-            return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(*parts_[b]), out, stats);
+    // A field exists only for a rigid part under the point-shell setting.
+    if (const SignedDistanceField* field = fields_[a].get(); field != nullptr && deformable(*parts_[b]))
+        return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(*parts_[b]), out, stats);
     queryPair(a, *parts_[a], collider(a), b, *parts_[b], collider(b), settings_.exactTest, out, stats);
 }
 
-std::shared_ptr<const SignedDistanceField> CollisionWorld::buildDistanceField(const Part& part) {
-    try {
-        return std::make_shared<SignedDistanceField>(part.model().mesh, part.model().topology);
-    } catch (const std::invalid_argument&) {
-        return nullptr;  // open or inconsistently oriented: the face query, which needs no inside, serves it
-    }
-}
+
 
 ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
     ResponseStats stats;
@@ -165,8 +173,7 @@ ResponseStats CollisionWorld::respond(std::span<const Contact> contacts) {
             pushed.reset(part.model().massCount());
             slots.assign(part.model().massCount(), 0u);
         }
-        const Face& masses = part.model().mesh.faces[face];
-        for (Index m : mass == kNoMass ? std::span<const Index>(masses) : std::span<const Index>(&mass, 1)) {
+        for (Index m : pressedMasses(part.model().mesh.faces[face], mass)) {
             if (pushed.insert(m)) {
                 slots[m] = Index(pushes_.size());
                 pushes_.push_back({(std::uint64_t(id) << 32) | m, displacement});

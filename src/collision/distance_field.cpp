@@ -1,5 +1,6 @@
 #include "flexfit/distance_field.hpp"
 #include "flexfit/collision.hpp"
+#include "flexfit/triangle_queries.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,36 +9,6 @@
 
 namespace flexfit {
 namespace {
-
-// Closest feature of a triangle: corners 0..2, edges 3 + e (edge e joins corners e and e+1),
-// the face 6.
-constexpr int kFaceFeature = 6;
-
-struct ClosestOnTriangle {
-    Vec3 point;
-    int feature;
-};
-
-// Ericson, Real-Time Collision Detection 5.1.5, keeping which Voronoi region held p.
-ClosestOnTriangle closestWithFeature(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-    const Vec3 ab = b - a, ac = c - a, ap = p - a;
-    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-    if (d1 <= 0.0 && d2 <= 0.0) return {a, 0};
-    const Vec3 bp = p - b;
-    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-    if (d3 >= 0.0 && d4 <= d3) return {b, 1};
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return {a + (d1 / (d1 - d3)) * ab, 3};
-    const Vec3 cp = p - c;
-    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-    if (d6 >= 0.0 && d5 <= d6) return {c, 2};
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return {a + (d2 / (d2 - d6)) * ac, 5};
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) return {b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b), 4};
-    const double denom = 1.0 / (va + vb + vc);
-    return {a + ab * (vb * denom) + ac * (vc * denom), kFaceFeature};
-}
 
 double squaredDistance(const Aabb& box, const Vec3& p) {
     return (box.min - p).cwiseMax(p - box.max).cwiseMax(0.0).squaredNorm();
@@ -119,8 +90,7 @@ void SignedDistanceField::setUpGrid(Grid& grid, double cell, std::size_t maxNode
         cell *= std::cbrt(nodes / double(maxNodes)) * 1.01;
     }
     grid.cell = cell;
-    grid.origin = grid.box.min;
-    for (int d = 0; d < 3; ++d) grid.box.max[d] = grid.origin[d] + cell * (grid.dims[std::size_t(d)] - 1);
+    for (int d = 0; d < 3; ++d) grid.box.max[d] = grid.box.min[d] + cell * (grid.dims[std::size_t(d)] - 1);
     grid.values.assign(std::size_t(grid.dims[0]) * std::size_t(grid.dims[1]) * std::size_t(grid.dims[2]),
                        std::numeric_limits<float>::quiet_NaN());
 }
@@ -130,8 +100,8 @@ void SignedDistanceField::fillBand(Grid& grid, int cells) const {
         const Aabb box = faceBox(vertices_, f);
         int lo[3], hi[3];
         for (int d = 0; d < 3; ++d) {
-            lo[d] = std::max(0, int(std::floor((box.min[d] - grid.origin[d]) / grid.cell)) - cells);
-            hi[d] = std::min(grid.dims[std::size_t(d)] - 1, int(std::ceil((box.max[d] - grid.origin[d]) / grid.cell)) + cells);
+            lo[d] = std::max(0, int(std::floor((box.min[d] - grid.box.min[d]) / grid.cell)) - cells);
+            hi[d] = std::min(grid.dims[std::size_t(d)] - 1, int(std::ceil((box.max[d] - grid.box.min[d]) / grid.cell)) + cells);
         }
         for (int k = lo[2]; k <= hi[2]; ++k)
             for (int j = lo[1]; j <= hi[1]; ++j)
@@ -142,13 +112,13 @@ void SignedDistanceField::fillBand(Grid& grid, int cells) const {
 void SignedDistanceField::fill(Grid& grid, int i, int j, int k) const {
     float& v = grid.node(i, j, k);
     if (!std::isnan(v)) return;
-    v = float(query(grid.origin + grid.cell * Vec3(i, j, k)).distance);
-    ++grid.filled;
+    v = float(query(grid.box.min + grid.cell * Vec3(i, j, k)).distance);
 }
 
 SignedDistanceField::Sample SignedDistanceField::query(const Vec3& p) const {
     double best = std::numeric_limits<double>::infinity();
-    ClosestOnTriangle closest{p, kFaceFeature};
+    Vec3 closest = p;
+    TriangleFeature closestFeature = TriangleFeature::Interior;
     Index bestFace = 0;
     const auto& nodes = bvh_.nodes();
     thread_local std::vector<std::int32_t> stack;
@@ -159,11 +129,13 @@ SignedDistanceField::Sample SignedDistanceField::query(const Vec3& p) const {
         if (squaredDistance(node.volume, p) >= best) continue;
         if (node.isLeaf()) {
             const Face& f = faces_[node.item];
-            const ClosestOnTriangle c = closestWithFeature(p, vertices_[f[0]], vertices_[f[1]], vertices_[f[2]]);
-            const double d2 = (p - c.point).squaredNorm();
+            TriangleFeature feature;
+            const Vec3 c = closestPointOnTriangle(p, {vertices_[f[0]], vertices_[f[1]], vertices_[f[2]]}, &feature);
+            const double d2 = (p - c).squaredNorm();
             if (d2 < best) {
                 best = d2;
                 closest = c;
+                closestFeature = feature;
                 bestFace = node.item;
             }
             continue;
@@ -180,14 +152,16 @@ SignedDistanceField::Sample SignedDistanceField::query(const Vec3& p) const {
         }
     }
     const Face& f = faces_[bestFace];
-    const Vec3 pseudo = closest.feature == kFaceFeature ? faceNormal_[bestFace]
-                        : closest.feature >= 3         ? edgeNormal_[bestFace][std::size_t(closest.feature - 3)]
-                                                       : vertexNormal_[f[std::size_t(closest.feature)]];
-    const Vec3 offset = p - closest.point;
+    // Pseudonormal of the closest feature (TriangleFeature numbers corners 0..2, edges 3..5).
+    const int feature = int(closestFeature);
+    const Vec3 pseudo = closestFeature == TriangleFeature::Interior ? faceNormal_[bestFace]
+                        : feature >= int(TriangleFeature::EdgeAB)
+                            ? edgeNormal_[bestFace][std::size_t(feature - int(TriangleFeature::EdgeAB))]
+                            : vertexNormal_[f[std::size_t(feature)]];
+    const Vec3 offset = p - closest;
     const double distance = std::sqrt(best);
     Sample s;
-    s.closest = closest.point;
-    s.face = bestFace;
+    s.closest = closest;
     s.distance = offset.dot(pseudo) < 0.0 ? -distance : distance;
     // Away from the surface the offset gives the normal; on it, the pseudonormal.
     s.normal = distance > 1e-12 * fine_.cell ? Vec3(offset / s.distance) : pseudo;
@@ -195,7 +169,7 @@ SignedDistanceField::Sample SignedDistanceField::query(const Vec3& p) const {
 }
 
 SignedDistanceField::Interpolated SignedDistanceField::sample(Grid& grid, const Vec3& p) const {
-    const Vec3 g = (p - grid.origin) / grid.cell;
+    const Vec3 g = (p - grid.box.min) / grid.cell;
     int base[3];
     double t[3];
     for (int d = 0; d < 3; ++d) {

@@ -17,11 +17,14 @@ Vec3 closestPointOnSegment(const Vec3& p, const Vec3& a, const Vec3& b) {
 }
 
 // Degenerate triangle (collinear or coincident vertices): the closest of its three edges.
-Vec3 closestPointOnEdges(const Vec3& p, const Triangle& t) {
+// The closest of the three edges' closest points, and which edge.
+Vec3 closestPointOnEdges(const Vec3& p, const Triangle& t, TriangleFeature& feature) {
     const Vec3 candidates[3] = {closestPointOnSegment(p, t.a, t.b), closestPointOnSegment(p, t.b, t.c),
                                 closestPointOnSegment(p, t.c, t.a)};
-    return *std::min_element(std::begin(candidates), std::end(candidates),
-                             [&](const Vec3& x, const Vec3& y) { return (x - p).squaredNorm() < (y - p).squaredNorm(); });
+    const auto* best = std::min_element(std::begin(candidates), std::end(candidates),
+                                        [&](const Vec3& x, const Vec3& y) { return (x - p).squaredNorm() < (y - p).squaredNorm(); });
+    feature = TriangleFeature(int(TriangleFeature::EdgeAB) + int(best - candidates));
+    return *best;
 }
 
 struct Interval {
@@ -59,35 +62,43 @@ bool strictlyOneSide(const Triangle& t, const Vec3& n, double d, double toleranc
 
 }  // namespace
 
-Vec3 closestPointOnTriangle(const Vec3& p, const Triangle& t) {
+Vec3 closestPointOnTriangle(const Vec3& p, const Triangle& t, TriangleFeature* feature) {
+    TriangleFeature ignored;
+    TriangleFeature& region = feature != nullptr ? *feature : ignored;
+    auto found = [&region](TriangleFeature where, const Vec3& point) {
+        region = where;
+        return point;
+    };
     const Vec3& a = t.a;
     const Vec3& b = t.b;
     const Vec3& c = t.c;
     const Vec3 ab = b - a, ac = c - a, ap = p - a;
     // Zero-area triangles have no face region: use the edges.
     if (!(ab.cross(ac).squaredNorm() > 1e-30 * std::max(ab.squaredNorm(), ac.squaredNorm()) * std::max(ab.squaredNorm(), ac.squaredNorm())))
-        return closestPointOnEdges(p, t);
+        return closestPointOnEdges(p, t, region);
     // Vertex region A.
     const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-    if (d1 <= 0 && d2 <= 0) return a;
+    if (d1 <= 0 && d2 <= 0) return found(TriangleFeature::CornerA, a);
     // Vertex region B.
     const Vec3 bp = p - b;
     const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-    if (d3 >= 0 && d4 <= d3) return b;
+    if (d3 >= 0 && d4 <= d3) return found(TriangleFeature::CornerB, b);
     // Edge region AB.
     const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return found(TriangleFeature::EdgeAB, a + (d1 / (d1 - d3)) * ab);
     // Vertex region C.
     const Vec3 cp = p - c;
     const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-    if (d6 >= 0 && d5 <= d6) return c;
+    if (d6 >= 0 && d5 <= d6) return found(TriangleFeature::CornerC, c);
     // Edge region AC.
     const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return found(TriangleFeature::EdgeCA, a + (d2 / (d2 - d6)) * ac);
     // Edge region BC.
     const double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+        return found(TriangleFeature::EdgeBC, b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b));
     // Face region: barycentric coordinates (u, v, w).
+    region = TriangleFeature::Interior;
     const double denominator = 1.0 / (va + vb + vc);
     return a + ab * (vb * denominator) + ac * (vc * denominator);
 }

@@ -91,12 +91,7 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
     body.linearVelocity = settings.linearVelocity;
     body.angularVelocity = settings.angularVelocity;
 
-    PartSettings ps = partSettings;
-    ps.simulation.timeStep = settings_.timeStep;
-    // Gravity moves bodies, not zone masses: the rest shape is the part's shape under its own
-    // weight, and in a falling body's frame the masses feel no gravity.
-    ps.simulation.gravity = Vec3::Zero();
-    auto part = std::make_unique<Part>(std::move(model), ps);
+    auto part = std::make_unique<Part>(std::move(model), inWorld(partSettings));
     part->setPose(pose);
     collision_.add(*part, settings.boundingVolume);
     parts_.push_back(std::move(part));
@@ -106,12 +101,17 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
     return BodyId(parts_.size() - 1);
 }
 
+PartSettings World::inWorld(PartSettings settings) const {
+    settings.simulation.timeStep = settings_.timeStep;
+    // Gravity moves bodies, not zone masses: the rest shape is the part's shape under its own
+    // weight, and in a falling body's frame the masses feel no gravity.
+    settings.simulation.gravity = Vec3::Zero();
+    return settings;
+}
+
 void World::setPartSettings(BodyId id, const PartSettings& settings) {
     if (id >= parts_.size()) throw InputError(kWorldSource, 0, "settings: no body " + std::to_string(id));
-    PartSettings ps = settings;
-    ps.simulation.timeStep = settings_.timeStep;
-    ps.simulation.gravity = Vec3::Zero();
-    parts_[id]->setSettings(ps);
+    parts_[id]->setSettings(inWorld(settings));
     collision_.refreshStiffness(std::uint32_t(id));
 }
 
@@ -276,8 +276,7 @@ void World::applyDeformableReactions(std::span<const Contact> contacts) {
                 owners.assign(parts_[part]->model().massCount(), 0u);
             }
             // Contacts come grouped by pair, so a mass pressed by two bodies counts once for each.
-            const Face& masses = parts_[part]->model().mesh.faces[face];
-            for (Index m : mass == kNoMass ? std::span<const Index>(masses) : std::span<const Index>(&mass, 1))
+            for (Index m : pressedMasses(parts_[part]->model().mesh.faces[face], mass))
                 if (counted.insert(m) || owners[m] != body) {
                     owners[m] = body;
                     reactionMasses_.push_back({body, part, m});

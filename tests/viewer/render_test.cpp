@@ -70,12 +70,10 @@ void checkDemoScreenshot(const std::filesystem::path& png) {
     EXPECT_GT(background, kWidth * kHeight / 4);
 
     // The zone's green where the rim's moving masses project (some are hidden by the ball).
-    Eigen::AlignedBox2d rimBox;
     int greenAtZone = 0, visibleZone = 0;
     for (Index m : w.part(0).movingMasses()) {
         const auto p = camera.project(w.part(0).worldPosition(m));
         if (!p) continue;
-        rimBox.extend(p->head<2>());
         const auto hit = pick(w, camera.rayThrough(p->x(), p->y()));
         if (!hit || hit->body != 0 || hit->distance < (w.part(0).worldPosition(m) - camera.eye()).norm() - 0.3) continue;
         ++visibleZone;
