@@ -1,15 +1,14 @@
-// One full-MSD step of torus1, torus2 and heart: Flexfit's struct-of-arrays step against the
-// thesis-style naive array-of-structs reference (tests/support/naive_msd.hpp), same physics,
-// same meshes, in one run; and the load/store floor of such a step (see BM_LoadStoreFloor).
+// One full-MSD step of torus1, torus2 and heart: Flexfit's step against the thesis-style naive
+// array-of-structs reference (tests/support/naive_msd.hpp), same physics, same meshes, in one
+// run. Also each way of the step forced: the per-mass sweep, and the spring blocks with the
+// scalar and AVX2 kernels (stepFullModel itself uses AVX-512 where the CPU has it).
 // Counters: steps/s and spring updates/s. Single thread.
+#include "dynamics/flush_denormals.hpp"
+#include "dynamics/full_step.hpp"
 #include "flexfit/flexfit.hpp"
-#include "naive_msd.hpp"
+#include "naive_from_mesh.hpp"
 
 #include <benchmark/benchmark.h>
-
-#if defined(__SSE2__)
-#include <xmmintrin.h>
-#endif
 
 namespace {
 
@@ -52,12 +51,9 @@ void BM_FlexfitFullStep(benchmark::State& state) {
 void BM_NaiveFullStep(benchmark::State& state) {
     const TriMesh& mesh = meshByIndex(int(state.range(0)));
     state.SetLabel(mesh.name);
-    std::vector<double> vertices;
-    std::vector<unsigned> faces;
-    for (const auto& v : mesh.vertices) vertices.insert(vertices.end(), {v.x(), v.y(), v.z()});
-    for (const auto& f : mesh.faces) faces.insert(faces.end(), {f[0], f[1], f[2]});
     const flexfit::Material m = flexfit::Material::elastic();
-    naive::Model model(vertices, faces, 1.0, m.stiffness, m.damping);
+    const auto owned = naive::modelFromMesh(mesh, 1.0, m.stiffness, m.damping);
+    naive::Model& model = *owned;
     for (auto _ : state) {
         model.step(1e-3, naive::Vector3D(0, -9.81, 0), 0.1);
         benchmark::DoNotOptimize(model.masses[0]->position.x);
@@ -65,64 +61,44 @@ void BM_NaiveFullStep(benchmark::State& state) {
     setCounters(state, std::size_t(model.numOfSprings));
 }
 
-// Not a simulator: the loads and stores that any full step over this state must do, with the
-// spring force replaced by a plain sum (no sqrt, no divide, no constants). For every spring it
-// reads both ends' positions and velocities and updates both ends' forces; then it integrates
-// every mass. Any real step does at least this memory work, so naive / floor bounds the
-// speed-up that code can reach over the naive reference on this machine with double-precision
-// Vec3 state. The sign makes it a damped diffusion, so values stay bounded over any run.
-void loadStoreFloorStep(const flexfit::PartModel& model, double h, flexfit::PartState& state) {
-    const std::size_t springs = model.springCount(), masses = model.massCount();
-    const flexfit::Index* springA = model.springA.data();
-    const flexfit::Index* springB = model.springB.data();
-    double* __restrict x = state.positions.data()->data();
-    double* __restrict v = state.velocities.data()->data();
-    double* __restrict f = state.forces.data()->data();
-    for (std::size_t e = 0; e < springs; ++e) {
-        const std::size_t a = 3 * std::size_t(springA[e]), b = 3 * std::size_t(springB[e]);
-        for (std::size_t c = 0; c < 3; ++c) {
-            const double g = (x[b + c] - x[a + c]) + (v[b + c] - v[a + c]);
-            f[a + c] += g;
-            f[b + c] -= g;
-        }
-    }
-    for (std::size_t j = 0; j < 3 * masses; ++j) {
-        v[j] += h * f[j];
-        f[j] = 0.0;
-        x[j] += h * v[j];
-    }
-}
-
-void BM_LoadStoreFloor(benchmark::State& state) {
+// The two ways of the full step, forced (stepFullModel picks blocks and the widest kernel).
+void runDetailStep(benchmark::State& state, bool sweep, flexfit::detail::BlockKernel kernel) {
     const TriMesh& mesh = meshByIndex(int(state.range(0)));
     state.SetLabel(mesh.name);
+    if (!sweep && !flexfit::detail::blockKernelAvailable(kernel)) {
+        state.SkipWithError("kernel not supported by this CPU");
+        return;
+    }
     const auto model = flexfit::buildPartModel(mesh, {flexfit::Material::elastic(), 1.0, {}, {}});
+    const auto update = flexfit::detail::MassUpdate::from(benchSettings());
     flexfit::PartState partState = flexfit::PartState::atRest(*model);
-    partState.velocities[0] = flexfit::Vec3(1.0, 0.0, 0.0);
-#if defined(__SSE2__)
-    const unsigned savedMode = _mm_getcsr();  // flush denormals, as the library's step does
-    _mm_setcsr(savedMode | 0x8040u);
-#endif
+    const flexfit::detail::FlushDenormals flush;  // as stepFullModel
     for (auto _ : state) {
-        loadStoreFloorStep(*model, 1e-3, partState);
+        if (sweep)
+            flexfit::detail::sweepFullModel(*model, update, partState);
+        else
+            flexfit::detail::stepSpringBlocks(*model, update, partState, kernel);
         benchmark::DoNotOptimize(partState.positions.data());
     }
-#if defined(__SSE2__)
-    _mm_setcsr(savedMode);
-#endif
     setCounters(state, model->springCount());
 }
 
-// Interleaved per mesh so that both implementations see the same machine state.
-BENCHMARK(BM_FlexfitFullStep)->Arg(0);
-BENCHMARK(BM_NaiveFullStep)->Arg(0);
-BENCHMARK(BM_LoadStoreFloor)->Arg(0);
-BENCHMARK(BM_FlexfitFullStep)->Arg(1);
-BENCHMARK(BM_NaiveFullStep)->Arg(1);
-BENCHMARK(BM_LoadStoreFloor)->Arg(1);
-BENCHMARK(BM_FlexfitFullStep)->Arg(2);
-BENCHMARK(BM_NaiveFullStep)->Arg(2);
-BENCHMARK(BM_LoadStoreFloor)->Arg(2);
+void BM_FlexfitSweep(benchmark::State& state) { runDetailStep(state, true, flexfit::detail::BlockKernel::Scalar); }
+void BM_FlexfitBlocksScalar(benchmark::State& state) {
+    runDetailStep(state, false, flexfit::detail::BlockKernel::Scalar);
+}
+void BM_FlexfitBlocksAvx2(benchmark::State& state) { runDetailStep(state, false, flexfit::detail::BlockKernel::Avx2); }
+
+// Interleaved per mesh so that all implementations see the same machine state.
+#define FLEXFIT_MSD_BENCHMARKS(mesh)                     \
+    BENCHMARK(BM_FlexfitFullStep)->Arg(mesh);            \
+    BENCHMARK(BM_NaiveFullStep)->Arg(mesh);              \
+    BENCHMARK(BM_FlexfitSweep)->Arg(mesh);               \
+    BENCHMARK(BM_FlexfitBlocksAvx2)->Arg(mesh);          \
+    BENCHMARK(BM_FlexfitBlocksScalar)->Arg(mesh)
+FLEXFIT_MSD_BENCHMARKS(0);
+FLEXFIT_MSD_BENCHMARKS(1);
+FLEXFIT_MSD_BENCHMARKS(2);
 
 }  // namespace
 

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "flexfit/mesh.hpp"
+#include "flexfit/spring_blocks.hpp"
 #include "flexfit/topology.hpp"
 
 #include <memory>
@@ -57,6 +58,9 @@ struct PartModel {
     std::vector<double> damping;       // (E) b
     // (V+1) springs whose first mass is a: [springAdr[a], springAdr[a+1]).
     std::vector<Index> springAdr;
+    // The springs again, grouped for the vector full step (spring_blocks.hpp); empty when the
+    // mesh's vertex order gives too few blocks.
+    SpringBlocks springBlocks;
 
     std::size_t massCount() const { return mass.size(); }
     std::size_t springCount() const { return springA.size(); }

@@ -70,6 +70,8 @@ struct StepCounters {
 };
 
 // Advances every mass of the part by one time step. Loads must name masses < massCount.
+// Models with spring blocks (spring_blocks.hpp) are stepped by blocks with the widest kernel
+// the CPU has (scalar, AVX2, AVX-512: the same bits on every CPU); others by a per-mass sweep.
 void stepFullModel(const PartModel& model, const SimulationSettings& settings,
                    std::span<const PointLoad> loads, PartState& state,
                    StepCounters* counters = nullptr);

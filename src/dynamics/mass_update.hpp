@@ -4,6 +4,8 @@
 
 #include "flexfit/simulation.hpp"
 
+#include <cmath>
+
 namespace flexfit::detail {
 
 // Per-step constants of the mass update, resolved once from the settings.
@@ -27,10 +29,13 @@ struct MassUpdate {
                 s.integrator == Integrator::SemiImplicitEuler};
     }
 
-    // Forces on a mass other than its springs: m g - drag v - k_a (x - rest).
+    // Forces on a mass other than its springs: m g - drag v (- k_a (x - rest) with anchors; left
+    // out, not multiplied by 0, without them, which the vector kernels rely on to skip rest).
     Vec3 bodyForce(double mass, const Vec3& x, const Vec3& v, const Vec3& rest) const {
-        return mass * gravity - drag * v - anchorStiffness * (x - rest);
+        const Vec3 free = mass * gravity - drag * v;
+        return anchorStiffness != 0.0 ? Vec3(free - anchorStiffness * (x - rest)) : free;
     }
+    bool readsRest() const { return anchorStiffness != 0.0 || constraint > 0.0; }
 
     // Integrates one mass under total force f, then applies the restoration constraint.
     void integrate(double inverseMass, const Vec3& f, const Vec3& rest, Vec3& x, Vec3& v) const {
@@ -53,15 +58,28 @@ struct MassUpdate {
     }
 };
 
-// Force of spring e on its first mass a (the second mass b receives the opposite):
-// -(k (|d| - L) + b (v_a - v_b).u) u with d = x_a - x_b, u = d/|d|; zero for coincident masses.
+// Force of a spring on its first mass a (the second mass b receives the opposite):
+// -(k (|d| - L) + c (v_a - v_b).u) u with d = x_a - x_b, u = d/|d|; zero for coincident masses.
+// Every step kernel, scalar or vector, evaluates it in exactly this order (no fused multiply-add:
+// the library builds with -ffp-contract=off), so all of them give the same bits.
+inline void springForce(double k, double c, double restLength, const double* xa, const double* xb, const double* va,
+                        const double* vb, double* g) {
+    const double dx = xa[0] - xb[0], dy = xa[1] - xb[1], dz = xa[2] - xb[2];
+    const double wx = va[0] - vb[0], wy = va[1] - vb[1], wz = va[2] - vb[2];
+    const double length = std::sqrt((dx * dx + dy * dy) + dz * dz);
+    const double inverse = length > 0.0 ? 1.0 / length : 0.0;
+    const double dot = (wx * dx + wy * dy) + wz * dz;
+    const double s = -((k * (length - restLength) + (c * dot) * inverse) * inverse);
+    g[0] = s * dx;
+    g[1] = s * dy;
+    g[2] = s * dz;
+}
+
 inline Vec3 springForceOnFirst(double k, double c, double restLength, const Vec3& xa, const Vec3& xb, const Vec3& va,
                                const Vec3& vb) {
-    const Vec3 d = xa - xb;
-    const double length = d.norm();
-    const double inverse = length > 0.0 ? 1.0 / length : 0.0;
-    const double magnitude = k * (length - restLength) + c * (va - vb).dot(d) * inverse;
-    return -(magnitude * inverse) * d;
+    Vec3 g;
+    springForce(k, c, restLength, xa.data(), xb.data(), va.data(), vb.data(), g.data());
+    return g;
 }
 
 }  // namespace flexfit::detail

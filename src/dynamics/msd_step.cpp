@@ -1,12 +1,13 @@
-// One step of the full mass-spring-damper model: a single sweep over the masses.
+// One step of the full mass-spring-damper model: by spring blocks when the model has them
+// (block_step.cpp), else a single sweep over the masses.
 #include "flexfit/simulation.hpp"
 #include "flush_denormals.hpp"
-#include "mass_update.hpp"
+#include "full_step.hpp"
 
 #include <cmath>
 
 namespace flexfit {
-namespace {
+namespace detail {
 
 // The whole step is one pass over the masses in index order. Springs are sorted by their first
 // (smaller) mass a, so visiting mass a evaluates springs (a, b > a): g goes to a in a register
@@ -16,7 +17,7 @@ namespace {
 //
 // f_a = (pending external force) + sum_j g_aj + m_a g - drag v_a - k_a (x_a - rest_a)
 // g_ab = -(k (|d| - L) + b (v_a - v_b).u) u,  d = x_a - x_b, u = d/|d|
-void sweep(const PartModel& model, const detail::MassUpdate& p, PartState& state) {
+void sweepFullModel(const PartModel& model, const MassUpdate& p, PartState& state) {
     const std::size_t masses = model.massCount();
     const Index* springAdr = model.springAdr.data();
     const Index* springB = model.springB.data();
@@ -33,7 +34,7 @@ void sweep(const PartModel& model, const detail::MassUpdate& p, PartState& state
         Vec3 fa = f[a] + p.bodyForce(mass[a], x[a], v[a], rest[a]);
         for (Index e = springAdr[a]; e < springAdr[a + 1]; ++e) {
             const Index b = springB[e];
-            const Vec3 g = detail::springForceOnFirst(k[e], c[e], restLength[e], x[a], x[b], v[a], v[b]);
+            const Vec3 g = springForceOnFirst(k[e], c[e], restLength[e], x[a], x[b], v[a], v[b]);
             fa += g;
             f[b] -= g;
         }
@@ -42,7 +43,7 @@ void sweep(const PartModel& model, const detail::MassUpdate& p, PartState& state
     }
 }
 
-}  // namespace
+}  // namespace detail
 
 void validateSettings(const SimulationSettings& s) {
     const std::string source = "simulation settings";
@@ -63,7 +64,11 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings, s
                    PartState& state, StepCounters* counters) {
     const detail::FlushDenormals flush;
     for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
-    sweep(model, detail::MassUpdate::from(settings), state);
+    const detail::MassUpdate update = detail::MassUpdate::from(settings);
+    if (model.springBlocks.empty())
+        detail::sweepFullModel(model, update, state);
+    else
+        detail::stepSpringBlocks(model, update, state, detail::fastestBlockKernel());
     state.time += settings.timeStep;
     ++state.stepCount;
     if (counters != nullptr) {

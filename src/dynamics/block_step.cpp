@@ -1,0 +1,120 @@
+// The spring-block full step: dispatch, the scalar kernel and the shared scalar passes.
+#include "full_step.hpp"
+
+namespace flexfit::detail {
+namespace {
+
+constexpr std::size_t W = SpringBlocks::kWidth;
+
+void blockForcesScalar(const SpringBlocks& blocks, const double* x, const double* v, double* f) {
+    double carry[3] = {0.0, 0.0, 0.0};  // g_7 of the previous offset-1 block
+    for (std::size_t q = 0; q < blocks.blockCount(); ++q) {
+        const std::size_t a0 = blocks.first[q], offset = blocks.offset[q];
+        double g[W][3];
+        for (std::size_t i = 0; i < W; ++i) {
+            const std::size_t a = 3 * (a0 + i), b = 3 * (a0 + i + offset), lane = W * q + i;
+            springForce(blocks.stiffness[lane], blocks.damping[lane], blocks.restLength[lane], x + a, x + b, v + a,
+                        v + b, g[i]);
+        }
+        if (offset == 1) {
+            const bool continues = blocks.continuesRow(q);
+            for (std::size_t i = 0; i < W; ++i)
+                for (std::size_t c = 0; c < 3; ++c) {
+                    const double previous = i > 0 ? g[i - 1][c] : continues ? carry[c] : 0.0;
+                    double& fm = f[3 * (a0 + i) + c];
+                    fm = (fm + g[i][c]) - previous;
+                }
+            for (std::size_t c = 0; c < 3; ++c) carry[c] = g[W - 1][c];
+            if (q + 1 == blocks.blockCount() || !blocks.continuesRow(q + 1))
+                for (std::size_t c = 0; c < 3; ++c) f[3 * (a0 + W) + c] -= g[W - 1][c];
+            continue;
+        }
+        for (std::size_t i = 0; i < W; ++i)
+            for (std::size_t c = 0; c < 3; ++c) f[3 * (a0 + i) + c] += g[i][c];
+        for (std::size_t i = 0; i < W; ++i)
+            for (std::size_t c = 0; c < 3; ++c) f[3 * (a0 + offset + i) + c] -= g[i][c];
+    }
+}
+
+void remainderForces(const PartModel& model, const double* x, const double* v, double* f, std::size_t begin = 0) {
+    const std::vector<Index>& remainder = model.springBlocks.remainder;
+    for (std::size_t i = begin; i < remainder.size(); ++i) {
+        const Index e = remainder[i];
+        const std::size_t a = 3 * std::size_t(model.springA[e]), b = 3 * std::size_t(model.springB[e]);
+        double g[3];
+        springForce(model.stiffness[e], model.damping[e], model.restLength[e], x + a, x + b, v + a, v + b, g);
+        for (std::size_t c = 0; c < 3; ++c) {
+            f[a + c] += g[c];
+            f[b + c] -= g[c];
+        }
+    }
+}
+
+void integrateScalar(const PartModel& model, const MassUpdate& p, PartState& state, std::size_t begin) {
+    Vec3* x = state.positions.data();
+    Vec3* v = state.velocities.data();
+    Vec3* f = state.forces.data();
+    for (std::size_t i = begin; i < model.massCount(); ++i) {
+        const Vec3 total = f[i] + p.bodyForce(model.mass[i], x[i], v[i], model.restPositions[i]);
+        f[i] = Vec3::Zero();
+        p.integrate(model.inverseMass[i], total, model.restPositions[i], x[i], v[i]);
+    }
+}
+
+bool cpuHas(BlockKernel kernel) {
+#if defined(FLEXFIT_X86_KERNELS)
+    if (kernel == BlockKernel::Avx2) return __builtin_cpu_supports("avx2");
+    if (kernel == BlockKernel::Avx512) return __builtin_cpu_supports("avx512f");
+#endif
+    return kernel == BlockKernel::Scalar;
+}
+
+}  // namespace
+
+bool blockKernelAvailable(BlockKernel kernel) {
+    return cpuHas(kernel);
+}
+
+BlockKernel fastestBlockKernel() {
+    static const BlockKernel best = cpuHas(BlockKernel::Avx512) ? BlockKernel::Avx512
+                                    : cpuHas(BlockKernel::Avx2) ? BlockKernel::Avx2
+                                                                : BlockKernel::Scalar;
+    return best;
+}
+
+const char* toString(BlockKernel kernel) {
+    switch (kernel) {
+        case BlockKernel::Scalar: return "scalar";
+        case BlockKernel::Avx2: return "avx2";
+        case BlockKernel::Avx512: return "avx512";
+    }
+    return "?";
+}
+
+void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel) {
+    const double* x = state.positions.data()->data();
+    const double* v = state.velocities.data()->data();
+    double* f = state.forces.data()->data();
+    std::size_t integrated = 0;
+    switch (kernel) {
+#if defined(FLEXFIT_X86_KERNELS)
+        case BlockKernel::Avx512:
+            blockForcesAvx512(model.springBlocks, x, v, f);
+            remainderForces(model, x, v, f, remainderForcesAvx512(model, x, v, f));
+            integrated = integrateAvx512(model, update, state);
+            break;
+        case BlockKernel::Avx2:
+            blockForcesAvx2(model.springBlocks, x, v, f);
+            remainderForces(model, x, v, f);
+            integrated = integrateAvx2(model, update, state);
+            break;
+#endif
+        default:
+            blockForcesScalar(model.springBlocks, x, v, f);
+            remainderForces(model, x, v, f);
+            break;
+    }
+    integrateScalar(model, update, state, integrated);
+}
+
+}  // namespace flexfit::detail

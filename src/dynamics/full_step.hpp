@@ -1,0 +1,47 @@
+// Internal to src/dynamics (and the step benchmark): the two ways of a full step.
+//
+// The per-mass sweep serves every model; the spring-block step serves models whose springs
+// mostly fall into blocks (spring_blocks.hpp) and is what stepFullModel uses for them. The block
+// step has a scalar kernel and, on x86-64, AVX2 and AVX-512 kernels chosen at run time; all
+// three give the same bits (tested), so a run does not depend on the machine's vector unit.
+#pragma once
+
+#include "mass_update.hpp"
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define FLEXFIT_X86_KERNELS 1  // block_step_x86.cpp: AVX2 and AVX-512 by function target attributes
+#endif
+
+namespace flexfit::detail {
+
+// One pass over the masses in index order: each mass's own springs, then its integration.
+void sweepFullModel(const PartModel& model, const MassUpdate& update, PartState& state);
+
+enum class BlockKernel { Scalar, Avx2, Avx512 };
+
+// Compiled in and supported by this CPU.
+bool blockKernelAvailable(BlockKernel kernel);
+// The widest available kernel, resolved once.
+BlockKernel fastestBlockKernel();
+const char* toString(BlockKernel kernel);
+
+// Springs by blocks, the remainder, then every mass. model.springBlocks must not be empty and
+// the kernel must be available.
+void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel);
+
+// The vector kernels (block_step_x86.cpp). Forces of all blocks into f (3 doubles per mass).
+void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* v, double* f);
+void blockForcesAvx512(const SpringBlocks& blocks, const double* x, const double* v, double* f);
+// Remainder springs [0, n) in order, for the largest n that is a multiple of 8; returns n.
+std::size_t remainderForcesAvx512(const PartModel& model, const double* x, const double* v, double* f);
+// s = -((k (sqrt(r2) - L) + c dot / sqrt(r2)) / sqrt(r2)) for 8 lanes (arrays of 8), as
+// detail::springForce: the active-region step batches its springs' square roots and divides.
+void springScalesAvx2(const double* r2, const double* dot, const double* k, const double* c,
+                      const double* restLength, double* s);
+void springScalesAvx512(const double* r2, const double* dot, const double* k, const double* c,
+                        const double* restLength, double* s);
+// Integrates masses [0, n) for the largest n that is a multiple of the width; returns n.
+std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state);
+std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state);
+
+}  // namespace flexfit::detail

@@ -1,0 +1,173 @@
+// The spring-block full step (src/dynamics/block_step*.cpp): its kernels against each other bit
+// for bit, and each against the thesis-style naive implementation and the per-mass sweep.
+#include "dynamics/flush_denormals.hpp"
+#include "dynamics/full_step.hpp"
+#include "flexfit/flexfit.hpp"
+#include "naive_from_mesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+#include <random>
+
+using namespace flexfit;
+using detail::BlockKernel;
+
+namespace {
+
+const std::vector<BlockKernel> kAllKernels = {BlockKernel::Scalar, BlockKernel::Avx2, BlockKernel::Avx512};
+
+// Random velocities, and two springs squeezed to zero length: one in a block, one in the remainder.
+PartState kickedState(const PartModel& model, unsigned seed) {
+    PartState state = PartState::atRest(model);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> kick(-1.0, 1.0);
+    for (Vec3& v : state.velocities) v = Vec3(kick(rng), kick(rng), kick(rng));
+    const SpringBlocks& blocks = model.springBlocks;
+    if (!blocks.empty()) {
+        const Index a = blocks.first[0] + 3;
+        state.positions[a + blocks.offset[0]] = state.positions[a];
+    }
+    if (!blocks.remainder.empty()) {
+        const Index e = blocks.remainder.back();
+        state.positions[model.springB[e]] = state.positions[model.springA[e]];
+    }
+    return state;
+}
+
+PartState runBlocks(const PartModel& model, const SimulationSettings& settings, BlockKernel kernel, int steps) {
+    const detail::FlushDenormals flush;
+    const detail::MassUpdate update = detail::MassUpdate::from(settings);
+    PartState state = kickedState(model, 5);
+    for (int step = 0; step < steps; ++step) {
+        state.forces[7] += Vec3(0.5, -0.25, 1.0);  // a pending external load every step
+        detail::stepSpringBlocks(model, update, state, kernel);
+    }
+    return state;
+}
+
+bool sameBits(const PartState& a, const PartState& b) {
+    return a.positions == b.positions && a.velocities == b.velocities && a.forces == b.forces;
+}
+
+SimulationSettings settingsFor(RestorationMethod method, Integrator integrator) {
+    SimulationSettings s;
+    s.gravity = Vec3(0, -9.81, 0);
+    s.globalDamping = 0.1;
+    s.integrator = integrator;
+    s.restoration.method = method;
+    s.restoration.constraintFraction = 0.01;
+    return s;
+}
+
+}  // namespace
+
+TEST(BlockStep, EveryKernelGivesTheScalarKernelsBits) {
+    int compared = 0;
+    for (const TriMesh& mesh : {makeTorus1(), makeTorus2(), makeHeart()}) {
+        const auto model = buildPartModel(mesh);
+        ASSERT_FALSE(model->springBlocks.empty());
+        for (RestorationMethod method : {RestorationMethod::None, RestorationMethod::AnchorSprings, RestorationMethod::Constraint})
+            for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::ExplicitEuler}) {
+                SCOPED_TRACE(mesh.name + " " + toString(method) + " " + toString(integrator));
+                const SimulationSettings settings = settingsFor(method, integrator);
+                const PartState scalar = runBlocks(*model, settings, BlockKernel::Scalar, 60);
+                for (BlockKernel kernel : kAllKernels) {
+                    if (kernel == BlockKernel::Scalar || !detail::blockKernelAvailable(kernel)) continue;
+                    EXPECT_TRUE(sameBits(scalar, runBlocks(*model, settings, kernel, 60))) << detail::toString(kernel);
+                    ++compared;
+                }
+                for (const Vec3& x : scalar.positions) ASSERT_TRUE(x.allFinite());
+            }
+    }
+    RecordProperty("vector_kernel_comparisons", compared);
+    if (compared == 0) GTEST_SKIP() << "this CPU has neither AVX2 nor AVX-512: only the scalar kernel ran";
+}
+
+TEST(BlockStep, EveryKernelMatchesTheNaiveReference) {
+    // The naive model (heap objects, its own spring set) shares no code with the library.
+    for (const TriMesh& mesh : {makeTorus2(), makeHeart()}) {
+        const Material material = Material::elastic();
+        const auto model = buildPartModel(mesh, {material, 1.5, {}, {}});
+        for (BlockKernel kernel : kAllKernels) {
+            if (!detail::blockKernelAvailable(kernel)) continue;
+            SCOPED_TRACE(mesh.name + " " + detail::toString(kernel));
+            const auto owned = naive::modelFromMesh(mesh, 1.5, material.stiffness, material.damping);
+            naive::Model& reference = *owned;
+            SimulationSettings settings = settingsFor(RestorationMethod::None, Integrator::SemiImplicitEuler);
+            settings.globalDamping = 0.3;
+            const detail::MassUpdate update = detail::MassUpdate::from(settings);
+            PartState state = PartState::atRest(*model);
+            std::mt19937 rng(11);
+            std::uniform_real_distribution<double> kick(-1.0, 1.0);
+            for (std::size_t i = 0; i < model->massCount(); ++i) {
+                state.velocities[i] = Vec3(kick(rng), kick(rng), kick(rng));
+                reference.masses[i]->velocity = {state.velocities[i].x(), state.velocities[i].y(), state.velocities[i].z()};
+            }
+            for (int step = 0; step < 300; ++step) {
+                detail::stepSpringBlocks(*model, update, state, kernel);
+                reference.step(1e-3, naive::Vector3D(0, -9.81, 0), 0.3);
+            }
+            double worst = 0.0;
+            for (std::size_t i = 0; i < model->massCount(); ++i) {
+                const naive::Vector3D& p = reference.masses[i]->position;
+                worst = std::max(worst, (state.positions[i] - Vec3(p.x, p.y, p.z)).norm());
+            }
+            EXPECT_LT(worst, 1e-9);
+        }
+    }
+}
+
+TEST(BlockStep, AgreesWithThePerMassSweep) {
+    const auto model = buildPartModel(makeHeart());
+    for (RestorationMethod method : {RestorationMethod::None, RestorationMethod::AnchorSprings, RestorationMethod::Constraint}) {
+        const SimulationSettings settings = settingsFor(method, Integrator::SemiImplicitEuler);
+        const detail::MassUpdate update = detail::MassUpdate::from(settings);
+        PartState blocks = kickedState(*model, 9), sweep = blocks;
+        for (int step = 0; step < 100; ++step) {
+            detail::stepSpringBlocks(*model, update, blocks, BlockKernel::Scalar);
+            detail::sweepFullModel(*model, update, sweep);
+        }
+        double worst = 0.0;
+        for (std::size_t i = 0; i < model->massCount(); ++i)
+            worst = std::max(worst, (blocks.positions[i] - sweep.positions[i]).norm());
+        EXPECT_LT(worst, 1e-12) << toString(method);  // only the order of the force sums differs
+    }
+}
+
+TEST(BlockStep, StepFullModelTakesBlocksWhenTheModelHasThem) {
+    const SimulationSettings settings = settingsFor(RestorationMethod::Constraint, Integrator::SemiImplicitEuler);
+    const detail::MassUpdate update = detail::MassUpdate::from(settings);
+    // Rows: the fastest block kernel, bit for bit.
+    const auto rows = buildPartModel(makeTorus1());
+    PartState viaApi = kickedState(*rows, 2), viaBlocks = viaApi;
+    StepCounters counters;
+    for (int step = 0; step < 20; ++step) {
+        stepFullModel(*rows, settings, {}, viaApi, &counters);
+        const detail::FlushDenormals flush;
+        detail::stepSpringBlocks(*rows, update, viaBlocks, detail::fastestBlockKernel());
+    }
+    EXPECT_TRUE(sameBits(viaApi, viaBlocks));
+    EXPECT_EQ(counters.springsEvaluated, 20 * rows->springCount());
+    EXPECT_EQ(counters.massesIntegrated, 20 * rows->massCount());
+    // No useful vertex order: the sweep.
+    TriMesh scrambled = makeTorus1();
+    std::vector<Index> order(scrambled.vertices.size());
+    std::iota(order.begin(), order.end(), Index{0});
+    std::shuffle(order.begin(), order.end(), std::mt19937(8));
+    std::vector<Vec3> vertices(order.size());
+    for (std::size_t v = 0; v < order.size(); ++v) vertices[order[v]] = scrambled.vertices[v];
+    for (Face& f : scrambled.faces)
+        for (Index& v : f) v = order[v];
+    scrambled.vertices = vertices;
+    const auto unordered = buildPartModel(scrambled);
+    ASSERT_TRUE(unordered->springBlocks.empty());
+    PartState apiState = kickedState(*unordered, 2), sweepState = apiState;
+    for (int step = 0; step < 20; ++step) {
+        stepFullModel(*unordered, settings, {}, apiState);
+        const detail::FlushDenormals flush;
+        detail::sweepFullModel(*unordered, update, sweepState);
+    }
+    EXPECT_TRUE(sameBits(apiState, sweepState));
+}
