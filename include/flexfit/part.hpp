@@ -117,7 +117,7 @@ public:
     void displaceMass(Index mass, const Vec3& worldDisplacement);
     // Masses whose position may have changed since clearChangedMasses(): every mass stepped or
     // displaced, and every mass that returned to rest. Collision hierarchies refit from it.
-    std::span<const Index> changedMasses() const { return changed_; }
+    std::span<const Index> changedMasses() const { return allChanged_ ? std::span<const Index>(allMasses_) : changed_; }
     void clearChangedMasses();
 
     // --- Step ---
@@ -170,8 +170,12 @@ private:
     std::vector<std::uint64_t> lastLoadStep_; // (V) step of the last force on each mass
     std::vector<Index> changed_;              // masses changed since clearChangedMasses()
     EpochMarks changedMarks_;  // (V) masses in changed_
+    // Every mass changed (a step moved them all): O(1) instead of marking each.
+    bool allChanged_ = false;
+    std::vector<Index> allMasses_;  // 0 .. V-1, built the first time every mass moves
 
     void markChanged(Index mass);
+    void markAllChanged();
 };
 
 }  // namespace flexfit

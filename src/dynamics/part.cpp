@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace flexfit {
 namespace {
@@ -117,12 +118,21 @@ void Part::removeMoving(Index mass) {
 }
 
 void Part::markChanged(Index mass) {
-    if (changedMarks_.insert(mass)) changed_.push_back(mass);
+    if (!allChanged_ && changedMarks_.insert(mass)) changed_.push_back(mass);
+}
+
+void Part::markAllChanged() {
+    if (allMasses_.empty()) {
+        allMasses_.resize(model_->massCount());
+        std::iota(allMasses_.begin(), allMasses_.end(), Index{0});
+    }
+    allChanged_ = true;
 }
 
 void Part::clearChangedMasses() {
     changed_.clear();
     changedMarks_.clear();
+    allChanged_ = false;
 }
 
 void Part::cover(std::span<const RingMember> members) {
@@ -239,7 +249,10 @@ void Part::step(StepCounters* counters) {
         return;
     }
     stepRegion(counters);
-    for (Index m : moving_) markChanged(m);
+    if (moving_.size() == model_->massCount())
+        markAllChanged();
+    else
+        for (Index m : moving_) markChanged(m);
     if (settings_.mode == PartMode::RigidDeformable) retireRestingZones();
 }
 

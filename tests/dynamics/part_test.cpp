@@ -285,3 +285,27 @@ TEST(Part, DeterministicStateHash) {
     };
     EXPECT_EQ(run(), run());
 }
+
+TEST(Part, ChangedMassesAreTheMovedOnesAndEveryMassWhenAllMove) {
+    const auto model = buildPartModel(makeTorus1());
+    Part part(model, zoneSettings());
+    part.openZone(ZoneSeed::mass(5), 2);
+    part.step();
+    EXPECT_EQ(asSet(part.changedMasses()), asSet(part.movingMasses()));
+    EXPECT_EQ(part.changedMasses().size(), part.movingMasses().size());  // each once
+    part.clearChangedMasses();
+    EXPECT_TRUE(part.changedMasses().empty());
+
+    part.openZone(ZoneSeed::mass(0), 255);  // every mass moves
+    ASSERT_EQ(part.movingMasses().size(), model->massCount());
+    part.step();
+    part.step();
+    std::set<Index> all;
+    for (Index m = 0; m < model->massCount(); ++m) all.insert(m);
+    EXPECT_EQ(asSet(part.changedMasses()), all);
+    EXPECT_EQ(part.changedMasses().size(), model->massCount());
+    part.clearChangedMasses();
+    EXPECT_TRUE(part.changedMasses().empty());
+    part.step();
+    EXPECT_EQ(part.changedMasses().size(), model->massCount());
+}
