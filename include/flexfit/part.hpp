@@ -24,8 +24,9 @@
 //
 // Modes. Rigid: never deforms (zones and forces are ignored). RigidDeformable: zones.
 // FullDeformable: every mass moves always (the thesis's baseline), stepped by stepFullModel.
-// A zone covering the whole mesh is stepped by the same sweep (fullSweepWhenComplete), and the
-// compact-array path gives the same trajectory up to summation order (tested).
+// A zone covering the whole mesh is stepped by the same full step (fullSweepWhenComplete: spring
+// blocks or the per-mass sweep), and the compact-array path gives the same trajectory up to
+// summation order (tested).
 //
 // Known limits: the part's own rigid-body motion (velocities, contacts) belongs to the world
 // (assembly stage); gravity here acts on moving masses only, in the part frame.
@@ -51,7 +52,7 @@ struct ZoneSettings {
     double activityThreshold = 0.01; // spring activity and rest-distance threshold (length units)
     double restSpeed = 1e-3;         // masses slower than this are at rest
     int retireCheckInterval = 16;    // steps between retirement checks of an unloaded zone
-    bool fullSweepWhenComplete = true;  // step a region covering every mass with the full sweep
+    bool fullSweepWhenComplete = true;  // step a region covering every mass with stepFullModel
 };
 
 struct PartSettings {

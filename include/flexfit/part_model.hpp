@@ -59,7 +59,8 @@ struct PartModel {
     // (V+1) springs whose first mass is a: [springAdr[a], springAdr[a+1]).
     std::vector<Index> springAdr;
     // The springs again, grouped for the vector full step (spring_blocks.hpp); empty when the
-    // mesh's vertex order gives too few blocks.
+    // mesh's vertex order gives too few blocks. It copies the spring constants: build models with
+    // buildPartModel, and do not edit a model's springs afterwards.
     SpringBlocks springBlocks;
 
     std::size_t massCount() const { return mass.size(); }

@@ -91,28 +91,34 @@ const char* toString(BlockKernel kernel) {
     return "?";
 }
 
+void blockForces(const SpringBlocks& blocks, const double* x, const double* v, double* f, BlockKernel kernel) {
+    switch (kernel) {
+#if defined(FLEXFIT_X86_KERNELS)
+        case BlockKernel::Avx512: blockForcesAvx512(blocks, x, v, f); return;
+        case BlockKernel::Avx2: blockForcesAvx2(blocks, x, v, f); return;
+#endif
+        default: blockForcesScalar(blocks, x, v, f); return;
+    }
+}
+
 void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel) {
     const double* x = state.positions.data()->data();
     const double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
+    blockForces(model.springBlocks, x, v, f, kernel);
     std::size_t integrated = 0;
     switch (kernel) {
 #if defined(FLEXFIT_X86_KERNELS)
         case BlockKernel::Avx512:
-            blockForcesAvx512(model.springBlocks, x, v, f);
             remainderForces(model, x, v, f, remainderForcesAvx512(model, x, v, f));
             integrated = integrateAvx512(model, update, state);
             break;
         case BlockKernel::Avx2:
-            blockForcesAvx2(model.springBlocks, x, v, f);
             remainderForces(model, x, v, f);
             integrated = integrateAvx2(model, update, state);
             break;
 #endif
-        default:
-            blockForcesScalar(model.springBlocks, x, v, f);
-            remainderForces(model, x, v, f);
-            break;
+        default: remainderForces(model, x, v, f); break;
     }
     integrateScalar(model, update, state, integrated);
 }

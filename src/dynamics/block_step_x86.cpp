@@ -167,7 +167,8 @@ FLEXFIT_AVX512 inline __m512d dot8(const Flat24& a, const Flat24& b) {
 
 FLEXFIT_AVX512 std::size_t remainder512(const PartModel& model, const double* x, const double* v, double* f) {
     const std::vector<Index>& springs = model.springBlocks.remainder;
-    if (3 * model.massCount() > std::size_t(INT32_MAX)) return 0;  // gather offsets are int32
+    if (3 * model.massCount() > std::size_t(INT32_MAX) || model.springCount() > std::size_t(INT32_MAX))
+        return 0;  // gather offsets are int32: the scalar pass does them all
     const std::size_t n = springs.size() / 8 * 8;
     for (std::size_t i = 0; i < n; i += 8) {
         alignas(32) std::int32_t e[8], a[8], b[8];
@@ -277,8 +278,9 @@ FLEXFIT_AVX2 inline Lanes4 springForces4(const Lanes4& d, const Lanes4& w, const
     const __m256d r2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d.x, d.x), _mm256_mul_pd(d.y, d.y)),
                                      _mm256_mul_pd(d.z, d.z));
     const __m256d length = _mm256_sqrt_pd(r2);
-    const __m256d inverse =
-        _mm256_and_pd(_mm256_cmp_pd(length, zero, _CMP_GT_OQ), _mm256_div_pd(_mm256_set1_pd(1.0), length));
+    const __m256d positive = _mm256_cmp_pd(length, zero, _CMP_GT_OQ);  // no 1/0: it would raise FE_DIVBYZERO
+    const __m256d inverse = _mm256_and_pd(
+        positive, _mm256_div_pd(_mm256_set1_pd(1.0), _mm256_blendv_pd(_mm256_set1_pd(1.0), length, positive)));
     const __m256d dot = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(w.x, d.x), _mm256_mul_pd(w.y, d.y)),
                                       _mm256_mul_pd(w.z, d.z));
     const __m256d magnitude =
@@ -378,36 +380,7 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
     return n;
 }
 
-FLEXFIT_AVX2 void springScales256(const double* r2, const double* dot, const double* k, const double* c,
-                                  const double* restLength, double* s) {
-    const __m256d zero = _mm256_setzero_pd();
-    for (int h = 0; h < 8; h += 4) {
-        const __m256d length = _mm256_sqrt_pd(_mm256_loadu_pd(r2 + h));
-        const __m256d inverse =
-            _mm256_and_pd(_mm256_cmp_pd(length, zero, _CMP_GT_OQ), _mm256_div_pd(_mm256_set1_pd(1.0), length));
-        const __m256d magnitude = _mm256_add_pd(
-            _mm256_mul_pd(_mm256_loadu_pd(k + h), _mm256_sub_pd(length, _mm256_loadu_pd(restLength + h))),
-            _mm256_mul_pd(_mm256_mul_pd(_mm256_loadu_pd(c + h), _mm256_loadu_pd(dot + h)), inverse));
-        _mm256_storeu_pd(s + h, _mm256_xor_pd(_mm256_mul_pd(magnitude, inverse), _mm256_set1_pd(-0.0)));
-    }
-}
-
-FLEXFIT_AVX512 void springScales512(const double* r2, const double* dot, const double* k, const double* c,
-                                    const double* restLength, double* s) {
-    _mm512_storeu_pd(s, springScale8(_mm512_loadu_pd(r2), _mm512_loadu_pd(dot), _mm512_loadu_pd(k), _mm512_loadu_pd(c),
-                                     _mm512_loadu_pd(restLength)));
-}
-
 }  // namespace
-
-void springScalesAvx2(const double* r2, const double* dot, const double* k, const double* c, const double* restLength,
-                      double* s) {
-    springScales256(r2, dot, k, c, restLength, s);
-}
-void springScalesAvx512(const double* r2, const double* dot, const double* k, const double* c, const double* restLength,
-                        double* s) {
-    springScales512(r2, dot, k, c, restLength, s);
-}
 
 void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* v, double* f) {
     blockForces256(blocks, x, v, f);

@@ -25,6 +25,10 @@ bool blockKernelAvailable(BlockKernel kernel);
 BlockKernel fastestBlockKernel();
 const char* toString(BlockKernel kernel);
 
+// The blocks' forces only, added into f (3 doubles per mass) in the order spring_blocks.hpp
+// fixes; the kernel must be available.
+void blockForces(const SpringBlocks& blocks, const double* x, const double* v, double* f, BlockKernel kernel);
+
 // Springs by blocks, the remainder, then every mass. model.springBlocks must not be empty and
 // the kernel must be available.
 void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel);
@@ -34,12 +38,6 @@ void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* 
 void blockForcesAvx512(const SpringBlocks& blocks, const double* x, const double* v, double* f);
 // Remainder springs [0, n) in order, for the largest n that is a multiple of 8; returns n.
 std::size_t remainderForcesAvx512(const PartModel& model, const double* x, const double* v, double* f);
-// s = -((k (sqrt(r2) - L) + c dot / sqrt(r2)) / sqrt(r2)) for 8 lanes (arrays of 8), as
-// detail::springForce: the active-region step batches its springs' square roots and divides.
-void springScalesAvx2(const double* r2, const double* dot, const double* k, const double* c,
-                      const double* restLength, double* s);
-void springScalesAvx512(const double* r2, const double* dot, const double* k, const double* c,
-                        const double* restLength, double* s);
 // Integrates masses [0, n) for the largest n that is a multiple of the width; returns n.
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state);
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state);
