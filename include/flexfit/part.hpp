@@ -177,6 +177,7 @@ private:
 
     void markChanged(Index mass);
     void markAllChanged();
+    bool everyMassMoves() const { return moving_.size() == model_->massCount(); }
 };
 
 }  // namespace flexfit

@@ -106,20 +106,15 @@ void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartStat
     const double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
     blockForces(model.springBlocks, x, v, f, kernel);
-    std::size_t integrated = 0;
-    switch (kernel) {
+    std::size_t gathered = 0, integrated = 0;  // what the vector kernels did; scalar passes finish
 #if defined(FLEXFIT_X86_KERNELS)
-        case BlockKernel::Avx512:
-            remainderForces(model, x, v, f, remainderForcesAvx512(model, x, v, f));
-            integrated = integrateAvx512(model, update, state);
-            break;
-        case BlockKernel::Avx2:
-            remainderForces(model, x, v, f);
-            integrated = integrateAvx2(model, update, state);
-            break;
+    if (kernel == BlockKernel::Avx512) gathered = remainderForcesAvx512(model, x, v, f);
 #endif
-        default: remainderForces(model, x, v, f); break;
-    }
+    remainderForces(model, x, v, f, gathered);
+#if defined(FLEXFIT_X86_KERNELS)
+    if (kernel == BlockKernel::Avx512) integrated = integrateAvx512(model, update, state);
+    if (kernel == BlockKernel::Avx2) integrated = integrateAvx2(model, update, state);
+#endif
     integrateScalar(model, update, state, integrated);
 }
 

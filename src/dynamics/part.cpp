@@ -235,7 +235,7 @@ SimulationSettings Part::partFrameSettings() const {
 
 void Part::stepRegion(StepCounters* counters) {
     const SimulationSettings s = partFrameSettings();
-    if (moving_.size() == model_->massCount() && settings_.zones.fullSweepWhenComplete) {
+    if (everyMassMoves() && settings_.zones.fullSweepWhenComplete) {
         stepFullModel(*model_, s, {}, state_, counters);
         return;
     }
@@ -249,7 +249,7 @@ void Part::step(StepCounters* counters) {
         return;
     }
     stepRegion(counters);
-    if (moving_.size() == model_->massCount())
+    if (everyMassMoves())
         markAllChanged();
     else
         for (Index m : moving_) markChanged(m);

@@ -4,13 +4,13 @@
 #include "dynamics/full_step.hpp"
 #include "flexfit/flexfit.hpp"
 #include "naive_from_mesh.hpp"
+#include "shuffled_mesh.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
 #include <iostream>
-#include <numeric>
 #include <random>
 
 using namespace flexfit;
@@ -186,16 +186,7 @@ TEST(BlockStep, StepFullModelTakesBlocksWhenTheModelHasThem) {
     EXPECT_EQ(counters.springsEvaluated, 20 * rows->springCount());
     EXPECT_EQ(counters.massesIntegrated, 20 * rows->massCount());
     // No useful vertex order: the sweep.
-    TriMesh scrambled = makeTorus1();
-    std::vector<Index> order(scrambled.vertices.size());
-    std::iota(order.begin(), order.end(), Index{0});
-    std::shuffle(order.begin(), order.end(), std::mt19937(8));
-    std::vector<Vec3> vertices(order.size());
-    for (std::size_t v = 0; v < order.size(); ++v) vertices[order[v]] = scrambled.vertices[v];
-    for (Face& f : scrambled.faces)
-        for (Index& v : f) v = order[v];
-    scrambled.vertices = vertices;
-    const auto unordered = buildPartModel(scrambled);
+    const auto unordered = buildPartModel(flexfit::testing::shuffledVertices(makeTorus1(), 8));
     ASSERT_TRUE(unordered->springBlocks.empty());
     PartState apiState = kickedState(*unordered, 2), sweepState = apiState;
     for (int step = 0; step < 20; ++step) {

@@ -1,14 +1,13 @@
 // buildSpringBlocks against brute force: every spring in exactly one place, each lane the spring
 // it claims to be, blocks only where the vertex order gives them.
 #include "flexfit/flexfit.hpp"
+#include "shuffled_mesh.hpp"
 #include "unit_cube.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <map>
-#include <numeric>
-#include <random>
 
 using namespace flexfit;
 
@@ -41,19 +40,6 @@ void expectEverySpringOnceWithItsConstants(const PartModel& model) {
     EXPECT_TRUE(std::is_sorted(blocks.remainder.begin(), blocks.remainder.end()));
     for (Index e : blocks.remainder) ++seen[e];
     for (std::size_t e = 0; e < seen.size(); ++e) EXPECT_EQ(seen[e], 1) << "spring " << e;
-}
-
-// The same surface with its vertices in random order.
-TriMesh shuffled(TriMesh mesh, unsigned seed) {
-    std::vector<Index> newIndex(mesh.vertices.size());
-    std::iota(newIndex.begin(), newIndex.end(), Index{0});
-    std::shuffle(newIndex.begin(), newIndex.end(), std::mt19937(seed));
-    std::vector<Vec3> vertices(mesh.vertices.size());
-    for (std::size_t v = 0; v < vertices.size(); ++v) vertices[newIndex[v]] = mesh.vertices[v];
-    for (Face& f : mesh.faces)
-        for (Index& v : f) v = newIndex[v];
-    mesh.vertices = std::move(vertices);
-    return mesh;
 }
 
 }  // namespace
@@ -103,8 +89,8 @@ TEST(SpringBlocks, BlocksAreMaximalRunsCutIntoEights) {
 }
 
 TEST(SpringBlocks, ShuffledVerticesAndSmallMeshesKeepTheSweep) {
-    EXPECT_TRUE(buildPartModel(shuffled(makeTorus1(), 3))->springBlocks.empty());
-    EXPECT_TRUE(buildPartModel(shuffled(makeHeart(), 4))->springBlocks.empty());
+    EXPECT_TRUE(buildPartModel(flexfit::testing::shuffledVertices(makeTorus1(), 3))->springBlocks.empty());
+    EXPECT_TRUE(buildPartModel(flexfit::testing::shuffledVertices(makeHeart(), 4))->springBlocks.empty());
     const auto cube = buildPartModel(flexfit::testing::unitCube());
     EXPECT_TRUE(cube->springBlocks.empty());
     EXPECT_TRUE(cube->springBlocks.remainder.empty());
