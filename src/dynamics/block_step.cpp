@@ -1,10 +1,14 @@
 // The spring-block full step: dispatch, the scalar kernel and the shared scalar passes.
 #include "full_step.hpp"
 
+#include <optional>
+
 namespace flexfit::detail {
 namespace {
 
 constexpr std::size_t W = SpringBlocks::kWidth;
+
+std::optional<BlockKernel> chosenKernel;  // ScopedBlockKernel
 
 void blockForcesScalar(const SpringBlocks& blocks, const double* x, const double* v, double* f) {
     double carry[3] = {0.0, 0.0, 0.0};  // g_7 of the previous offset-1 block
@@ -81,6 +85,11 @@ BlockKernel fastestBlockKernel() {
                                                                 : BlockKernel::Scalar;
     return best;
 }
+
+BlockKernel fullStepKernel() { return chosenKernel.value_or(fastestBlockKernel()); }
+
+ScopedBlockKernel::ScopedBlockKernel(BlockKernel kernel) { chosenKernel = kernel; }
+ScopedBlockKernel::~ScopedBlockKernel() { chosenKernel.reset(); }
 
 const char* toString(BlockKernel kernel) {
     switch (kernel) {

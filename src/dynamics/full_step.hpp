@@ -23,6 +23,17 @@ enum class BlockKernel { Scalar, Avx2, Avx512 };
 bool blockKernelAvailable(BlockKernel kernel);
 // The widest available kernel, resolved once.
 BlockKernel fastestBlockKernel();
+// The kernel stepFullModel uses: the fastest, unless a ScopedBlockKernel chose another.
+BlockKernel fullStepKernel();
+// Tests: every full step in this scope runs `kernel` (which must be available), so a whole
+// scene can be checked with each kernel. Not thread-safe; scopes must not overlap.
+class ScopedBlockKernel {
+public:
+    explicit ScopedBlockKernel(BlockKernel kernel);
+    ~ScopedBlockKernel();
+    ScopedBlockKernel(const ScopedBlockKernel&) = delete;
+    ScopedBlockKernel& operator=(const ScopedBlockKernel&) = delete;
+};
 const char* toString(BlockKernel kernel);
 
 // The blocks' forces only, added into f (3 doubles per mass) in the order spring_blocks.hpp

@@ -68,7 +68,7 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings, s
     if (model.springBlocks.empty())
         detail::sweepFullModel(model, update, state);
     else
-        detail::stepSpringBlocks(model, update, state, detail::fastestBlockKernel());
+        detail::stepSpringBlocks(model, update, state, detail::fullStepKernel());
     state.time += settings.timeStep;
     ++state.stepCount;
     if (counters != nullptr) {

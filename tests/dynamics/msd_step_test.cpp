@@ -1,7 +1,9 @@
 // stepFullModel against independent references: the analytic damped oscillator, conservation
 // laws, and the thesis-style naive implementation (tests/support/naive_msd.hpp).
 #include "flexfit/flexfit.hpp"
+#include "golden.hpp"
 #include "naive_from_mesh.hpp"
+#include "shuffled_mesh.hpp"
 
 #include <gtest/gtest.h>
 
@@ -241,4 +243,61 @@ TEST(MsdStep, SettingsValidation) {
     s = {};
     s.gravity = Vec3(0, INFINITY, 0);
     EXPECT_THROW(validateSettings(s), InputError);
+}
+
+// --- Pinned hashes (golden.hpp) ---
+
+namespace {
+
+struct FullStepCase {
+    const char* name;
+    std::shared_ptr<const PartModel> model;
+    SimulationSettings settings;
+    std::uint64_t golden;
+};
+
+// 300 steps with a load on three masses for the first 100 and an initial twist: every spring
+// stretches, the restoration acts, and the load's release is in the run.
+std::uint64_t fullStepRun(const PartModel& model, const SimulationSettings& settings) {
+    PartState state = PartState::atRest(model);
+    for (Index m = 0; m < model.massCount(); ++m) state.velocities[m] = 0.05 * model.restPositions[m].cross(Vec3::UnitY());
+    for (int step = 0; step < 300; ++step) {
+        const std::vector<PointLoad> loads = {{3, Vec3(0.4, -0.2, 0.1)}, {Index(model.massCount() / 2), Vec3(-0.3, 0.5, 0.0)},
+                                              {Index(model.massCount() - 1), Vec3(0.0, 0.0, 0.7)}};
+        stepFullModel(model, settings, step < 100 ? std::span<const PointLoad>(loads) : std::span<const PointLoad>(), state);
+    }
+    return stateHash(state);
+}
+
+SimulationSettings anchorsExplicit() {
+    SimulationSettings s;
+    s.integrator = Integrator::ExplicitEuler;
+    s.restoration.method = RestorationMethod::AnchorSprings;
+    s.restoration.anchorStiffness = 0.5;
+    s.restoration.anchorDamping = 0.05;
+    s.globalDamping = 0.02;
+    s.gravity = Vec3(0.0, -9.81, 0.0);
+    return s;
+}
+
+}  // namespace
+
+TEST(MsdStep, GoldenHashOfTheFullStepInEveryKernel) {
+    const auto torus2 = buildPartModel(makeTorus2());
+    const auto heart = buildPartModel(makeHeart());
+    const auto shuffled = buildPartModel(flexfit::testing::shuffledVertices(makeTorus2(), 11));
+    ASSERT_FALSE(torus2->springBlocks.empty());
+    ASSERT_TRUE(shuffled->springBlocks.empty());  // the per-mass sweep
+    const std::vector<FullStepCase> cases = {
+        {"torus2 blocks, constraint", torus2, SimulationSettings{}, 0x3574bd4878f369c6ull},
+        {"torus2 blocks, anchors explicit", torus2, anchorsExplicit(), 0x6c6e8bac0d8ac948ull},
+        {"heart blocks, constraint", heart, SimulationSettings{}, 0x408965384e5fa52full},
+        {"shuffled torus2 sweep, anchors explicit", shuffled, anchorsExplicit(), 0x77590df23126cbe0ull},
+    };
+    for (const auto kernel : flexfit::testing::availableBlockKernels()) {
+        const detail::ScopedBlockKernel chosen(kernel);
+        for (const FullStepCase& c : cases)
+            EXPECT_EQ(flexfit::testing::hex(fullStepRun(*c.model, c.settings)), flexfit::testing::hex(c.golden))
+                << c.name << ", kernel " << detail::toString(kernel);
+    }
 }

@@ -1,6 +1,7 @@
 // Rigid-deformable parts: zones against brute-force k-rings and spring sets, counters against
 // the active region, frame invariance, retirement, and equivalence with the full MSD model.
 #include "flexfit/flexfit.hpp"
+#include "golden.hpp"
 
 #include <gtest/gtest.h>
 
@@ -308,4 +309,43 @@ TEST(Part, ChangedMassesAreTheMovedOnesAndEveryMassWhenAllMove) {
     EXPECT_TRUE(part.changedMasses().empty());
     part.step();
     EXPECT_EQ(part.changedMasses().size(), model->massCount());
+}
+
+// --- Pinned hashes (golden.hpp) ---
+
+TEST(Part, GoldenHashUnderLoad) {
+    // Zones opened by a face and by forces, grown, a rigid turn each step, the load released and
+    // every zone retired by the end: the whole zone lifecycle in one hash.
+    const auto model = buildPartModel(makeTorus2(), {Material::rigid(), 1.0, {}, {}});
+    PartSettings settings = zoneSettings();
+    settings.simulation.restoration = {RestorationMethod::AnchorSprings, 2.0, 0.5, 0.05};
+    Part part(model, settings);
+    const ZoneId zone = part.openZone(ZoneSeed::face(17), 3);
+    for (int i = 0; i < 12000; ++i) {
+        if (i < 400) part.applyForce(900, Vec3(0.2, 0.1, 0));
+        if (i < 250) part.applyForce(1500, Vec3(0.0, -0.3, 0.1));
+        if (i == 100) part.setZoneLevel(zone, 5);
+        part.rotate(Vec3::UnitY(), 1e-3);
+        part.step();
+        if (i != 999) continue;
+        EXPECT_GT(part.movingMasses().size(), 0u);
+        EXPECT_EQ(flexfit::testing::hex(stateHash(part.state())), "abf43bf7d128b97f") << "deformed, at 1 s";
+    }
+    EXPECT_EQ(part.zoneCount(), 0u);
+    EXPECT_EQ(flexfit::testing::hex(stateHash(part.state())), "9c2a1c379137e0ff");
+}
+
+TEST(Part, GoldenHashOfAFullDeformablePartInEveryKernel) {
+    const auto model = buildPartModel(makeHeart());
+    PartSettings settings;
+    settings.mode = PartMode::FullDeformable;
+    for (const auto kernel : flexfit::testing::availableBlockKernels()) {
+        const detail::ScopedBlockKernel chosen(kernel);
+        Part part(model, settings);
+        for (int i = 0; i < 200; ++i) {
+            if (i < 80) part.applyForce(1234, Vec3(0.5, 0.0, -0.5));
+            part.step();
+        }
+        EXPECT_EQ(flexfit::testing::hex(stateHash(part.state())), "37242833896664d2") << detail::toString(kernel);
+    }
 }

@@ -2,6 +2,7 @@
 // target), the thesis's ball-through-torus cases with the shipped example scene, and
 // determinism of a whole scene run.
 #include "flexfit/scene.hpp"
+#include "golden.hpp"
 
 #include <gtest/gtest.h>
 
@@ -141,3 +142,42 @@ TEST(SceneRun, WholeRunIsDeterministic) {
     EXPECT_EQ(d.second, 1u);
     EXPECT_NE(d.first, a.first);
 }
+
+// --- Pinned hashes (golden.hpp): every example scene for its whole duration, with each block
+// kernel the CPU has. The same numbers as `flexfit run examples/<scene>.toml` prints. ---
+
+namespace {
+
+struct GoldenScene {
+    const char* file;
+    const char* hash;
+};
+
+const GoldenScene kGoldenScenes[] = {
+    {"ball_torus.toml", "8ed71ef566397074"},   {"ball_torus_haptic.toml", "d33c4367fe205d20"},
+    {"ball_torus_rigid.toml", "d4b63ce728b38f4d"}, {"contact.toml", "391238feb38a73f9"},
+    {"restoration.toml", "2bc6f95d3b2e0cfe"},  {"snap_vector.toml", "9ae6d4634631f9cc"},
+    {"zones.toml", "8256e010fa0e79ca"},
+};
+
+void PrintTo(const GoldenScene& scene, std::ostream* out) { *out << scene.file; }
+
+class GoldenSceneRun : public ::testing::TestWithParam<GoldenScene> {};
+
+}  // namespace
+
+TEST_P(GoldenSceneRun, GoldenHashWithEveryKernel) {
+    const Scene scene = exampleScene(GetParam().file);
+    for (const auto kernel : flexfit::testing::availableBlockKernels()) {
+        const detail::ScopedBlockKernel chosen(kernel);
+        SceneRun run(scene);
+        runFor(run, scene.duration);
+        EXPECT_EQ(flexfit::testing::hex(run.world().stateHash()), GetParam().hash) << detail::toString(kernel);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Examples, GoldenSceneRun, ::testing::ValuesIn(kGoldenScenes), [](const auto& param) {
+    std::string name = param.param.file;
+    name = name.substr(0, name.find('.'));
+    return name;
+});

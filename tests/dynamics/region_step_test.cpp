@@ -1,0 +1,137 @@
+// stepActiveRegion (src/dynamics/region_step.cpp) against the naive reference with every mass
+// outside the region pinned, and its pinned hash.
+#include "flexfit/flexfit.hpp"
+#include "golden.hpp"
+#include "naive_from_mesh.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace flexfit;
+
+namespace {
+
+// A region as a part builds it: masses in the order given, and with each mass the springs
+// touching it that are not yet computed, in the topology's order.
+struct Region {
+    std::vector<Index> moving, computed;
+    std::vector<std::uint16_t> mask;
+};
+
+Region regionOf(const PartModel& model, const std::vector<Index>& masses) {
+    Region r;
+    r.mask.assign(model.massCount(), 0);
+    std::vector<char> counted(model.springCount(), 0);
+    for (Index m : masses) {
+        r.moving.push_back(m);
+        r.mask[m] = 1;
+        for (Index e : model.topology.edgesOf(m))
+            if (!counted[e]) {
+                counted[e] = 1;
+                r.computed.push_back(e);
+            }
+    }
+    return r;
+}
+
+// Masses 100-159 (a band across the tube) and every seventh mass: several pieces, and springs
+// with one end fixed as well as two moving ends.
+std::vector<Index> scatteredMasses(const PartModel& model) {
+    std::vector<Index> masses;
+    for (Index m = 100; m < 160; ++m) masses.push_back(m);
+    for (Index m = 3; m < model.massCount(); m += 7)
+        if (m < 100 || m >= 160) masses.push_back(m);
+    return masses;
+}
+
+SimulationSettings noRestoration() {
+    SimulationSettings s;
+    s.restoration.method = RestorationMethod::None;
+    s.gravity = Vec3(0.0, -9.81, 0.0);
+    s.globalDamping = 0.03;
+    return s;
+}
+
+}  // namespace
+
+namespace {
+
+// One step of the naive model by hand (its Model::step puts gravity on every mass; here the
+// pinned masses of 1e300 kg must not feel it), with an external force on one mass.
+void naiveStep(naive::Model& model, const std::vector<std::uint16_t>& moving, double dt, double gravityY, double drag,
+               int loaded, const naive::Vector3D& load) {
+    for (int i = 0; i < model.numOfMasses; ++i) model.masses[i]->init();
+    for (int s = 0; s < model.numOfSprings; ++s) model.springs[s]->solve();
+    for (int i = 0; i < model.numOfMasses; ++i) {
+        naive::Mass& m = *model.masses[i];
+        if (moving[std::size_t(i)] != 0) m.applyForce(naive::Vector3D(0.0, gravityY * m.mass, 0.0));
+        m.applyForce(-m.velocity * drag);
+    }
+    model.masses[loaded]->applyForce(load);
+    for (int i = 0; i < model.numOfMasses; ++i) model.masses[i]->simulate(dt);
+}
+
+}  // namespace
+
+TEST(RegionStep, MatchesTheNaiveReferenceWithEveryOtherMassPinned) {
+    // The naive model shares no code with the library: masses outside the region get a mass of
+    // 1e300, so they feel their springs but do not move, which is what the region step assumes.
+    const TriMesh mesh = makeTorus1();
+    const auto model = buildPartModel(mesh, {Material{0.8, 0.05}, 1.0, {}, {}});
+    const Region region = regionOf(*model, scatteredMasses(*model));
+    const auto reference = naive::modelFromMesh(mesh, 1.0, 0.8, 0.05);
+    for (Index m = 0; m < model->massCount(); ++m)
+        if (region.mask[m] == 0) reference->masses[m]->mass = 1e300;
+    PartState state = PartState::atRest(*model);
+    const SimulationSettings settings = noRestoration();
+    for (int step = 0; step < 500; ++step) {
+        const Vec3 load = step < 200 ? Vec3(0.0, 2.0, 0.5) : Vec3::Zero();
+        state.forces[120] += load;
+        stepActiveRegion(*model, settings, region.moving, region.computed, region.mask, state);
+        naiveStep(*reference, region.mask, settings.timeStep, settings.gravity.y(), settings.globalDamping, 120,
+                  naive::Vector3D(load.x(), load.y(), load.z()));
+    }
+    double worst = 0.0;
+    for (Index m = 0; m < model->massCount(); ++m) {
+        const naive::Vector3D& p = reference->masses[m]->position;
+        worst = std::max(worst, (state.positions[m] - Vec3(p.x, p.y, p.z)).norm());
+    }
+    EXPECT_GT((state.positions[120] - model->restPositions[120]).norm(), 0.01);  // it moved
+    EXPECT_LT(worst, 1e-9);
+    for (Index m = 0; m < model->massCount(); ++m) {
+        if (region.mask[m] != 0) continue;
+        ASSERT_EQ(state.positions[m], model->restPositions[m]) << "mass " << m;
+    }
+}
+
+TEST(RegionStep, CostsTheRegionAndConsumesItsForces) {
+    const auto model = buildPartModel(makeTorus2());
+    const Region region = regionOf(*model, scatteredMasses(*model));
+    PartState state = PartState::atRest(*model);
+    state.forces[120] = Vec3(1.0, 0.0, 0.0);
+    StepCounters counters;
+    stepActiveRegion(*model, SimulationSettings{}, region.moving, region.computed, region.mask, state, &counters);
+    EXPECT_EQ(counters.springsEvaluated, region.computed.size());
+    EXPECT_EQ(counters.massesIntegrated, region.moving.size());
+    EXPECT_EQ(state.forces[120], Vec3::Zero());
+    EXPECT_EQ(state.stepCount, 1u);
+}
+
+TEST(RegionStep, GoldenHash) {
+    const auto model = buildPartModel(makeTorus2());
+    const Region region = regionOf(*model, scatteredMasses(*model));
+    const auto run = [&](const SimulationSettings& settings) {
+        PartState state = PartState::atRest(*model);
+        for (int step = 0; step < 400; ++step) {
+            if (step < 150) state.forces[120] += Vec3(0.3, 0.6, -0.2);
+            if (step < 150) state.forces[3] += Vec3(-0.5, 0.0, 0.25);
+            stepActiveRegion(*model, settings, region.moving, region.computed, region.mask, state);
+        }
+        return flexfit::testing::hex(stateHash(state));
+    };
+    SimulationSettings anchors;
+    anchors.integrator = Integrator::ExplicitEuler;
+    anchors.restoration.method = RestorationMethod::AnchorSprings;
+    anchors.restoration.anchorStiffness = 0.4;
+    EXPECT_EQ(run(SimulationSettings{}), "8ec3b0bc2127c984") << "constraint, semi-implicit";
+    EXPECT_EQ(run(anchors), "568db3cb61fd5fea") << "anchors, explicit";
+}
