@@ -175,7 +175,7 @@ void BM_BroadPhase(benchmark::State& state) {
     for (int i = 0; i < 200; ++i) {
         parts.push_back(std::make_unique<Part>(model));
         parts.back()->translate(Vec3(i % 10, (i / 10) % 10, i / 100) * 2.5);
-        world.add(*parts.back());
+        world.add(BodyId(parts.size() - 1), *parts.back());
     }
     std::size_t pairs = 0;
     double t = 0.0;

@@ -3,7 +3,8 @@
 // the scene, runs it (untimed) to `settle` steps after the first contact, then times
 // kTimedSteps steps in contact. Counters: steps_per_s (in contact), contacts, moving masses,
 // and the mean per-stage time in microseconds (the world's own profile over the timed steps).
-#include "flexfit/scene.hpp"
+#include "flexfit/scene_file.hpp"
+#include "flexfit/scene_run.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -10,6 +10,12 @@
 #include <sstream>
 
 namespace flexfit::cli {
+
+void warn(const std::string& text) { fmt::print(stderr, "warning: {}\n", text); }
+
+void printWarnings(const Scene& scene) {
+    for (const SceneWarning& w : scene.warnings) warn(fmt::format("{}:{}: {}", scene.source, w.line, w.message));
+}
 namespace {
 
 double parseNumber(std::string_view token, const std::string& option, const std::string& whole) {

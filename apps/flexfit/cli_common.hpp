@@ -5,6 +5,7 @@
 #include "flexfit/flexfit.hpp"
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,27 @@ PointLoad parseLoad(const std::string& text, const std::string& option);
 // "MASS@LEVEL" or "face:F@LEVEL" -> zone request; throws InputError naming `option`.
 struct ZoneRequest;
 ZoneRequest parseZone(const std::string& text, const std::string& option);
+
+// "warning: <text>" on stderr.
+void warn(const std::string& text);
+// Prints a scene's warnings (old spellings) on stderr, with the file and line.
+void printWarnings(const Scene& scene);
+
+// The value of an option that names an enum (names.hpp). Old spellings are accepted with a
+// warning on stderr that names the new one; anything else throws InputError naming `option`.
+template <class Enum>
+Enum enumOption(const std::string& text, const std::string& option) {
+    std::string replacement;
+    const std::optional<Enum> value = parseName<Enum>(text, &replacement);
+    if (!value) throw InputError(option, 0, "unknown value '" + text + "' (expected one of " + nameList<Enum>() + ")");
+    if (!replacement.empty()) warn(option + ": " + deprecationWarning(text, replacement));
+    return *value;
+}
+// The names an enum option accepts (old spellings included), for CLI11's IsMember check.
+template <class Enum>
+std::vector<std::string> enumChoices() {
+    return allNames<Enum>(true);
+}
 
 // Reads any supported mesh and prints its warnings to stderr.
 MeshReadResult loadMesh(const std::filesystem::path& path, double weldTolerance = 0.0);

@@ -33,8 +33,8 @@ Pose parsePose(const std::string& translation, const std::string& rotation, cons
 }
 
 void run(const CollideOptions& opt) {
-    const BoundingVolumeKind kind = opt.bv == "sphere" ? BoundingVolumeKind::Sphere : BoundingVolumeKind::Aabb;
-    const ExactTest test = opt.test == "sphere" ? ExactTest::SphereTriangle : ExactTest::TriangleTriangle;
+    const BoundingVolumeKind kind = enumOption<BoundingVolumeKind>(opt.bv, "option --bv");
+    const ExactTest test = enumOption<ExactTest>(opt.test, "option --test");
     PartSettings rigid;
     rigid.mode = PartMode::Rigid;
     Part a(buildPartModel(loadMesh(opt.a).mesh), rigid), b(buildPartModel(loadMesh(opt.b).mesh), rigid);
@@ -89,10 +89,10 @@ void registerCollide(CLI::App& app) {
     cmd->add_option("--rotate-a", opt->rotateA, "Rotation of A: axis and degrees ax,ay,az,deg");
     cmd->add_option("--pose-b", opt->translateB, "Translation x,y,z of B")->capture_default_str();
     cmd->add_option("--rotate-b", opt->rotateB, "Rotation of B: axis and degrees ax,ay,az,deg");
-    cmd->add_option("--bv", opt->bv, "Bounding volume of the face hierarchies")->check(CLI::IsMember({"sphere", "aabb"}))
+    cmd->add_option("--bv", opt->bv, "Bounding volume of the face hierarchies")->check(CLI::IsMember(enumChoices<BoundingVolumeKind>()))
         ->capture_default_str();
     cmd->add_option("--test", opt->test, "Exact test: triangle (triangle-triangle) or sphere (thesis: sphere-triangle)")
-        ->check(CLI::IsMember({"triangle", "sphere"}))->capture_default_str();
+        ->check(CLI::IsMember(enumChoices<ExactTest>()))->capture_default_str();
     cmd->add_flag("--json", opt->json, "Print one JSON object with every contact");
     cmd->add_option("--max", opt->maxPrint, "Contacts listed in the text output")->check(CLI::NonNegativeNumber)->capture_default_str();
     cmd->callback([opt] { run(*opt); });

@@ -1,4 +1,5 @@
 // flexfit run SCENE: a scene file run headless, its metrics written for analysis.
+#include "cli_common.hpp"
 #include "commands.hpp"
 #include "scene_runner.hpp"
 
@@ -20,6 +21,7 @@ void registerRun(CLI::App& app) {
     cmd->add_flag("--no-progress", opt->noProgress, "No progress bar");
     cmd->callback([opt] {
         const Scene scene = loadScene(opt->scene);
+        printWarnings(scene);
         RunOptions options;
         if (opt->duration > 0.0) options.duration = opt->duration;
         options.out = opt->out;
@@ -30,12 +32,12 @@ void registerRun(CLI::App& app) {
         if (s.contactSteps) fmt::print("; in contact {} steps at {:.0f} steps/s", s.contactSteps, double(s.contactSteps) / s.contactWallSeconds);
         fmt::print("\n  max contacts {}, zones {}, moving masses {}, computed springs {}, deformation {:.4g}\n", s.maxContacts, s.maxZones,
                    s.maxMovingMasses, s.maxComputedSprings, s.maxDeformation);
-        fmt::print("  per step (mean, us):");
-        for (int i = 0; i < int(Stage::Count); ++i)
-            fmt::print(" {} {:.1f};", toString(Stage(i)), 1e6 * s.profile.totalSeconds[std::size_t(i)] / double(std::max<std::uint64_t>(1, s.steps)));
+        const double perStep = 1e6 / double(std::max<std::uint64_t>(1, s.steps));
+        fmt::print("  per step (mean, us): world step {:.1f} =", perStep * s.profile.totalStepSeconds);
+        for (std::size_t i = 0; i < kStageCount; ++i) fmt::print(" {} {:.1f};", labelOf(Stage(i)), perStep * s.profile.totalSeconds[i]);
         fmt::print("\n");
         for (const AssemblyEvent& e : s.events)
-            fmt::print("  assembled: '{}' by {} at t = {:.3f} s\n", e.rule, toString(e.technique), e.time);
+            fmt::print("  assembled: '{}' by {} at t = {:.3f} s\n", e.rule, labelOf(e.technique), e.time);
         fmt::print("  state hash {:016x}\n", s.stateHash);
     });
 }

@@ -24,7 +24,7 @@ struct SimulateOptions {
     std::vector<double> objTimes;
     std::string objPrefix = "frame";
     bool untilRestored = false;
-    std::string mode = "full";
+    std::string mode = "full-deformable";
     std::vector<std::string> zones;
     int defaultLevel = 2;
 };
@@ -59,7 +59,7 @@ void run(const SimulateOptions& opt) {
     PerturbationConfig config;
     config.model = buildPartModel(read.mesh, opt.sim.modelSettings());
     config.part.simulation = opt.sim.simulationSettings(*config.model);
-    config.part.mode = opt.mode == "rigid" ? PartMode::Rigid : opt.mode == "full" ? PartMode::FullDeformable : PartMode::RigidDeformable;
+    config.part.mode = enumOption<PartMode>(opt.mode, "option --mode");
     config.part.zones.defaultLevel = opt.defaultLevel;
     config.part.zones.activityThreshold = opt.thresholds.empty() ? 0.01 : opt.thresholds.front();
     for (const std::string& z : opt.zones) config.zones.push_back(parseZone(z, "--zone"));
@@ -117,17 +117,17 @@ void registerSimulate(CLI::App& app) {
     auto* cmd = app.add_subcommand("simulate", "Simulate a full-deformable part under point loads");
     auto opt = std::make_shared<SimulateOptions>();
     cmd->add_option("file", opt->file, "Mesh file")->required();
-    cmd->footer("In --mode zones, a force on a mass no zone covers opens a zone there at --level; zones retire once\n"
+    cmd->footer("In --mode rigid-deformable, a force on a mass no zone covers opens a zone there at --level; zones retire once\n"
                 "their springs are inactive at the first --threshold and their masses at rest.");
     opt->sim.addTo(*cmd);
     cmd->add_option("--force", opt->forces, "Point load MASS:FX,FY,FZ (repeatable)");
     cmd->add_option("--force-duration", opt->forceDuration, "Seconds the loads act before release")->capture_default_str();
     cmd->add_option("--duration", opt->duration, "Simulated seconds")->check(CLI::PositiveNumber)->capture_default_str();
     cmd->add_option("--threshold", opt->thresholds, "Activity thresholds (length units)")->capture_default_str();
-    cmd->add_option("--mode", opt->mode, "rigid (never deforms), zones (rigid-deformable), full (whole-mesh MSD)")
-        ->check(CLI::IsMember({"rigid", "zones", "full"}))->capture_default_str();
-    cmd->add_option("--zone", opt->zones, "Zone MASS@LEVEL or face:F@LEVEL opened at the start (repeatable, --mode zones)");
-    cmd->add_option("--level", opt->defaultLevel, "Level of zones opened by forces (--mode zones)")
+    cmd->add_option("--mode", opt->mode, "rigid (never deforms), rigid-deformable (zones), full-deformable (whole-mesh MSD)")
+        ->check(CLI::IsMember(enumChoices<PartMode>()))->capture_default_str();
+    cmd->add_option("--zone", opt->zones, "Zone MASS@LEVEL or face:F@LEVEL opened at the start (repeatable, --mode rigid-deformable)");
+    cmd->add_option("--level", opt->defaultLevel, "Level of zones opened by forces (--mode rigid-deformable)")
         ->check(CLI::Range(1, 255))->capture_default_str();
     cmd->add_flag("--until-restored", opt->untilRestored, "Stop once every threshold has restored after the release");
     cmd->add_option("--csv", opt->csv, "Per-step metrics CSV");

@@ -40,11 +40,8 @@ double deformation(const Part& part) {
 
 std::string csvHeader(const Scene& scene) {
     std::string h = "time,contacts,zones,moving_masses,computed_springs,coupling_fx,coupling_fy,coupling_fz,coupling_tx,coupling_ty,coupling_tz";
-    for (int s = 0; s < int(Stage::Count); ++s) {
-        std::string name = toString(Stage(s));
-        std::replace(name.begin(), name.end(), ' ', '_');
-        h += ",us_" + name;
-    }
+    for (std::size_t s = 0; s < kStageCount; ++s) h += std::string(",us_") + toString(Stage(s));
+    h += ",us_world_step";
     for (const ScenePart& p : scene.parts) {
         if (p.body.motion != MotionType::Static) h += "," + p.name + "_x," + p.name + "_y," + p.name + "_z";
         if (p.part.mode != PartMode::Rigid) h += "," + p.name + "_deformation";
@@ -58,6 +55,7 @@ std::string csvRow(const Scene& scene, const World& w) {
                                   movingMasses(w), computedSprings(w), c.force.x(), c.force.y(), c.force.z(), c.torque.x(),
                                   c.torque.y(), c.torque.z());
     for (double s : w.profile().lastSeconds) row += fmt::format(",{:.3f}", s * 1e6);
+    row += fmt::format(",{:.3f}", w.profile().lastStepSeconds * 1e6);
     for (BodyId id = 0; id < scene.parts.size(); ++id) {
         if (scene.parts[id].body.motion != MotionType::Static) {
             const Vec3 p = w.centreOfMass(id);
@@ -160,9 +158,10 @@ std::string summaryJson(const Scene& scene, const RunSummary& s) {
                      s.maxContacts, s.maxZones, s.maxMovingMasses, s.maxComputedSprings);
     j += fmt::format("  \"max_deformation\": {:.9g},\n  \"last_contact\": {},\n  \"restored_at\": {},\n  \"max_coupling_force\": {:.9g},\n",
                      s.maxDeformation, optionalJson(s.lastContact), optionalJson(s.restored), s.maxCouplingForce);
-    j += fmt::format("  \"substeps\": {},\n  \"stage_seconds\": {{", s.profile.substeps);
-    for (int i = 0; i < int(Stage::Count); ++i)
-        j += fmt::format("{}{}: {:.6f}", i ? ", " : "", jsonString(toString(Stage(i))), s.profile.totalSeconds[std::size_t(i)]);
+    j += fmt::format("  \"substeps\": {},\n  \"world_step_seconds\": {:.9f},\n  \"stage_seconds\": {{", s.profile.substeps,
+                     s.profile.totalStepSeconds);
+    for (std::size_t i = 0; i < kStageCount; ++i)
+        j += fmt::format("{}{}: {:.9f}", i ? ", " : "", jsonString(toString(Stage(i))), s.profile.totalSeconds[i]);
     j += "},\n  \"assembly_events\": [";
     for (std::size_t i = 0; i < s.events.size(); ++i) {
         const AssemblyEvent& e = s.events[i];

@@ -3,7 +3,8 @@
 // frames. Shared by `flexfit run` and `flexfit experiment ball-torus`.
 #pragma once
 
-#include "flexfit/scene.hpp"
+#include "flexfit/scene_file.hpp"
+#include "flexfit/scene_run.hpp"
 
 #include <filesystem>
 #include <optional>

@@ -12,16 +12,16 @@ void SimulationOptions::addTo(CLI::App& cmd) {
     cmd.add_option("--stiffness", stiffness, "Spring stiffness k (overrides the preset)")->check(CLI::NonNegativeNumber);
     cmd.add_option("--damping", damping, "Spring damping b (overrides the preset)")->check(CLI::NonNegativeNumber);
     cmd.add_option("--mass", vertexMass, "Mass of every vertex (kg)")->check(CLI::PositiveNumber)->capture_default_str();
-    cmd.add_option("--restore", restore, "Shape restoration")->check(CLI::IsMember({"none", "anchor", "constraint"}))
-        ->capture_default_str();
+    cmd.add_option("--restore", restore, "Shape restoration: " + nameList<RestorationMethod>())
+        ->check(CLI::IsMember(enumChoices<RestorationMethod>()))->capture_default_str();
     cmd.add_option("--anchor-stiffness", anchorStiffness, "Anchor spring k_a (default: the material's k)")
         ->check(CLI::NonNegativeNumber);
     cmd.add_option("--anchor-damping", anchorDamping, "Anchor spring b_a (default: the material's b)")
         ->check(CLI::NonNegativeNumber);
     cmd.add_option("--constraint-fraction", constraintFraction, "Share of the separation restored per step (0, 1]")
         ->capture_default_str();
-    cmd.add_option("--integrator", integrator, "Time integrator")
-        ->check(CLI::IsMember({"semi-implicit", "explicit"}))->capture_default_str();
+    cmd.add_option("--integrator", integrator, "Time integrator: " + nameList<Integrator>())
+        ->check(CLI::IsMember(enumChoices<Integrator>()))->capture_default_str();
     cmd.add_option("--dt", timeStep, "Time step (s)")->capture_default_str();
     cmd.add_option("--gravity", gravity, "Gravity x,y,z (m/s^2)")->capture_default_str();
     cmd.add_option("--global-damping", globalDamping, "Global damping gamma (kg/s)")->capture_default_str();
@@ -46,12 +46,10 @@ SimulationSettings SimulationOptions::simulationSettings(const PartModel& model)
     const Material m = resolvedMaterial();
     SimulationSettings s;
     s.timeStep = timeStep;
-    s.integrator = integrator == "explicit" ? Integrator::ExplicitEuler : Integrator::SemiImplicitEuler;
+    s.integrator = enumOption<Integrator>(integrator, "option --integrator");
     s.gravity = parseVec3(gravity, "--gravity");
     s.globalDamping = globalDamping;
-    s.restoration.method = restore == "none"     ? RestorationMethod::None
-                           : restore == "anchor" ? RestorationMethod::AnchorSprings
-                                                 : RestorationMethod::Constraint;
+    s.restoration.method = enumOption<RestorationMethod>(restore, "option --restore");
     s.restoration.anchorStiffness = anchorStiffness >= 0.0 ? anchorStiffness : m.stiffness;
     s.restoration.anchorDamping = anchorDamping >= 0.0 ? anchorDamping : m.damping;
     s.restoration.constraintFraction = constraintFraction;

@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
             const World& w = app.session().world();
             fmt::print("{}: {} frames, t = {:.3f} s, {} steps, renderer {}\n", scene, frames, w.time(), app.session().steps(), context.renderer());
             for (const AssemblyEvent& e : w.assemblyEvents())
-                fmt::print("  assembled: '{}' by {} at t = {:.3f} s\n", e.rule, toString(e.technique), e.time);
+                fmt::print("  assembled: '{}' by {} at t = {:.3f} s\n", e.rule, labelOf(e.technique), e.time);
             return EXIT_SUCCESS;
         }
         auto last = std::chrono::steady_clock::now();

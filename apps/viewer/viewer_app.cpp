@@ -15,8 +15,23 @@ namespace flexfit::viewer {
 namespace {
 
 const char* kMaterials[] = {"rigid", "elastic", "superelastic"};
-const char* kRestorations[] = {"anchor springs", "constraint", "none"};
-const RestorationMethod kMethods[] = {RestorationMethod::AnchorSprings, RestorationMethod::Constraint, RestorationMethod::None};
+
+// The restoration methods in the vocabulary's order (names.hpp), by label, for the combo box.
+const std::vector<const char*>& restorationLabels() {
+    static const std::vector<const char*> labels = [] {
+        std::vector<const char*> out;
+        for (const auto& e : enumNames<RestorationMethod>()) out.push_back(e.label);
+        return out;
+    }();
+    return labels;
+}
+RestorationMethod restorationAt(int index) { return enumNames<RestorationMethod>()[std::size_t(index)].value; }
+int restorationIndex(RestorationMethod method) {
+    const auto names = enumNames<RestorationMethod>();
+    for (std::size_t i = 0; i < names.size(); ++i)
+        if (names[i].value == method) return int(i);
+    return 0;
+}
 
 void addSegment(std::vector<LineVertex>& out, const Vec3& a, const Vec3& b, const Vec3& colour) {
     out.push_back(lineVertex(a, colour));
@@ -107,7 +122,7 @@ void App::load(const std::filesystem::path& scene) {
     for (const ScenePart& part : session_->scene().parts)
         if (part.part.mode != PartMode::Rigid) {  // the panel starts from the first deformable part
             contactLevel_ = part.part.zones.contactLevel;
-            restoration_ = int(std::find(std::begin(kMethods), std::end(kMethods), part.part.simulation.restoration.method) - std::begin(kMethods));
+            restoration_ = restorationIndex(part.part.simulation.restoration.method);
             break;
         }
 }
@@ -182,7 +197,7 @@ void App::frame(double frameSeconds) {
 }
 
 void App::drawScene() {
-    World& w = session_->world();
+    const World& w = session_->world();
     renderer_->begin(camera_, kBackground);
     std::vector<int> depths;
     std::vector<Vec3> colours;
@@ -223,8 +238,8 @@ void App::drawScene() {
     glEnable(GL_DEPTH_TEST);
 }
 
-std::vector<LineVertex> App::overlayLines() {
-    World& w = session_->world();  // the colliders refit lazily when asked for
+std::vector<LineVertex> App::overlayLines() const {
+    const World& w = session_->world();  // drawing reads the world, never changes it
     std::vector<LineVertex> lines;
     const double scale = camera_.distance * 0.02;
     if (overlays.springs)
@@ -357,14 +372,10 @@ void App::drawHud() {
     ImGui::Text("computed springs %zu", computed);
     ImGui::Text("zones %zu   contacts %zu", zones, w.contacts().size());
     ImGui::Separator();
-    double total = 0.0;
-    for (std::size_t s = 0; s < std::size_t(Stage::Count); ++s) {
-        const double us = 1e6 * w.profile().lastSeconds[s];
-        total += us;
-        ImGui::Text("%-17s %8.1f us", toString(Stage(s)), us);
-    }
-    ImGui::Text("%-17s %8.1f us", "step", total);
-    for (const AssemblyEvent& e : w.assemblyEvents()) ImGui::Text("assembled '%s' (%s) at %.3f s", e.rule.c_str(), toString(e.technique), e.time);
+    for (std::size_t s = 0; s < kStageCount; ++s) ImGui::Text("%-17s %8.1f us", labelOf(Stage(s)), 1e6 * w.profile().lastSeconds[s]);
+    ImGui::Text("%-17s %8.1f us", "step", 1e6 * w.profile().lastStepSeconds);
+    for (const AssemblyEvent& e : w.assemblyEvents())
+        ImGui::Text("assembled '%s' (%s) at %.3f s", e.rule.c_str(), labelOf(e.technique), e.time);
     if (!message_.empty()) ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "%s", message_.c_str());
     ImGui::End();
 }
@@ -425,7 +436,7 @@ void App::drawPanels() {
     if (ImGui::CollapsingHeader("Deformable parts")) {
         // Restoration and contact level change the running world; the material (the model's
         // spring constants, immutable) restarts the scene.
-        bool live = ImGui::Combo("restoration", &restoration_, kRestorations, 3);
+        bool live = ImGui::Combo("restoration", &restoration_, restorationLabels().data(), int(restorationLabels().size()));
         live |= ImGui::SliderInt("contact level", &contactLevel_, 0, 12);
         if (live) applyLiveSettings();
         ImGui::Combo("material", &material_, kMaterials, 3);
@@ -440,11 +451,11 @@ void App::applyLiveSettings() {
     for (BodyId id = 0; id < w.bodyCount(); ++id) {
         if (w.part(id).mode() == PartMode::Rigid) continue;
         PartSettings settings = w.part(id).settings();
-        settings.simulation.restoration.method = kMethods[restoration_];
+        settings.simulation.restoration.method = restorationAt(restoration_);
         settings.zones.contactLevel = contactLevel_;
         try {
             w.setPartSettings(id, settings);
-            message_ = std::string("now: ") + kRestorations[restoration_] + ", contact level " + std::to_string(contactLevel_);
+            message_ = std::string("now: ") + restorationLabels()[std::size_t(restoration_)] + ", contact level " + std::to_string(contactLevel_);
         } catch (const std::exception& e) {
             message_ = e.what();
         }
@@ -460,13 +471,14 @@ void App::applySettingsAndRestart() {
         model.material = materials[material_];
         model.vertexMasses = part.model->mass;
         part.model = buildPartModel(part.model->mesh, model);
-        part.part.simulation.restoration.method = kMethods[restoration_];
+        part.part.simulation.restoration.method = restorationAt(restoration_);
         part.part.zones.contactLevel = contactLevel_;
     }
     session_->reset();
     selection_.reset();
     rebuildMeshes();
-    message_ = std::string("restarted: ") + kMaterials[material_] + ", " + kRestorations[restoration_] + ", level " + std::to_string(contactLevel_);
+    message_ = std::string("restarted: ") + kMaterials[material_] + ", " + restorationLabels()[std::size_t(restoration_)] + ", level " +
+               std::to_string(contactLevel_);
 }
 
 void App::screenshot(const std::filesystem::path& file) {

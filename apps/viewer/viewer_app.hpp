@@ -40,7 +40,7 @@ private:
     void drawScene();
     void drawPanels();
     void drawHud();
-    std::vector<LineVertex> overlayLines();  // non-const: asking for a collider refits it
+    std::vector<LineVertex> overlayLines() const;  // reads the world, never changes it
     void applySettingsAndRestart();
     void applyLiveSettings();
 

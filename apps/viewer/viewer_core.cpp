@@ -173,16 +173,20 @@ bool SurfaceNormals::update(const Part& part) {
     if (moving.empty() && previouslyMoving_.empty()) return false;
     // A vertex's normal depends on its own position and its neighbours': the 1-ring of the
     // masses that move or have just stopped, each vertex once.
-    seeds_.assign(moving.begin(), moving.end());
-    seeds_.insert(seeds_.end(), previouslyMoving_.begin(), previouslyMoving_.end());
-    ring_.collect(part.model().topology, seeds_, 1, members_);
+    const Topology& topology = part.model().topology;
+    ring_.clear();
+    for (const std::span<const Index> seeds : {moving, std::span<const Index>(previouslyMoving_)})
+        for (Index seed : seeds) {
+            ring_.insert(seed);
+            for (Index n : topology.neighborsOf(seed)) ring_.insert(n);
+        }
     const auto& faces = part.model().mesh.faces;
-    for (const RingMember& member : members_) {
+    for (Index mass : ring_) {
         Vec3 sum = Vec3::Zero();
-        for (Index f : part.model().topology.facesOf(member.mass)) sum += faceNormalTimesTwoArea(part.state().positions, faces[f]);
-        normals_[member.mass] = sum.norm() > 0.0 ? Vec3(sum.normalized()) : Vec3(Vec3::UnitY());
+        for (Index f : topology.facesOf(mass)) sum += faceNormalTimesTwoArea(part.state().positions, faces[f]);
+        normals_[mass] = sum.norm() > 0.0 ? Vec3(sum.normalized()) : Vec3(Vec3::UnitY());
     }
-    recomputed_ = members_.size();
+    recomputed_ = ring_.size();
     previouslyMoving_.assign(moving.begin(), moving.end());
     return true;
 }

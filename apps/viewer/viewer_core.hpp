@@ -17,8 +17,8 @@
 // keyboard add operator actions on top (grab and drag, forces on selected masses).
 #pragma once
 
-#include "flexfit/kring.hpp"
-#include "flexfit/scene.hpp"
+#include "flexfit/scene_file.hpp"
+#include "flexfit/scene_run.hpp"
 
 #include <Eigen/Geometry>
 
@@ -95,9 +95,7 @@ public:
 private:
     std::vector<Vec3> normals_;
     std::vector<Index> previouslyMoving_;
-    KRingWalker ring_;                 // the 1-ring of the seeds
-    std::vector<Index> seeds_;         // scratch: moving and previously moving masses
-    std::vector<RingMember> members_;  // scratch
+    IndexSet ring_;  // (V) scratch: the moving and previously moving masses and their neighbours
     std::size_t recomputed_ = 0;
 };
 

@@ -7,12 +7,12 @@
 // after their parent, with parent links for refits.
 //
 // refit() updates the leaves of the items that changed and then only their ancestors, bottom-up
-// in order of depth, so a local deformation costs O(changed x depth), not O(items). Marks are
-// epoch-stamped: a refit allocates nothing once its scratch arrays have grown.
+// in order of depth, so a local deformation costs O(changed x depth), not O(items). The dirty
+// ancestors are a compact index set: a refit allocates nothing once it has grown.
 #pragma once
 
 #include "flexfit/bounding_volume.hpp"
-#include "flexfit/epoch_marks.hpp"
+#include "flexfit/index_set.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -52,21 +52,21 @@ public:
         std::vector<Index> items(leafVolumes.size());
         std::iota(items.begin(), items.end(), Index(0));
         buildNode(leafVolumes, items, 0, items.size(), -1, 0);
-        dirtyMarks_.reset(nodes_.size());
+        dirty_.reset(nodes_.size());
     }
 
     // Leaves of `items` get new volumes from leafVolume(item); their ancestors are refitted.
     template <class LeafVolume>
     void refit(std::span<const Index> items, LeafVolume leafVolume) {
         if (nodes_.empty()) return;
-        dirtyMarks_.clear();
         dirty_.clear();
         for (Index item : items) {
-            std::int32_t n = std::int32_t(leafOf_[item]);
-            nodes_[std::size_t(n)].volume = leafVolume(item);
+            Node& leaf = nodes_[leafOf_[item]];
+            leaf.volume = leafVolume(item);
             ++refitNodes_;
-            for (n = nodes_[std::size_t(n)].parent; n >= 0 && dirtyMarks_.insert(std::size_t(n)); n = nodes_[std::size_t(n)].parent)
-                dirty_.push_back(n);
+            // Its ancestors, up to the first one already marked (whose ancestors are marked too).
+            std::int32_t n = leaf.parent;
+            while (n >= 0 && dirty_.insert(Index(n))) n = nodes_[std::size_t(n)].parent;
         }
         // Children come after their parent in the node array: descending index is bottom-up.
         // Many dirty nodes: one backward scan of the marks beats sorting them.
@@ -76,10 +76,10 @@ public:
         };
         if (dirty_.size() * 16 > nodes_.size()) {
             for (std::size_t n = nodes_.size(); n-- > 0;)
-                if (dirtyMarks_.contains(n)) merge(n);
+                if (dirty_.contains(Index(n))) merge(n);
         } else {
-            std::sort(dirty_.begin(), dirty_.end(), std::greater<>());
-            for (std::int32_t n : dirty_) merge(std::size_t(n));
+            dirty_.sort();
+            for (std::size_t s = dirty_.size(); s-- > 0;) merge(dirty_[s]);
         }
         refitNodes_ += dirty_.size();
     }
@@ -142,8 +142,7 @@ private:
 
     std::vector<Node> nodes_;
     std::vector<Index> leafOf_;          // item -> leaf node
-    EpochMarks dirtyMarks_;              // (nodes) refit
-    std::vector<std::int32_t> dirty_;    // scratch
+    IndexSet dirty_;                     // (nodes) ancestors to merge in a refit
     std::size_t refitNodes_ = 0;
 };
 

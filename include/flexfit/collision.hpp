@@ -21,9 +21,7 @@
 #include <span>
 
 #include "flexfit/bvh.hpp"
-#include "flexfit/epoch_marks.hpp"
 #include "flexfit/part.hpp"
-#include "flexfit/triangle_queries.hpp"
 
 #include <variant>
 
@@ -70,15 +68,23 @@ public:
     ExactTest exactTest() const { return test_; }
     // Rebuilds the hierarchy from the part's current (part-frame) positions.
     void rebuild(const Part& part);
-    // Refits the faces around `changedMasses` (positions read from the part), and the bound.
+    // Records that `changedMasses` moved: the faces around them wait for the next refit
+    // (O(changed x valence)). The hierarchy itself is unchanged until refitPending().
+    void noteChanges(const Part& part, std::span<const Index> changedMasses);
+    // Refits the waiting faces from the part's positions, and their ancestors; the hierarchy
+    // then matches the part's shape. CollisionWorld refits in its narrow phase, only the
+    // hierarchies a query needs, so a part met only by point-shell queries never pays for it.
+    void refitPending(const Part& part);
+    bool upToDate() const { return pendingFaces_.empty(); }
+    // noteChanges() then refitPending().
     void refit(const Part& part, std::span<const Index> changedMasses);
     // The bounding sphere's growth: the largest displacement of a moving mass from rest
-    // (O(moving)). Refits leave the hierarchy to the callers that need it (CollisionWorld
-    // refits lazily, so a part met only by point-shell queries never pays for them).
+    // (O(moving)).
     void updateDisplacementBound(const Part& part);
-    // Masses at their rest positions in a hierarchy of points, built on first use (point-shell
-    // queries: the masses at rest never move, so this tree never needs a refit).
-    const Bvh<Aabb>& restPointTree(const Part& part);
+    // Masses at their rest positions in a hierarchy of points, for point-shell queries: the
+    // masses at rest never move, so this tree never needs a refit. Empty until built.
+    void buildRestPointTree(const Part& part);
+    const Bvh<Aabb>& restPointTree() const { return restPoints_; }
 
     // The part's bounding sphere in its own frame: the thesis's sphere of the rest shape
     // (midpoint of the masses' box, radius to the farthest mass), grown by the largest
@@ -103,8 +109,7 @@ private:
     std::variant<Bvh<Sphere>, Bvh<Aabb>> bvh_;
     Sphere restSphere_;
     double maxDisplacement_ = 0.0;
-    EpochMarks changedFaceMarks_;          // (F) refit
-    std::vector<Index> changedFaces_;      // scratch
+    IndexSet pendingFaces_;  // (F) faces moved since the last refit
     Bvh<Aabb> restPoints_;
 };
 
@@ -126,7 +131,7 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
 // from A's field (distance_field.hpp) is <= 0 is one contact (massB), with depth = minus that
 // distance, point = the mass, normal = minus the field's normalised gradient (so it pushes A
 // out of B, as for face contacts). B's moving masses are each sampled; its masses at rest are
-// found through restPointsB (PartCollider::restPointTree), pruned with the field's Lipschitz
+// found through restPointsB (PartCollider::restPointTree, built), pruned with the field's Lipschitz
 // bound, so the cost follows the masses near A's surface, not the pairs of faces, and needs no
 // refit. Faces of A that poke between B's masses are not seen: meant for B finer than A (a
 // deformable part against a rigid tool or ball). stats: volumeTests = tree nodes visited,

@@ -11,10 +11,9 @@
 // a moving mass is computed, and masses beyond stay at their rest positions. Zones may
 // overlap: the region is their union (a mass moves while any zone covers it).
 //
-// Active region. Moving masses and computed springs are compact index arrays maintained
-// incrementally (coverage counts, swap-remove): opening, growing, shrinking or retiring a zone
-// costs what it changes, and a step costs O(moving masses + computed springs). An untouched
-// part's step is O(1).
+// Active region. Moving masses and computed springs are compact index sets kept incrementally
+// (active_region.hpp): opening, growing, shrinking or retiring a zone costs what it changes, and
+// a step costs O(moving masses + computed springs). An untouched part's step is O(1).
 //
 // Lifecycle. A zone opens on request or when a force is applied to a mass no zone covers; it
 // stays while any of its masses was loaded in the last `retireCheckInterval` steps; every
@@ -28,12 +27,14 @@
 // blocks or the per-mass sweep), and the compact-array path gives the same trajectory up to
 // summation order (tested).
 //
-// Known limits: the part's own rigid-body motion (velocities, contacts) belongs to the world
-// (assembly stage); gravity here acts on moving masses only, in the part frame.
+// Stepping. step() advances a part on its own, with its settings' time step and gravity (on
+// moving masses, in the part frame). A world drives its parts through the same two halves,
+// advance() with the world's step context and retireRestingZones(), as two stages.
+//
+// Known limits: the part's own rigid-body motion (velocities, contacts) belongs to the world.
 #pragma once
 
-#include "flexfit/epoch_marks.hpp"
-#include "flexfit/kring.hpp"
+#include "flexfit/active_region.hpp"
 #include "flexfit/pose.hpp"
 #include "flexfit/simulation.hpp"
 
@@ -57,6 +58,8 @@ struct ZoneSettings {
 
 struct PartSettings {
     PartMode mode = PartMode::RigidDeformable;
+    // In a world, simulation.timeStep and simulation.gravity are not used: the world's step
+    // context gives them (world.hpp).
     SimulationSettings simulation;
     ZoneSettings zones;
 };
@@ -71,10 +74,15 @@ struct ZoneSeed {
 using ZoneId = std::uint32_t;
 inline constexpr ZoneId kNoZone = 0;
 
+class KRingWalker;
+
 class Part {
 public:
     // Throws InputError for invalid settings.
     explicit Part(std::shared_ptr<const PartModel> model, const PartSettings& settings = {});
+    ~Part();
+    Part(Part&&) noexcept;
+    Part& operator=(Part&&) noexcept;
 
     const PartModel& model() const { return *model_; }
     const std::shared_ptr<const PartModel>& sharedModel() const { return model_; }
@@ -101,7 +109,7 @@ public:
     ZoneId openZone(ZoneSeed seed, int level);
     void setZoneLevel(ZoneId zone, int level);
     void retireZone(ZoneId zone);
-    std::size_t zoneCount() const { return zones_.size(); }
+    std::size_t zoneCount() const;
     std::vector<ZoneId> zoneIds() const;
 
     // --- Loads, for the next step ---
@@ -118,16 +126,24 @@ public:
     void displaceMass(Index mass, const Vec3& worldDisplacement);
     // Masses whose position may have changed since clearChangedMasses(): every mass stepped or
     // displaced, and every mass that returned to rest. Collision hierarchies refit from it.
-    std::span<const Index> changedMasses() const { return allChanged_ ? std::span<const Index>(allMasses_) : changed_; }
+    std::span<const Index> changedMasses() const { return allChanged_ ? std::span<const Index>(allMasses_) : changed_.members(); }
     void clearChangedMasses();
 
     // --- Step ---
+    // One step alone: advance() with the settings' time step and gravity, then
+    // retireRestingZones().
     void step(StepCounters* counters = nullptr);
+    // The moving masses by one step of context.timeStep, under context.gravity (world frame);
+    // O(1) when nothing moves.
+    void advance(const StepContext& context, StepCounters* counters = nullptr);
+    // Every retireCheckInterval steps: retires the zones at rest (see Lifecycle above).
+    void retireRestingZones();
 
     // --- Read-out ---
-    std::span<const Index> movingMasses() const { return moving_; }
-    std::span<const Index> computedSprings() const { return computed_; }
-    bool isMoving(Index mass) const { return cover_[mass] > 0; }
+    const ActiveRegion& region() const { return region_; }
+    std::span<const Index> movingMasses() const { return region_.masses().members(); }
+    std::span<const Index> computedSprings() const { return region_.springs().members(); }
+    bool isMoving(Index mass) const { return region_.moves(mass); }
     const PartState& state() const { return state_; }  // part frame; non-moving masses at rest
     Vec3 worldPosition(Index mass) const { return pose_.apply(state_.positions[mass]); }
     void worldPositions(std::vector<Vec3>& out) const;
@@ -136,48 +152,31 @@ public:
     double time() const { return state_.time; }
 
 private:
-    struct Zone {
-        ZoneId id;
-        std::vector<Index> seeds;
-        int level;
-        std::vector<RingMember> members;
-    };
+    struct Zone;  // its seeds, level and members (part.cpp)
 
-    void cover(std::span<const RingMember> members);
-    void uncover(std::span<const RingMember> members);
-    void addMoving(Index mass);
-    void removeMoving(Index mass);
+    void cover(const Zone& zone);
+    void uncover(const Zone& zone);
+    void returnToRest(Index mass);
     Zone* findZone(ZoneId id);
     void collectMembers(Zone& zone);
-    void retireRestingZones();
     bool zoneAtRest(const Zone& zone) const;
-    void stepRegion(StepCounters* counters);
-    SimulationSettings partFrameSettings() const;
+    void markChanged(Index mass);
+    void markAllChanged();
 
     std::shared_ptr<const PartModel> model_;
     PartSettings settings_;
     Pose pose_;
     PartState state_;
-    KRingWalker walker_;
+    std::unique_ptr<KRingWalker> walker_;
 
     std::vector<Zone> zones_;
     ZoneId nextZoneId_ = 1;
-    std::vector<std::uint16_t> cover_;        // (V) zones covering each mass
-    std::vector<Index> moving_;               // moving masses (compact)
-    std::vector<Index> movingSlot_;           // (V) position in moving_, or kAbsent
-    std::vector<std::uint8_t> springEnds_;    // (E) moving endpoints of each spring
-    std::vector<Index> computed_;             // computed springs (compact)
-    std::vector<Index> computedSlot_;         // (E) position in computed_, or kAbsent
+    ActiveRegion region_;
     std::vector<std::uint64_t> lastLoadStep_; // (V) step of the last force on each mass
-    std::vector<Index> changed_;              // masses changed since clearChangedMasses()
-    EpochMarks changedMarks_;  // (V) masses in changed_
+    IndexSet changed_;                        // (V) masses changed since clearChangedMasses()
     // Every mass changed (a step moved them all): O(1) instead of marking each.
     bool allChanged_ = false;
     std::vector<Index> allMasses_;  // 0 .. V-1, built the first time every mass moves
-
-    void markChanged(Index mass);
-    void markAllChanged();
-    bool everyMassMoves() const { return moving_.size() == model_->massCount(); }
 };
 
 }  // namespace flexfit

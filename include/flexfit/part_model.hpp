@@ -9,7 +9,6 @@
 #pragma once
 
 #include "flexfit/mesh.hpp"
-#include "flexfit/spring_blocks.hpp"
 #include "flexfit/topology.hpp"
 
 #include <memory>
@@ -18,6 +17,8 @@
 #include <vector>
 
 namespace flexfit {
+
+struct SpringBlocks;  // the full step's vector layout of the springs (internal)
 
 // Spring constants: stiffness k (kg/s^2) and damping b (kg/s).
 struct Material {
@@ -58,10 +59,12 @@ struct PartModel {
     std::vector<double> damping;       // (E) b
     // (V+1) springs whose first mass is a: [springAdr[a], springAdr[a+1]).
     std::vector<Index> springAdr;
-    // The springs again, grouped for the vector full step (spring_blocks.hpp); empty when the
+    // The springs again, grouped for the vector full step (an internal layout); empty when the
     // mesh's vertex order gives too few blocks. It copies the spring constants: build models with
     // buildPartModel, and do not edit a model's springs afterwards.
-    SpringBlocks springBlocks;
+    std::shared_ptr<const SpringBlocks> springBlocks;
+    // Whether the full step runs by spring blocks (else by a per-mass sweep).
+    bool hasSpringBlocks() const;
 
     std::size_t massCount() const { return mass.size(); }
     std::size_t springCount() const { return springA.size(); }

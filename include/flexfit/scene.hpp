@@ -1,4 +1,5 @@
-// Scene files (SPEC 7-8): a world described in TOML, and the scripted run of it.
+// A scene (SPEC 7-8): a world described as data, its parts, assembly rules and scripted
+// actions. scene_file.hpp reads it from TOML; scene_run.hpp runs it in a World.
 //
 // Why TOML (toml++ from Debian's libtomlplusplus-dev): a scene is a handful of flat tables
 // ([world], [[part]], [[assembly]], [[action]], [output]) that engineers write by hand. TOML
@@ -29,11 +30,17 @@
 //
 // Loading builds every mesh and model up front: a scene either loads whole or throws
 // InputError, never half-built.
+//
+// Names (mode, motion, restoration, ...) are those of names.hpp.
 #pragma once
 
-#include "flexfit/world.hpp"
+#include "flexfit/assembly.hpp"
+#include "flexfit/body.hpp"
+#include "flexfit/names.hpp"
+#include "flexfit/part.hpp"
+#include "flexfit/world_settings.hpp"
 
-#include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -61,6 +68,13 @@ struct SceneAction {
     Vec3 linear = Vec3::Zero(), angular = Vec3::Zero();
 };
 const char* toString(SceneAction::Kind kind);
+template <> std::span<const EnumName<SceneAction::Kind>> enumNames();
+
+// Something the reader accepted but the user should change (an old spelling, for now).
+struct SceneWarning {
+    std::size_t line = 0;
+    std::string message;
+};
 
 struct Scene {
     std::string source;       // the file, for messages
@@ -70,36 +84,10 @@ struct Scene {
     std::vector<AssemblyRule> assemblies;
     std::vector<SceneAction> actions;  // by time (stable: file order among equal times)
     double objEvery = 0.0;    // s between OBJ frames; 0: none
+    std::vector<SceneWarning> warnings;
 
     // The part named `name`, or nullopt.
     std::optional<BodyId> find(std::string_view name) const;
-};
-
-// Throws InputError naming the file, the line and the key for every problem.
-Scene loadScene(const std::filesystem::path& file);
-// The same from text; mesh paths are resolved against `baseDirectory`.
-Scene parseScene(std::string_view text, const std::string& source, const std::filesystem::path& baseDirectory);
-
-// A scene's world, driven by its scripted actions: the same run for `flexfit run`, the
-// experiments and the viewer.
-class SceneRun {
-public:
-    explicit SceneRun(const Scene& scene);
-    World& world() { return *world_; }
-    const World& world() const { return *world_; }
-    const Scene& scene() const { return scene_; }
-    // Applies the actions due in this step, then steps the world.
-    void step();
-    bool finished() const;
-    // Operator actions that the scene did not script (the viewer's mouse) go to world() directly.
-
-private:
-    void start(const SceneAction& action);
-    void apply(const SceneAction& action, const Pose& moveStart, double t);
-    Scene scene_;
-    std::unique_ptr<World> world_;
-    std::size_t next_ = 0;                           // first action not yet started
-    std::vector<std::pair<SceneAction, Pose>> running_;  // actions with a duration, and a move's start target
 };
 
 }  // namespace flexfit

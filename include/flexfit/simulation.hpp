@@ -27,6 +27,7 @@
 //                  c for the stiffness wanted (c = 1e-4 at 1 kHz ~ 100 N/m per kg).
 #pragma once
 
+#include "flexfit/active_region.hpp"
 #include "flexfit/part_state.hpp"
 
 #include <span>
@@ -57,6 +58,15 @@ struct SimulationSettings {
 // Throws InputError (source "simulation settings") for non-finite or out-of-range values.
 void validateSettings(const SimulationSettings& settings);
 
+// What one step takes from whoever drives it. A part stepped alone takes the time step and
+// gravity of its settings; a world gives every stage its own (world.hpp).
+struct StepContext {
+    double timeStep = 1e-3;       // s
+    Vec3 gravity = Vec3::Zero();  // m/s^2, world frame
+    std::uint64_t index = 0;      // steps the driver took before this one
+    double time = 0.0;            // s, at the start of the step
+};
+
 // An external force on one mass for the current step.
 struct PointLoad {
     Index mass = 0;
@@ -76,13 +86,11 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings,
                    std::span<const PointLoad> loads, PartState& state,
                    StepCounters* counters = nullptr);
 
-// Advances only an active region: the `moving` masses (each listed once; movingMask[i] != 0
-// exactly for them) and the `computed` springs (every spring touching a moving mass). Masses
-// outside the region are read (at their current, rest, positions) but never written. Two
-// passes over the compact arrays: springs, then masses. O(|moving| + |computed|).
-void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, std::span<const Index> moving,
-                      std::span<const Index> computed, std::span<const std::uint16_t> movingMask, PartState& state,
-                      StepCounters* counters = nullptr);
+// Advances only an active region (active_region.hpp): its moving masses and computed springs.
+// Masses outside the region are read (at their current, rest, positions) but never written.
+// Two passes over the compact arrays: springs, then masses. O(|moving| + |computed|).
+void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
+                      PartState& state, StepCounters* counters = nullptr);
 
 // Total kinetic + spring + anchor potential energy (no gravity), and linear momentum.
 double totalEnergy(const PartModel& model, const SimulationSettings& settings, const PartState& state);

@@ -3,7 +3,6 @@
 
 namespace flexfit {
 
-const char* toString(BoundingVolumeKind kind) { return kind == BoundingVolumeKind::Sphere ? "sphere" : "aabb"; }
 
 Sphere Sphere::around(std::span<const Vec3> points) {
     Eigen::AlignedBox3d box;

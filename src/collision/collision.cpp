@@ -1,5 +1,7 @@
 #include "flexfit/collision.hpp"
 
+#include "collision/triangle_queries.hpp"
+#include "core/epoch_marks.hpp"
 #include "flexfit/distance_field.hpp"
 
 #include <stdexcept>
@@ -66,7 +68,6 @@ void dispatch(const PartCollider& a, const PartCollider& b, Visit visit) {
 
 }  // namespace
 
-const char* toString(ExactTest test) { return test == ExactTest::SphereTriangle ? "sphere-triangle" : "triangle-triangle"; }
 
 QueryStats& QueryStats::operator+=(const QueryStats& o) {
     volumeTests += o.volumeTests;
@@ -96,7 +97,7 @@ Aabb faceSphereBox(std::span<const Vec3> positions, const Face& face) {
 PartCollider::PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest test) : kind_(kind), test_(test) {
     if (kind == BoundingVolumeKind::Aabb) bvh_.emplace<Bvh<Aabb>>();
     restSphere_ = Sphere::around(part.model().restPositions);
-    changedFaceMarks_.reset(part.model().faceCount());
+    pendingFaces_.reset(part.model().faceCount());
     const auto& rest = part.model().restPositions;
     restPlanes_.reserve(part.model().faceCount());
     for (const Face& f : part.model().mesh.faces) {
@@ -114,6 +115,7 @@ PartCollider::PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest 
 }
 
 void PartCollider::rebuild(const Part& part) {
+    pendingFaces_.clear();
     std::visit([&](auto& bvh) { buildHierarchy(bvh, part, test_); }, bvh_);
     updateDisplacementBound(part);
 }
@@ -124,31 +126,35 @@ void PartCollider::updateDisplacementBound(const Part& part) {
         maxDisplacement_ = std::max(maxDisplacement_, (part.state().positions[m] - part.model().restPositions[m]).norm());
 }
 
-void PartCollider::refit(const Part& part, std::span<const Index> changedMasses) {
-    const PartModel& model = part.model();
-    changedFaceMarks_.clear();
-    changedFaces_.clear();
+void PartCollider::noteChanges(const Part& part, std::span<const Index> changedMasses) {
     for (Index m : changedMasses)
-        for (Index f : model.topology.facesOf(m))
-            if (changedFaceMarks_.insert(f)) changedFaces_.push_back(f);
+        for (Index f : part.model().topology.facesOf(m)) pendingFaces_.insert(f);
+}
+
+void PartCollider::refitPending(const Part& part) {
+    if (pendingFaces_.empty()) return;
+    const PartModel& model = part.model();
     const std::span<const Vec3> positions = part.state().positions;
     std::visit(
         [&](auto& bvh) {
             using BV = std::decay_t<decltype(bvh.rootVolume())>;
-            bvh.refit(changedFaces_, [&](Index f) { return leafVolume((const BV*)nullptr, positions, model.mesh.faces[f], test_); });
+            bvh.refit(pendingFaces_.members(), [&](Index f) { return leafVolume((const BV*)nullptr, positions, model.mesh.faces[f], test_); });
         },
         bvh_);
+    pendingFaces_.clear();
+}
+
+void PartCollider::refit(const Part& part, std::span<const Index> changedMasses) {
+    noteChanges(part, changedMasses);
+    refitPending(part);
     updateDisplacementBound(part);
 }
 
-const Bvh<Aabb>& PartCollider::restPointTree(const Part& part) {
-    if (restPoints_.empty()) {
-        const auto& rest = part.model().restPositions;
-        std::vector<Aabb> points(rest.size());
-        for (std::size_t m = 0; m < rest.size(); ++m) points[m] = {rest[m], rest[m]};
-        restPoints_.build(points);
-    }
-    return restPoints_;
+void PartCollider::buildRestPointTree(const Part& part) {
+    const auto& rest = part.model().restPositions;
+    std::vector<Aabb> points(rest.size());
+    for (std::size_t m = 0; m < rest.size(); ++m) points[m] = {rest[m], rest[m]};
+    restPoints_.build(points);
 }
 
 Sphere PartCollider::worldSphere(const Part& part) const {

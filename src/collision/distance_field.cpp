@@ -1,6 +1,6 @@
 #include "flexfit/distance_field.hpp"
 #include "flexfit/collision.hpp"
-#include "flexfit/triangle_queries.hpp"
+#include "collision/triangle_queries.hpp"
 
 #include <algorithm>
 #include <cmath>

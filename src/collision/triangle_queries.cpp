@@ -1,4 +1,4 @@
-#include "flexfit/triangle_queries.hpp"
+#include "collision/triangle_queries.hpp"
 
 #include <algorithm>
 #include <array>

@@ -41,7 +41,7 @@ void blockForcesScalar(const SpringBlocks& blocks, const double* x, const double
 }
 
 void remainderForces(const PartModel& model, const double* x, const double* v, double* f, std::size_t begin = 0) {
-    const std::vector<Index>& remainder = model.springBlocks.remainder;
+    const std::vector<Index>& remainder = model.springBlocks->remainder;
     for (std::size_t i = begin; i < remainder.size(); ++i) {
         const Index e = remainder[i];
         const std::size_t a = 3 * std::size_t(model.springA[e]), b = 3 * std::size_t(model.springB[e]);
@@ -114,7 +114,7 @@ void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartStat
     const double* x = state.positions.data()->data();
     const double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
-    blockForces(model.springBlocks, x, v, f, kernel);
+    blockForces(*model.springBlocks, x, v, f, kernel);
     std::size_t gathered = 0, integrated = 0;  // what the vector kernels did; scalar passes finish
 #if defined(FLEXFIT_X86_KERNELS)
     if (kernel == BlockKernel::Avx512) gathered = remainderForcesAvx512(model, x, v, f);

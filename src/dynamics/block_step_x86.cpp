@@ -166,7 +166,7 @@ FLEXFIT_AVX512 inline __m512d dot8(const Flat24& a, const Flat24& b) {
 }
 
 FLEXFIT_AVX512 std::size_t remainder512(const PartModel& model, const double* x, const double* v, double* f) {
-    const std::vector<Index>& springs = model.springBlocks.remainder;
+    const std::vector<Index>& springs = model.springBlocks->remainder;
     if (3 * model.massCount() > std::size_t(INT32_MAX) || model.springCount() > std::size_t(INT32_MAX))
         return 0;  // gather offsets are int32: the scalar pass does them all
     const std::size_t n = springs.size() / 8 * 8;

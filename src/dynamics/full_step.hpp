@@ -7,6 +7,7 @@
 #pragma once
 
 #include "mass_update.hpp"
+#include "model/spring_blocks.hpp"
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #define FLEXFIT_X86_KERNELS 1  // block_step_x86.cpp: AVX2 and AVX-512 by function target attributes

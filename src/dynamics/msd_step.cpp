@@ -65,7 +65,7 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings, s
     const detail::FlushDenormals flush;
     for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
     const detail::MassUpdate update = detail::MassUpdate::from(settings);
-    if (model.springBlocks.empty())
+    if (!model.hasSpringBlocks())
         detail::sweepFullModel(model, update, state);
     else
         detail::stepSpringBlocks(model, update, state, detail::fullStepKernel());
@@ -94,19 +94,6 @@ Vec3 linearMomentum(const PartModel& model, const PartState& state) {
     Vec3 momentum = Vec3::Zero();
     for (std::size_t i = 0; i < model.massCount(); ++i) momentum += model.mass[i] * state.velocities[i];
     return momentum;
-}
-
-const char* toString(Integrator integrator) {
-    return integrator == Integrator::SemiImplicitEuler ? "semi-implicit-euler" : "explicit-euler";
-}
-
-const char* toString(RestorationMethod method) {
-    switch (method) {
-        case RestorationMethod::None: return "none";
-        case RestorationMethod::AnchorSprings: return "anchor";
-        case RestorationMethod::Constraint: return "constraint";
-    }
-    return "?";
 }
 
 }  // namespace flexfit

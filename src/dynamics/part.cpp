@@ -1,5 +1,7 @@
 #include "flexfit/part.hpp"
 
+#include "model/kring.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -8,7 +10,6 @@
 namespace flexfit {
 namespace {
 
-constexpr Index kAbsent = std::numeric_limits<Index>::max();
 constexpr std::uint64_t kNeverLoaded = std::numeric_limits<std::uint64_t>::max();
 const std::string kPartSource = "part";
 
@@ -24,36 +25,31 @@ void checkZoneSettings(const ZoneSettings& z) {
 
 }  // namespace
 
-const char* toString(PartMode mode) {
-    switch (mode) {
-        case PartMode::Rigid: return "rigid";
-        case PartMode::RigidDeformable: return "zones";
-        case PartMode::FullDeformable: return "full";
-    }
-    return "?";
-}
+
+struct Part::Zone {
+    ZoneId id;
+    std::vector<Index> seeds;
+    int level;
+    std::vector<RingMember> members;
+};
 
 Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
     : model_(std::move(model)),
       settings_(settings),
       state_(PartState::atRest(*model_)),
-      walker_(model_->massCount()),
-      cover_(model_->massCount(), 0),
-      movingSlot_(model_->massCount(), kAbsent),
-      springEnds_(model_->springCount(), 0),
-      computedSlot_(model_->springCount(), kAbsent),
+      walker_(std::make_unique<KRingWalker>(model_->massCount())),
+      region_(*model_),
       lastLoadStep_(model_->massCount(), kNeverLoaded),
-      changedMarks_(model_->massCount()) {
+      changed_(model_->massCount()) {
     validateSettings(settings_.simulation);
     checkZoneSettings(settings_.zones);
-    if (settings_.mode == PartMode::FullDeformable) {
-        // Every mass moves, always: the region is the whole mesh (kept for the read-out).
-        for (Index m = 0; m < model_->massCount(); ++m) {
-            cover_[m] = 1;
-            addMoving(m);
-        }
-    }
+    if (settings_.mode == PartMode::FullDeformable)  // every mass moves, always: the region is the mesh
+        for (Index m = 0; m < model_->massCount(); ++m) region_.cover(m);
 }
+
+Part::~Part() = default;
+Part::Part(Part&&) noexcept = default;
+Part& Part::operator=(Part&&) noexcept = default;
 
 void Part::setSettings(const PartSettings& settings) {
     if (settings.mode != settings_.mode) throw InputError("part settings", 0, "the mode of a part cannot change");
@@ -86,31 +82,8 @@ Vec3 Part::centre() const { return pose_.apply(boundingBox(model_->mesh).center(
 
 // --- Active region bookkeeping ---
 
-void Part::addMoving(Index mass) {
-    movingSlot_[mass] = Index(moving_.size());
-    moving_.push_back(mass);
-    for (Index e : model_->topology.edgesOf(mass))
-        if (springEnds_[e]++ == 0) {
-            computedSlot_[e] = Index(computed_.size());
-            computed_.push_back(e);
-        }
-}
-
-void Part::removeMoving(Index mass) {
-    // Swap-remove from the compact arrays; the mass returns exactly to rest.
-    const Index slot = movingSlot_[mass];
-    moving_[slot] = moving_.back();
-    movingSlot_[moving_[slot]] = slot;
-    moving_.pop_back();
-    movingSlot_[mass] = kAbsent;
-    for (Index e : model_->topology.edgesOf(mass))
-        if (--springEnds_[e] == 0) {
-            const Index s = computedSlot_[e];
-            computed_[s] = computed_.back();
-            computedSlot_[computed_[s]] = s;
-            computed_.pop_back();
-            computedSlot_[e] = kAbsent;
-        }
+// A mass that stops moving returns exactly to rest.
+void Part::returnToRest(Index mass) {
     state_.positions[mass] = model_->restPositions[mass];
     state_.velocities[mass] = Vec3::Zero();
     state_.forces[mass] = Vec3::Zero();
@@ -118,7 +91,7 @@ void Part::removeMoving(Index mass) {
 }
 
 void Part::markChanged(Index mass) {
-    if (!allChanged_ && changedMarks_.insert(mass)) changed_.push_back(mass);
+    if (!allChanged_) changed_.insert(mass);
 }
 
 void Part::markAllChanged() {
@@ -131,18 +104,16 @@ void Part::markAllChanged() {
 
 void Part::clearChangedMasses() {
     changed_.clear();
-    changedMarks_.clear();
     allChanged_ = false;
 }
 
-void Part::cover(std::span<const RingMember> members) {
-    for (const RingMember& m : members)
-        if (cover_[m.mass]++ == 0) addMoving(m.mass);
+void Part::cover(const Zone& zone) {
+    for (const RingMember& m : zone.members) region_.cover(m.mass);
 }
 
-void Part::uncover(std::span<const RingMember> members) {
-    for (const RingMember& m : members)
-        if (--cover_[m.mass] == 0) removeMoving(m.mass);
+void Part::uncover(const Zone& zone) {
+    for (const RingMember& m : zone.members)
+        if (region_.uncover(m.mass)) returnToRest(m.mass);
 }
 
 // --- Zones ---
@@ -159,7 +130,7 @@ void Part::collectMembers(Zone& zone) {
         zone.members.clear();
         return;
     }
-    walker_.collect(model_->topology, zone.seeds, zone.level - 1, zone.members);
+    walker_->collect(model_->topology, zone.seeds, zone.level - 1, zone.members);
 }
 
 ZoneId Part::openZone(ZoneSeed seed, int level) {
@@ -180,7 +151,7 @@ ZoneId Part::openZone(ZoneSeed seed, int level) {
     if (settings_.mode != PartMode::RigidDeformable) return kNoZone;
     ++nextZoneId_;
     collectMembers(zone);
-    cover(zone.members);
+    cover(zone);
     zones_.push_back(std::move(zone));
     return zones_.back().id;
 }
@@ -190,19 +161,21 @@ void Part::setZoneLevel(ZoneId id, int level) {
     Zone* zone = findZone(id);
     if (zone == nullptr || zone->level == level) return;
     // Cover the new members before uncovering the old, so masses in both keep their state.
-    std::vector<RingMember> old = std::move(zone->members);
+    Zone old{zone->id, {}, zone->level, std::move(zone->members)};
     zone->level = level;
     collectMembers(*zone);
-    cover(zone->members);
+    cover(*zone);
     uncover(old);
 }
 
 void Part::retireZone(ZoneId id) {
     auto it = std::find_if(zones_.begin(), zones_.end(), [id](const Zone& z) { return z.id == id; });
     if (it == zones_.end()) return;
-    uncover(it->members);
+    uncover(*it);
     zones_.erase(it);
 }
+
+std::size_t Part::zoneCount() const { return zones_.size(); }
 
 std::vector<ZoneId> Part::zoneIds() const {
     std::vector<ZoneId> ids;
@@ -219,7 +192,7 @@ void Part::applyForce(Index mass, const Vec3& worldForce) {
     if (!worldForce.allFinite()) throw InputError(kPartSource, 0, "force must be finite");
     if (settings_.mode == PartMode::Rigid) return;
     if (settings_.mode == PartMode::RigidDeformable) {
-        if (cover_[mass] == 0) openZone(ZoneSeed::mass(mass), std::max(settings_.zones.defaultLevel, 1));
+        if (!region_.moves(mass)) openZone(ZoneSeed::mass(mass), std::max(settings_.zones.defaultLevel, 1));
         lastLoadStep_[mass] = state_.stepCount;  // keeps the zones covering it alive
     }
     state_.forces[mass] += pose_.rotateInverse(worldForce);
@@ -227,33 +200,28 @@ void Part::applyForce(Index mass, const Vec3& worldForce) {
 
 // --- Step ---
 
-SimulationSettings Part::partFrameSettings() const {
-    SimulationSettings s = settings_.simulation;
-    s.gravity = pose_.rotateInverse(s.gravity);  // world gravity seen in the part frame
-    return s;
-}
-
-void Part::stepRegion(StepCounters* counters) {
-    const SimulationSettings s = partFrameSettings();
-    if (everyMassMoves() && settings_.zones.fullSweepWhenComplete) {
-        stepFullModel(*model_, s, {}, state_, counters);
-        return;
-    }
-    stepActiveRegion(*model_, s, moving_, computed_, cover_, state_, counters);
-}
-
 void Part::step(StepCounters* counters) {
-    if (moving_.empty()) {  // rigid, or no zone open: nothing moves, O(1)
-        state_.time += settings_.simulation.timeStep;
+    advance({settings_.simulation.timeStep, settings_.simulation.gravity}, counters);
+    retireRestingZones();
+}
+
+void Part::advance(const StepContext& context, StepCounters* counters) {
+    if (region_.empty()) {  // rigid, or no zone open: nothing moves, O(1)
+        state_.time += context.timeStep;
         ++state_.stepCount;
         return;
     }
-    stepRegion(counters);
-    if (everyMassMoves())
+    SimulationSettings s = settings_.simulation;
+    s.timeStep = context.timeStep;
+    s.gravity = pose_.rotateInverse(context.gravity);  // world gravity seen in the part frame
+    if (region_.coversEveryMass() && settings_.zones.fullSweepWhenComplete)
+        stepFullModel(*model_, s, {}, state_, counters);
+    else
+        stepActiveRegion(*model_, s, region_, state_, counters);
+    if (region_.coversEveryMass())
         markAllChanged();
     else
-        for (Index m : moving_) markChanged(m);
-    if (settings_.mode == PartMode::RigidDeformable) retireRestingZones();
+        for (Index m : region_.masses()) markChanged(m);
 }
 
 // --- Contacts ---
@@ -264,13 +232,13 @@ void Part::touchFace(Index face) {
                                              std::to_string(model_->faceCount()) + " faces)");
     if (settings_.mode == PartMode::Rigid) return;
     const Face& f = model_->mesh.faces[face];
-    if (settings_.mode == PartMode::RigidDeformable && (cover_[f[0]] == 0 || cover_[f[1]] == 0 || cover_[f[2]] == 0))
+    if (settings_.mode == PartMode::RigidDeformable && !(region_.moves(f[0]) && region_.moves(f[1]) && region_.moves(f[2])))
         openZone(ZoneSeed::face(face), std::max(settings_.zones.contactLevel, 1));
     for (Index m : f) lastLoadStep_[m] = state_.stepCount;
 }
 
 void Part::displaceMass(Index mass, const Vec3& worldDisplacement) {
-    if (mass >= model_->massCount() || cover_[mass] == 0 || settings_.mode == PartMode::Rigid) return;
+    if (mass >= model_->massCount() || !region_.moves(mass) || settings_.mode == PartMode::Rigid) return;
     const Vec3 d = pose_.rotateInverse(worldDisplacement);
     state_.positions[mass] += d;
     const double length = d.norm();
@@ -300,11 +268,13 @@ bool Part::zoneAtRest(const Zone& zone) const {
 }
 
 void Part::retireRestingZones() {
+    // Nothing moves: nothing to retire, in O(1) (an untouched part costs nothing here either).
+    if (settings_.mode != PartMode::RigidDeformable || region_.empty()) return;
     if (state_.stepCount % std::uint64_t(settings_.zones.retireCheckInterval) != 0) return;
     for (std::size_t z = 0; z < zones_.size();) {
         const Zone& zone = zones_[z];
         if (zoneAtRest(zone)) {
-            uncover(zone.members);
+            uncover(zone);
             zones_.erase(zones_.begin() + std::ptrdiff_t(z));
         } else {
             ++z;

@@ -5,9 +5,8 @@
 
 namespace flexfit {
 
-void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, std::span<const Index> moving,
-                      std::span<const Index> computed, std::span<const std::uint16_t> movingMask, PartState& state,
-                      StepCounters* counters) {
+void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
+                      PartState& state, StepCounters* counters) {
     const detail::FlushDenormals flush;
     const detail::MassUpdate p = detail::MassUpdate::from(settings);
     const Index* springA = model.springA.data();
@@ -15,7 +14,8 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
     Vec3* __restrict x = state.positions.data();
     Vec3* __restrict v = state.velocities.data();
     Vec3* __restrict f = state.forces.data();
-    const std::uint16_t* mask = movingMask.data();
+    const std::uint16_t* mask = region.coverCounts().data();
+    const std::span<const Index> computed = region.springs().members(), moving = region.masses().members();
 
     // Springs: forces reach only the moving ends (a fixed end is held by the rigid body).
     for (Index e : computed) {

@@ -1,4 +1,4 @@
-#include "flexfit/kring.hpp"
+#include "model/kring.hpp"
 
 #include <algorithm>
 

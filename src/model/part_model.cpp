@@ -1,5 +1,7 @@
 #include "flexfit/part_model.hpp"
 
+#include "model/spring_blocks.hpp"
+
 #include <cmath>
 
 namespace flexfit {
@@ -65,10 +67,12 @@ std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSet
     model->springAdr.assign(vertices + 1, 0);
     for (Index a : model->springA) ++model->springAdr[a + 1];
     for (std::size_t v = 0; v < vertices; ++v) model->springAdr[v + 1] += model->springAdr[v];
-    model->springBlocks = buildSpringBlocks(model->springA, model->springB, model->restLength, model->stiffness,
-                                            model->damping);
+    model->springBlocks = std::make_shared<const SpringBlocks>(
+        buildSpringBlocks(model->springA, model->springB, model->restLength, model->stiffness, model->damping));
     model->mesh = std::move(mesh);
     return model;
 }
+
+bool PartModel::hasSpringBlocks() const { return springBlocks != nullptr && !springBlocks->empty(); }
 
 }  // namespace flexfit

@@ -1,4 +1,4 @@
-#include "flexfit/spring_blocks.hpp"
+#include "model/spring_blocks.hpp"
 
 #include <algorithm>
 #include <numeric>

@@ -1,19 +1,12 @@
 #include "flexfit/assembly.hpp"
 
+#include "assembly_stage.hpp"
+
 #include <algorithm>
 #include <cmath>
 
 namespace flexfit {
 
-const char* toString(SnapTechnique technique) {
-    switch (technique) {
-        case SnapTechnique::CollisionSnap: return "collision snapping";
-        case SnapTechnique::ProximitySnap: return "proximity snapping";
-        case SnapTechnique::VectorSnap: return "improved snap-fitting";
-        case SnapTechnique::ZoneSnap: return "zone snap-fitting";
-    }
-    return "?";
-}
 
 bool AssemblyArea::contains(const Vec3& pointInPart) const {
     const Vec3 p = frame.applyInverse(pointInPart);
@@ -61,3 +54,61 @@ Pose interpolate(const Pose& from, const Pose& to, double s) {
 }
 
 }  // namespace flexfit
+
+// --- The stage (assembly_stage.hpp) ---
+
+namespace flexfit::detail {
+namespace {
+
+bool touching(std::span<const Contact> contacts, BodyId a, BodyId b) {
+    for (const Contact& c : contacts)
+        if ((c.partA == a && c.partB == b) || (c.partA == b && c.partB == a)) return true;
+    return false;
+}
+
+// The rule's condition holds: the snap starts, and the primary is the snap's from now on.
+void startSnap(const StepContext& step, const Pose& target, RuleState& state, AssemblyState& assembly, Bodies& bodies,
+               OperatorState& op) {
+    const AssemblyRule& rule = state.rule;
+    state.phase = RuleState::Phase::Snapping;
+    state.start = step.time;
+    state.from = bodies.parts[rule.primary]->pose();
+    assembly.events.push_back({rule.name, rule.technique, step.time, state.from, target});
+    if (op.grabbed == rule.primary) release(op);  // the snap takes the part from the operator
+    RigidBody& body = bodies.rigid[rule.primary];
+    body.motion = MotionType::Kinematic;  // the snap drives it from now on
+    body.linearVelocity.setZero();
+    body.angularVelocity.setZero();
+}
+
+}  // namespace
+
+std::size_t addRule(const AssemblyRule& rule, std::size_t bodyCount, AssemblyState& assembly) {
+    if (rule.primary >= bodyCount || rule.secondary >= bodyCount || rule.primary == rule.secondary)
+        throw InputError("world", 0, "assembly rule '" + rule.name + "' needs two different existing bodies");
+    if (!(rule.snapDuration >= 0.0) || !std::isfinite(rule.snapDuration))
+        throw InputError("world", 0, "assembly rule '" + rule.name + "': snap duration must be finite and >= 0");
+    RuleState state;
+    state.rule = rule;
+    assembly.rules.push_back(state);
+    return assembly.rules.size() - 1;
+}
+
+void assemble(const StepContext& step, std::span<const Contact> contacts, AssemblyState& assembly, Bodies& bodies,
+              OperatorState& op) {
+    for (RuleState& state : assembly.rules) {
+        const AssemblyRule& rule = state.rule;
+        Part& primary = *bodies.parts[rule.primary];
+        const Pose& secondary = bodies.parts[rule.secondary]->pose();
+        const Pose target = finalPose(rule, secondary);
+        if (state.phase == RuleState::Phase::Waiting) {
+            if (!snapConditionHolds(rule, primary.pose(), secondary, touching(contacts, rule.primary, rule.secondary))) continue;
+            startSnap(step, target, state, assembly, bodies, op);
+        }
+        const double s = rule.snapDuration > 0.0 ? (step.time + step.timeStep - state.start) / rule.snapDuration : 1.0;
+        primary.setPose(interpolate(state.from, target, s));
+        if (s >= 1.0) state.phase = RuleState::Phase::Assembled;  // and stays attached
+    }
+}
+
+}  // namespace flexfit::detail

@@ -1,5 +1,5 @@
 // The scripted run of a scene (scene.hpp).
-#include "flexfit/scene.hpp"
+#include "flexfit/scene_run.hpp"
 
 #include <algorithm>
 

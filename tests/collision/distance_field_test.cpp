@@ -1,6 +1,7 @@
 // The signed distance field against independent references: the analytic distance to a box,
 // brute force over every face of a sphere mesh, the stated interpolation error, and the
 // pruning bound against dense sampling.
+#include "collision/triangle_queries.hpp"
 #include "flexfit/flexfit.hpp"
 
 #include <gtest/gtest.h>

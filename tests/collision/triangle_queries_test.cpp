@@ -1,5 +1,6 @@
 // Triangle queries against independent references: dense sampling of the triangle for the
 // closest point, and edge-through-triangle (Moller-Trumbore) tests for intersection.
+#include "collision/triangle_queries.hpp"
 #include "flexfit/flexfit.hpp"
 
 #include <gtest/gtest.h>

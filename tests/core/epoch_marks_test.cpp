@@ -1,5 +1,5 @@
 // EpochMarks against a plain vector<bool> that is cleared for real, over random operations.
-#include "flexfit/epoch_marks.hpp"
+#include "core/epoch_marks.hpp"
 
 #include <gtest/gtest.h>
 

@@ -26,7 +26,7 @@ PartState kickedState(const PartModel& model, unsigned seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> kick(-1.0, 1.0);
     for (Vec3& v : state.velocities) v = Vec3(kick(rng), kick(rng), kick(rng));
-    const SpringBlocks& blocks = model.springBlocks;
+    const SpringBlocks& blocks = *model.springBlocks;
     if (!blocks.empty()) {
         const Index a = blocks.first[0] + 3;
         state.positions[a + blocks.offset[0]] = state.positions[a];
@@ -101,7 +101,7 @@ TEST(BlockStep, EveryKernelGivesTheScalarKernelsBits) {
     int compared = 0;
     for (const TriMesh& mesh : {makeTorus1(), makeTorus2(), makeHeart()}) {
         const auto model = buildPartModel(mesh);
-        ASSERT_FALSE(model->springBlocks.empty());
+        ASSERT_FALSE(model->springBlocks->empty());
         for (RestorationMethod method : {RestorationMethod::None, RestorationMethod::AnchorSprings, RestorationMethod::Constraint})
             for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::ExplicitEuler}) {
                 SCOPED_TRACE(mesh.name + " " + toString(method) + " " + toString(integrator));
@@ -187,7 +187,7 @@ TEST(BlockStep, StepFullModelTakesBlocksWhenTheModelHasThem) {
     EXPECT_EQ(counters.massesIntegrated, 20 * rows->massCount());
     // No useful vertex order: the sweep.
     const auto unordered = buildPartModel(flexfit::testing::shuffledVertices(makeTorus1(), 8));
-    ASSERT_TRUE(unordered->springBlocks.empty());
+    ASSERT_TRUE(unordered->springBlocks->empty());
     PartState apiState = kickedState(*unordered, 2), sweepState = apiState;
     for (int step = 0; step < 20; ++step) {
         stepFullModel(*unordered, settings, {}, apiState);

@@ -10,27 +10,10 @@ using namespace flexfit;
 
 namespace {
 
-// A region as a part builds it: masses in the order given, and with each mass the springs
-// touching it that are not yet computed, in the topology's order.
-struct Region {
-    std::vector<Index> moving, computed;
-    std::vector<std::uint16_t> mask;
-};
-
-Region regionOf(const PartModel& model, const std::vector<Index>& masses) {
-    Region r;
-    r.mask.assign(model.massCount(), 0);
-    std::vector<char> counted(model.springCount(), 0);
-    for (Index m : masses) {
-        r.moving.push_back(m);
-        r.mask[m] = 1;
-        for (Index e : model.topology.edgesOf(m))
-            if (!counted[e]) {
-                counted[e] = 1;
-                r.computed.push_back(e);
-            }
-    }
-    return r;
+ActiveRegion regionOf(const PartModel& model, const std::vector<Index>& masses) {
+    ActiveRegion region(model);
+    for (Index m : masses) region.cover(m);
+    return region;
 }
 
 // Masses 100-159 (a band across the tube) and every seventh mass: several pieces, and springs
@@ -57,13 +40,13 @@ namespace {
 
 // One step of the naive model by hand (its Model::step puts gravity on every mass; here the
 // pinned masses of 1e300 kg must not feel it), with an external force on one mass.
-void naiveStep(naive::Model& model, const std::vector<std::uint16_t>& moving, double dt, double gravityY, double drag,
+void naiveStep(naive::Model& model, const ActiveRegion& region, double dt, double gravityY, double drag,
                int loaded, const naive::Vector3D& load) {
     for (int i = 0; i < model.numOfMasses; ++i) model.masses[i]->init();
     for (int s = 0; s < model.numOfSprings; ++s) model.springs[s]->solve();
     for (int i = 0; i < model.numOfMasses; ++i) {
         naive::Mass& m = *model.masses[i];
-        if (moving[std::size_t(i)] != 0) m.applyForce(naive::Vector3D(0.0, gravityY * m.mass, 0.0));
+        if (region.moves(Index(i))) m.applyForce(naive::Vector3D(0.0, gravityY * m.mass, 0.0));
         m.applyForce(-m.velocity * drag);
     }
     model.masses[loaded]->applyForce(load);
@@ -77,17 +60,17 @@ TEST(RegionStep, MatchesTheNaiveReferenceWithEveryOtherMassPinned) {
     // 1e300, so they feel their springs but do not move, which is what the region step assumes.
     const TriMesh mesh = makeTorus1();
     const auto model = buildPartModel(mesh, {Material{0.8, 0.05}, 1.0, {}, {}});
-    const Region region = regionOf(*model, scatteredMasses(*model));
+    const ActiveRegion region = regionOf(*model, scatteredMasses(*model));
     const auto reference = naive::modelFromMesh(mesh, 1.0, 0.8, 0.05);
     for (Index m = 0; m < model->massCount(); ++m)
-        if (region.mask[m] == 0) reference->masses[m]->mass = 1e300;
+        if (!region.moves(m)) reference->masses[m]->mass = 1e300;
     PartState state = PartState::atRest(*model);
     const SimulationSettings settings = noRestoration();
     for (int step = 0; step < 500; ++step) {
         const Vec3 load = step < 200 ? Vec3(0.0, 2.0, 0.5) : Vec3::Zero();
         state.forces[120] += load;
-        stepActiveRegion(*model, settings, region.moving, region.computed, region.mask, state);
-        naiveStep(*reference, region.mask, settings.timeStep, settings.gravity.y(), settings.globalDamping, 120,
+        stepActiveRegion(*model, settings, region, state);
+        naiveStep(*reference, region, settings.timeStep, settings.gravity.y(), settings.globalDamping, 120,
                   naive::Vector3D(load.x(), load.y(), load.z()));
     }
     double worst = 0.0;
@@ -98,33 +81,33 @@ TEST(RegionStep, MatchesTheNaiveReferenceWithEveryOtherMassPinned) {
     EXPECT_GT((state.positions[120] - model->restPositions[120]).norm(), 0.01);  // it moved
     EXPECT_LT(worst, 1e-9);
     for (Index m = 0; m < model->massCount(); ++m) {
-        if (region.mask[m] != 0) continue;
+        if (region.moves(m)) continue;
         ASSERT_EQ(state.positions[m], model->restPositions[m]) << "mass " << m;
     }
 }
 
 TEST(RegionStep, CostsTheRegionAndConsumesItsForces) {
     const auto model = buildPartModel(makeTorus2());
-    const Region region = regionOf(*model, scatteredMasses(*model));
+    const ActiveRegion region = regionOf(*model, scatteredMasses(*model));
     PartState state = PartState::atRest(*model);
     state.forces[120] = Vec3(1.0, 0.0, 0.0);
     StepCounters counters;
-    stepActiveRegion(*model, SimulationSettings{}, region.moving, region.computed, region.mask, state, &counters);
-    EXPECT_EQ(counters.springsEvaluated, region.computed.size());
-    EXPECT_EQ(counters.massesIntegrated, region.moving.size());
+    stepActiveRegion(*model, SimulationSettings{}, region, state, &counters);
+    EXPECT_EQ(counters.springsEvaluated, region.springs().size());
+    EXPECT_EQ(counters.massesIntegrated, region.masses().size());
     EXPECT_EQ(state.forces[120], Vec3::Zero());
     EXPECT_EQ(state.stepCount, 1u);
 }
 
 TEST(RegionStep, GoldenHash) {
     const auto model = buildPartModel(makeTorus2());
-    const Region region = regionOf(*model, scatteredMasses(*model));
+    const ActiveRegion region = regionOf(*model, scatteredMasses(*model));
     const auto run = [&](const SimulationSettings& settings) {
         PartState state = PartState::atRest(*model);
         for (int step = 0; step < 400; ++step) {
             if (step < 150) state.forces[120] += Vec3(0.3, 0.6, -0.2);
             if (step < 150) state.forces[3] += Vec3(-0.5, 0.0, 0.25);
-            stepActiveRegion(*model, settings, region.moving, region.computed, region.mask, state);
+            stepActiveRegion(*model, settings, region, state);
         }
         return flexfit::testing::hex(stateHash(state));
     };

@@ -1,5 +1,6 @@
 // k-rings against an independent BFS over a dense adjacency matrix built from the faces.
 #include "flexfit/flexfit.hpp"
+#include "model/kring.hpp"
 
 #include <gtest/gtest.h>
 

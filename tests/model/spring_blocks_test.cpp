@@ -1,6 +1,7 @@
 // buildSpringBlocks against brute force: every spring in exactly one place, each lane the spring
 // it claims to be, blocks only where the vertex order gives them.
 #include "flexfit/flexfit.hpp"
+#include "model/spring_blocks.hpp"
 #include "shuffled_mesh.hpp"
 #include "unit_cube.hpp"
 
@@ -21,7 +22,7 @@ std::map<std::pair<Index, Index>, std::size_t> springsByEnds(const PartModel& mo
 }
 
 void expectEverySpringOnceWithItsConstants(const PartModel& model) {
-    const SpringBlocks& blocks = model.springBlocks;
+    const SpringBlocks& blocks = *model.springBlocks;
     const auto ends = springsByEnds(model);
     std::vector<int> seen(model.springCount(), 0);
     for (std::size_t q = 0; q < blocks.blockCount(); ++q) {
@@ -48,8 +49,8 @@ TEST(SpringBlocks, RowMeshesPutMostSpringsInBlocksAndEverySpringOnce) {
     for (const TriMesh& mesh : {makeTorus1(), makeTorus2(), makeHeart()}) {
         SCOPED_TRACE(mesh.name);
         const auto model = buildPartModel(mesh);
-        ASSERT_FALSE(model->springBlocks.empty());
-        const double share = double(model->springBlocks.blockCount() * SpringBlocks::kWidth) / double(model->springCount());
+        ASSERT_FALSE(model->springBlocks->empty());
+        const double share = double(model->springBlocks->blockCount() * SpringBlocks::kWidth) / double(model->springCount());
         EXPECT_GE(share, SpringBlocks::kMinBlockedShare);
         expectEverySpringOnceWithItsConstants(*model);
     }
@@ -82,18 +83,18 @@ TEST(SpringBlocks, BlocksAreMaximalRunsCutIntoEights) {
             run = 1;
         }
     }
-    EXPECT_EQ(model->springBlocks.blockCount(), expected);
-    const SpringBlocks& b = model->springBlocks;
+    EXPECT_EQ(model->springBlocks->blockCount(), expected);
+    const SpringBlocks& b = *model->springBlocks;
     for (std::size_t q = 1; q < b.blockCount(); ++q)
         EXPECT_TRUE(b.offset[q - 1] < b.offset[q] || (b.offset[q - 1] == b.offset[q] && b.first[q - 1] < b.first[q]));
 }
 
 TEST(SpringBlocks, ShuffledVerticesAndSmallMeshesKeepTheSweep) {
-    EXPECT_TRUE(buildPartModel(flexfit::testing::shuffledVertices(makeTorus1(), 3))->springBlocks.empty());
-    EXPECT_TRUE(buildPartModel(flexfit::testing::shuffledVertices(makeHeart(), 4))->springBlocks.empty());
+    EXPECT_TRUE(buildPartModel(flexfit::testing::shuffledVertices(makeTorus1(), 3))->springBlocks->empty());
+    EXPECT_TRUE(buildPartModel(flexfit::testing::shuffledVertices(makeHeart(), 4))->springBlocks->empty());
     const auto cube = buildPartModel(flexfit::testing::unitCube());
-    EXPECT_TRUE(cube->springBlocks.empty());
-    EXPECT_TRUE(cube->springBlocks.remainder.empty());
+    EXPECT_TRUE(cube->springBlocks->empty());
+    EXPECT_TRUE(cube->springBlocks->remainder.empty());
 }
 
 TEST(SpringBlocks, ContinuesRowOnlyForAdjacentOffsetOneBlocks) {

@@ -1,7 +1,8 @@
 // Scripted scene runs against analytic mechanics (impulse of a push, the interpolated grab
 // target), the thesis's ball-through-torus cases with the shipped example scene, and
 // determinism of a whole scene run.
-#include "flexfit/scene.hpp"
+#include "flexfit/scene_file.hpp"
+#include "flexfit/scene_run.hpp"
 #include "golden.hpp"
 
 #include <gtest/gtest.h>

@@ -176,34 +176,62 @@ TEST(World, DeformableRimStopsAWeakPushAndYieldsToAStrongOne) {
 }
 
 TEST(World, PartSettingsChangeWhileRunning) {
-    World world;
+    WorldSettings settings;
+    settings.timeStep = 2e-3;
+    World world(settings);
     PartSettings rim;
     rim.simulation.restoration = {RestorationMethod::AnchorSprings, 10.0, 6.0, 1e-3};
     rim.zones.contactLevel = 2;
     const BodyId torus = world.add(buildPartModel(makeTorus1()), rim, BodySettings{}, Pose{});
-    const double before = world.collision().effectiveStiffness(torus);
+    // A kinematic probe above the top of the tube (torus1: R = 10, r = 2.5).
+    PartSettings rigid;
+    rigid.mode = PartMode::Rigid;
+    BodySettings kinematic;
+    kinematic.motion = MotionType::Kinematic;
+    const BodyId probe = world.add(buildPartModel(makeIcoSphere(1.0, 2)), rigid, kinematic, Pose{{1, 0, 0, 0}, Vec3(10, 4, 0)});
+    const double before = world.contactStiffness(torus);
     // Stiffer anchors and deeper contact zones, live: the contact stiffness follows (mean spring
-    // k + k_a), new zones take the new level, the world's step and no-gravity rule stay.
+    // k + k_a), new zones take the new level. The part's own time step and gravity are kept as
+    // given and not used: the world's step context rules.
     PartSettings changed = world.part(torus).settings();
     changed.simulation.restoration.anchorStiffness = 50.0;
-    changed.simulation.timeStep = 0.5;         // ignored: the world's step rules
-    changed.simulation.gravity = Vec3(0, -9.81, 0);  // ignored: zone masses feel no gravity
+    changed.simulation.timeStep = 0.5;
+    changed.simulation.gravity = Vec3(0, -9.81, 0);
     changed.zones.contactLevel = 4;
     world.setPartSettings(torus, changed);
-    EXPECT_NEAR(world.collision().effectiveStiffness(torus) - before, 40.0, 1e-12);
-    EXPECT_EQ(world.part(torus).settings().simulation.timeStep, world.settings().timeStep);
-    EXPECT_EQ(world.part(torus).settings().simulation.gravity, Vec3::Zero());
-    world.part(torus).touchFace(0);
+    EXPECT_NEAR(world.contactStiffness(torus) - before, 40.0, 1e-12);
+    EXPECT_EQ(world.part(torus).settings().simulation.timeStep, 0.5);
+    world.setKinematicTarget(probe, Pose{{1, 0, 0, 0}, Vec3(10, 3.3, 0)});  // 0.2 into the tube
+    world.step();
+    ASSERT_FALSE(world.contacts().empty());
     std::vector<int> depths;
     world.part(torus).zoneDepths(depths);
-    EXPECT_EQ(*std::max_element(depths.begin(), depths.end()), 3);  // level 4: depths 0..3
+    EXPECT_EQ(*std::max_element(depths.begin(), depths.end()), 3);  // contact zones of level 4: depths 0..3
+    EXPECT_EQ(world.part(torus).time(), 2e-3);                      // the world's step, not the part's 0.5 s
     // A mode change or invalid settings are refused and change nothing.
-    PartSettings rigid = changed;
-    rigid.mode = PartMode::Rigid;
-    EXPECT_THROW(world.setPartSettings(torus, rigid), InputError);
+    PartSettings rigidMode = changed;
+    rigidMode.mode = PartMode::Rigid;
+    EXPECT_THROW(world.setPartSettings(torus, rigidMode), InputError);
     PartSettings bad = changed;
     bad.simulation.restoration.anchorStiffness = -1.0;
     EXPECT_THROW(world.setPartSettings(torus, bad), InputError);
     EXPECT_EQ(world.part(torus).settings().simulation.restoration.anchorStiffness, 50.0);
     EXPECT_THROW(world.setPartSettings(7, changed), InputError);
+}
+
+TEST(World, ZoneMassesFeelNoGravityAndPartsKeepTheirSettings) {
+    // An open zone under the world's gravity, nothing touching it: its masses stay exactly at
+    // rest (a part's rest shape is its shape under its own weight), although the part's own
+    // settings, kept as given, ask for gravity.
+    World world;  // gravity -9.81 along y
+    PartSettings settings;
+    settings.simulation.gravity = Vec3(0, -9.81, 0);
+    settings.zones.retireCheckInterval = 1000000;
+    const BodyId torus = world.add(buildPartModel(makeTorus1()), settings, BodySettings{}, Pose{});
+    world.openZone(torus, ZoneSeed::mass(17), 3);
+    ASSERT_GT(world.part(torus).movingMasses().size(), 0u);
+    for (int i = 0; i < 200; ++i) world.step();
+    EXPECT_GT(world.part(torus).movingMasses().size(), 0u);
+    EXPECT_EQ(world.part(torus).state().positions, world.part(torus).model().restPositions);
+    EXPECT_EQ(world.part(torus).settings().simulation.gravity, Vec3(0, -9.81, 0));
 }

@@ -1,6 +1,6 @@
 // Scene files: every error class names the file, the line and the key, and nothing is built;
 // a valid scene gives exactly the values it states (checked key by key against the text).
-#include "flexfit/scene.hpp"
+#include "flexfit/scene_file.hpp"
 
 #include <gtest/gtest.h>
 
@@ -124,7 +124,7 @@ TEST(Scene, OutOfRangeValueIsReported) {
 
 TEST(Scene, UnknownChoiceListsTheOptions) {
     const std::string e = errorOf(withLine("name = \"ball\"", "bounding_volume = \"capsule\""));
-    EXPECT_NE(e.find(":18: part 2, key 'bounding_volume': unknown value 'capsule' (expected one of 'aabb', 'sphere')"),
+    EXPECT_NE(e.find(":18: part 2, key 'bounding_volume': unknown value 'capsule' (expected one of 'sphere', 'aabb')"),
               std::string::npos)
         << e;
 }

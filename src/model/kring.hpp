@@ -5,7 +5,7 @@
 // what it visits, whatever the mesh size.
 #pragma once
 
-#include "flexfit/epoch_marks.hpp"
+#include "core/epoch_marks.hpp"
 #include "flexfit/topology.hpp"
 
 #include <cstdint>

@@ -1,0 +1,119 @@
+// One vocabulary: every enum a user names (in a scene file, on the command line, in JSON
+// output or in the viewer) has one table of names here, and all of them read it.
+//
+// Each value has one name, the spelling users type and read (scene files, CLI options,
+// toString, JSON), and a label, words for prose and the viewer ("anchors" is named so and
+// labelled "anchor springs"). Spellings that older versions accepted stay readable for a
+// while: parseName() maps them to their value and says which name replaces them, so the
+// caller can warn with the file and line.
+#pragma once
+
+#include "flexfit/assembly.hpp"
+#include "flexfit/body.hpp"
+#include "flexfit/collision_world.hpp"
+#include "flexfit/part.hpp"
+#include "flexfit/profile.hpp"
+#include "flexfit/simulation.hpp"
+
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace flexfit {
+
+template <class Enum>
+struct EnumName {
+    Enum value;
+    const char* name;   // the one spelling
+    const char* label;  // for prose and the viewer
+};
+
+template <class Enum>
+struct DeprecatedName {
+    const char* name;   // an old spelling, still read with a warning
+    Enum value;
+};
+
+// The tables (names.cpp): every value once, in declaration order.
+template <class Enum>
+std::span<const EnumName<Enum>> enumNames();
+template <class Enum>
+std::span<const DeprecatedName<Enum>> deprecatedNames();
+
+template <> std::span<const EnumName<PartMode>> enumNames();
+template <> std::span<const EnumName<MotionType>> enumNames();
+template <> std::span<const EnumName<Integrator>> enumNames();
+template <> std::span<const EnumName<RestorationMethod>> enumNames();
+template <> std::span<const EnumName<ExactTest>> enumNames();
+template <> std::span<const EnumName<BoundingVolumeKind>> enumNames();
+template <> std::span<const EnumName<BroadPhaseUpdate>> enumNames();
+template <> std::span<const EnumName<RigidDeformableQuery>> enumNames();
+template <> std::span<const EnumName<SnapTechnique>> enumNames();
+template <> std::span<const EnumName<AssemblyArea::Shape>> enumNames();
+template <> std::span<const EnumName<Stage>> enumNames();
+
+template <> std::span<const DeprecatedName<PartMode>> deprecatedNames();
+template <> std::span<const DeprecatedName<RestorationMethod>> deprecatedNames();
+
+// Enums with no old spellings.
+template <class Enum>
+std::span<const DeprecatedName<Enum>> deprecatedNames() {
+    return {};
+}
+
+template <class Enum>
+const EnumName<Enum>& entryOf(Enum value) {
+    for (const EnumName<Enum>& e : enumNames<Enum>())
+        if (e.value == value) return e;
+    return enumNames<Enum>().front();  // unreachable for a valid value: each table lists every value
+}
+
+template <class Enum>
+const char* nameOf(Enum value) {
+    return entryOf(value).name;
+}
+
+template <class Enum>
+const char* labelOf(Enum value) {
+    return entryOf(value).label;
+}
+
+// The value named `text`, or nullopt. For an old spelling, `replacement` (when given)
+// receives the name to write instead; it is left empty otherwise.
+template <class Enum>
+std::optional<Enum> parseName(std::string_view text, std::string* replacement = nullptr) {
+    if (replacement != nullptr) replacement->clear();
+    for (const EnumName<Enum>& e : enumNames<Enum>())
+        if (text == e.name) return e.value;
+    for (const DeprecatedName<Enum>& d : deprecatedNames<Enum>())
+        if (text == d.name) {
+            if (replacement != nullptr) *replacement = nameOf(d.value);
+            return d.value;
+        }
+    return std::nullopt;
+}
+
+// "'a', 'b', 'c'": the names, for messages.
+template <class Enum>
+std::string nameList() {
+    std::string list;
+    for (const EnumName<Enum>& e : enumNames<Enum>()) list += (list.empty() ? "'" : ", '") + std::string(e.name) + "'";
+    return list;
+}
+
+// The names (and, with `withDeprecated`, the old spellings): for a CLI's list of choices.
+template <class Enum>
+std::vector<std::string> allNames(bool withDeprecated = false) {
+    std::vector<std::string> out;
+    for (const EnumName<Enum>& e : enumNames<Enum>()) out.emplace_back(e.name);
+    if (withDeprecated)
+        for (const DeprecatedName<Enum>& d : deprecatedNames<Enum>()) out.emplace_back(d.name);
+    return out;
+}
+
+// The warning for an old spelling: "'anchor' is deprecated: write 'anchors'".
+std::string deprecationWarning(std::string_view oldName, std::string_view replacement);
+
+}  // namespace flexfit

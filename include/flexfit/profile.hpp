@@ -1,0 +1,39 @@
+// Where a world step's time goes: one entry per named stage (world.hpp lists what each does).
+//
+// The stages partition the step: from the first instruction of World::step to its last, every
+// instant is charged to exactly one stage, the one running then. A stage running inside
+// another (the narrow-phase queries and contact projections inside the rigid motion's
+// sub-steps) is charged to itself and paused in the outer one. So the stages add up to
+// stepSeconds, and a stage that reads near zero did next to nothing.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace flexfit {
+
+enum class Stage {
+    OperatorInput,    // the operator's coupling force, kinematic targets
+    RigidMotion,      // rigid bodies integrated, in sub-steps (no tunnelling)
+    BroadPhase,       // parts' bounding spheres, candidate pairs
+    NarrowPhase,      // contacts of the candidate pairs (and of each sub-step's body)
+    ContactResponse,  // deformable pushes and reactions, rigid projections
+    ZoneDynamics,     // the deformable parts' masses (restoration included)
+    ZoneRetirement,   // zones at rest retired, their masses back at rest
+    Assembly,         // the snapping rules
+    Count
+};
+const char* toString(Stage stage);
+inline constexpr std::size_t kStageCount = std::size_t(Stage::Count);
+
+struct Profile {
+    std::array<double, kStageCount> lastSeconds{};   // the last step, per stage
+    std::array<double, kStageCount> totalSeconds{};  // since the start, per stage
+    double lastStepSeconds = 0.0;                    // the last World::step, whole
+    double totalStepSeconds = 0.0;                   // every World::step so far
+    std::uint64_t steps = 0;
+    std::uint64_t substeps = 0;  // dynamic sub-steps taken in all (no-tunnelling bound)
+};
+
+}  // namespace flexfit

@@ -1,0 +1,24 @@
+// Scene files: a scene (scene.hpp) written in TOML.
+//
+// Why TOML (toml++ from Debian's libtomlplusplus-dev): a scene is a handful of flat tables
+// ([world], [[part]], [[assembly]], [[action]], [output]) that engineers write by hand. TOML
+// has no indentation rules to get wrong and no implicit typing surprises (YAML's "no" is a
+// boolean), and toml++ keeps the line of every key, so each error names file, line and key.
+// Every key is checked: an unknown key is an error, as is a value of the wrong type or out of
+// range. Old spellings of names (names.hpp) are read, with a warning in Scene::warnings.
+#pragma once
+
+#include "flexfit/scene.hpp"
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace flexfit {
+
+// Throws InputError naming the file, the line and the key for every problem.
+Scene loadScene(const std::filesystem::path& file);
+// The same from text; mesh paths are resolved against `baseDirectory`.
+Scene parseScene(std::string_view text, const std::string& source, const std::filesystem::path& baseDirectory);
+
+}  // namespace flexfit

@@ -1,0 +1,47 @@
+// The broad phase (collision_world.hpp): each body's bounding sphere, the hierarchy of those
+// spheres, and the pairs whose spheres overlap.
+#include "flexfit/collision_world.hpp"
+
+#include <algorithm>
+
+namespace flexfit {
+
+void CollisionWorld::noteShapeChanges(BodyId id, std::span<const Index> changedMasses) {
+    if (!changedMasses.empty()) colliders_[id].noteChanges(*parts_[id], changedMasses);
+}
+
+void CollisionWorld::updateBounds() {
+    for (std::size_t i = 0; i < parts_.size(); ++i) {
+        colliders_[i].updateDisplacementBound(*parts_[i]);
+        partSpheres_[i] = colliders_[i].worldSphere(*parts_[i]);
+    }
+}
+
+void CollisionWorld::update() {
+    updateBounds();
+    if (settings_.broadPhase == BroadPhaseUpdate::Rebuild)
+        broadPhase_.build(partSpheres_);
+    else
+        broadPhase_.refitAll([&](Index i) { return partSpheres_[i]; });
+    // Each body's sphere against the tree, depth-first.
+    pairs_.clear();
+    const RelativePose identity;
+    const auto& nodes = broadPhase_.nodes();
+    for (BodyId i = 0; i < partSpheres_.size(); ++i) {
+        stack_.assign(1, 0);
+        while (!stack_.empty()) {
+            const auto& node = nodes[std::size_t(stack_.back())];
+            stack_.pop_back();
+            if (!overlap(partSpheres_[i], node.volume, identity)) continue;
+            if (!node.isLeaf()) {
+                stack_.push_back(node.right);
+                stack_.push_back(node.left);
+            } else if (node.item > i) {
+                pairs_.emplace_back(i, node.item);
+            }
+        }
+    }
+    std::sort(pairs_.begin(), pairs_.end());
+}
+
+}  // namespace flexfit

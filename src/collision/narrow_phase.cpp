@@ -1,0 +1,54 @@
+// The narrow phase (collision_world.hpp): the contacts of candidate pairs, by face hierarchies
+// or by point shell, and one body's contacts for the rigid motion's sub-steps.
+#include "flexfit/collision_world.hpp"
+
+#include <algorithm>
+
+namespace flexfit {
+namespace {
+
+bool deformable(const Part& p) { return p.mode() != PartMode::Rigid; }
+
+}  // namespace
+
+const std::vector<Contact>& CollisionWorld::narrowPhase() {
+    contacts_.clear();
+    stats_ = {};
+    for (auto [i, j] : pairs_) {
+        if (!pressesFirst(i, j)) std::swap(i, j);
+        queryPair(i, j, contacts_, stats_);
+    }
+    return contacts_;
+}
+
+const std::vector<Contact>& CollisionWorld::findContacts() {
+    update();
+    return narrowPhase();
+}
+
+const std::vector<Contact>& CollisionWorld::contactsOf(BodyId id, bool rigidPartnersOnly) {
+    updateBounds();
+    bodyContacts_.clear();
+    const RelativePose identity;
+    // Other bodies in ascending id: the same pairs, in the same order, as the broad phase gives.
+    for (BodyId other = 0; other < parts_.size(); ++other) {
+        if (other == id || !overlap(partSpheres_[id], partSpheres_[other], identity)) continue;
+        if (rigidPartnersOnly && deformable(*parts_[other])) continue;
+        BodyId a = std::min(id, other), b = std::max(id, other);
+        if (!pressesFirst(a, b)) std::swap(a, b);
+        QueryStats ignored;
+        queryPair(a, b, bodyContacts_, ignored);
+    }
+    return bodyContacts_;
+}
+
+void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats) {
+    // A field exists only for a rigid part under the point-shell setting.
+    if (const SignedDistanceField* field = fields_[a].get(); field != nullptr && deformable(*parts_[b]))
+        return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(), out, stats);
+    colliders_[a].refitPending(*parts_[a]);
+    colliders_[b].refitPending(*parts_[b]);
+    flexfit::queryPair(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, out, stats);
+}
+
+}  // namespace flexfit

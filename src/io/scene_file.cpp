@@ -1,0 +1,447 @@
+// TOML scene parsing (scene_file.hpp). Every table is read through a Table that remembers
+// which keys were used, so unknown keys (typos) are reported instead of silently ignored.
+#include "flexfit/scene_file.hpp"
+
+#include "flexfit/generators.hpp"
+#include "flexfit/mesh_io.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace flexfit {
+namespace {
+
+std::size_t lineOf(const toml::node& node) { return node.source().begin.line; }
+
+// One TOML table with its name for messages ("part 'ball'") and the keys read from it.
+class Table {
+public:
+    Table(const toml::table& table, std::string what, const std::string& file, std::vector<SceneWarning>& warnings)
+        : table_(table), what_(std::move(what)), file_(file), warnings_(warnings) {}
+
+    [[noreturn]] void fail(const toml::node& at, const std::string& key, const std::string& problem) const {
+        throw InputError(file_, lineOf(at), what_ + ", key '" + key + "': " + problem);
+    }
+    [[noreturn]] void fail(const std::string& problem) const { throw InputError(file_, lineOf(table_), what_ + ": " + problem); }
+
+    bool has(const std::string& key) const { return table_.contains(key); }
+    const toml::node* node(const std::string& key) {
+        used_.insert(key);
+        return table_.get(key);
+    }
+    std::size_t line(const std::string& key) const {
+        const toml::node* n = table_.get(key);
+        return n ? lineOf(*n) : lineOf(table_);
+    }
+    std::size_t line() const { return lineOf(table_); }
+
+    double number(const std::string& key, double fallback) {
+        const toml::node* n = node(key);
+        if (!n) return fallback;
+        if (!n->is_number()) fail(*n, key, "expected a number");
+        const double v = n->value<double>().value();
+        if (!std::isfinite(v)) fail(*n, key, "must be finite");
+        return v;
+    }
+    double positive(const std::string& key, double fallback) {
+        const double v = number(key, fallback);
+        if (!(v > 0.0)) fail(*table_.get(key), key, "must be > 0");
+        return v;
+    }
+    double nonNegative(const std::string& key, double fallback) {
+        const double v = number(key, fallback);
+        if (!(v >= 0.0)) fail(*table_.get(key), key, "must be >= 0");
+        return v;
+    }
+    int integer(const std::string& key, int fallback, int lo, int hi) {
+        const toml::node* n = node(key);
+        if (!n) return fallback;
+        if (!n->is_integer()) fail(*n, key, "expected an integer");
+        const std::int64_t v = n->value<std::int64_t>().value();
+        if (v < lo || v > hi) fail(*n, key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        return int(v);
+    }
+    std::string text(const std::string& key, const std::string& fallback) {
+        const toml::node* n = node(key);
+        if (!n) return fallback;
+        if (!n->is_string()) fail(*n, key, "expected a string");
+        return std::string(n->value<std::string>().value());
+    }
+    std::string requiredText(const std::string& key) {
+        if (!has(key)) fail("missing key '" + key + "'");
+        return text(key, "");
+    }
+    Vec3 vec3(const std::string& key, const Vec3& fallback) {
+        const toml::node* n = node(key);
+        if (!n) return fallback;
+        const toml::array* a = n->as_array();
+        if (!a || a->size() != 3) fail(*n, key, "expected an array of 3 numbers");
+        Vec3 v;
+        for (int i = 0; i < 3; ++i) {
+            const toml::node& e = *a->get(std::size_t(i));
+            if (!e.is_number()) fail(e, key, "expected an array of 3 numbers");
+            v[i] = e.value<double>().value();
+        }
+        if (!v.allFinite()) fail(*n, key, "must be finite");
+        return v;
+    }
+    // Rotation as degrees about x, then y, then z (world axes).
+    Eigen::Quaterniond rotation(const std::string& key) {
+        const Vec3 deg = vec3(key, Vec3::Zero()) * (M_PI / 180.0);
+        return Eigen::Quaterniond(Eigen::AngleAxisd(deg.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(deg.y(), Vec3::UnitY()) *
+                                  Eigen::AngleAxisd(deg.x(), Vec3::UnitX()));
+    }
+    Pose pose(const std::string& positionKey, const std::string& rotationKey) {
+        Pose p;
+        p.translation = vec3(positionKey, Vec3::Zero());
+        p.rotation = rotation(rotationKey);
+        return p;
+    }
+    std::vector<Index> indices(const std::string& key) {
+        const toml::node* n = node(key);
+        std::vector<Index> out;
+        if (!n) return out;
+        const toml::array* a = n->as_array();
+        if (!a) fail(*n, key, "expected an array of indices");
+        for (const toml::node& e : *a) {
+            if (!e.is_integer() || e.value<std::int64_t>().value() < 0 || e.value<std::int64_t>().value() > 0x7fffffff)
+                fail(e, key, "expected non-negative integer indices");
+            out.push_back(Index(e.value<std::int64_t>().value()));
+        }
+        return out;
+    }
+    Table sub(const std::string& key) {
+        const toml::node* n = node(key);
+        if (!n || !n->is_table()) fail(n ? *n : static_cast<const toml::node&>(table_), key, "expected a table");
+        return Table(*n->as_table(), what_ + "." + key, file_, warnings_);
+    }
+    // One of the enum's names (names.hpp); an old spelling is read with a warning.
+    template <class Enum>
+    Enum choice(const std::string& key, Enum fallback) {
+        if (!has(key)) {
+            used_.insert(key);
+            return fallback;
+        }
+        const std::string value = text(key, "");
+        std::string replacement;
+        const std::optional<Enum> e = parseName<Enum>(value, &replacement);
+        if (!e) fail(*table_.get(key), key, "unknown value '" + value + "' (expected one of " + nameList<Enum>() + ")");
+        if (!replacement.empty()) warnings_.push_back({line(key), what_ + ", key '" + key + "': " + deprecationWarning(value, replacement)});
+        return *e;
+    }
+    // Every key must have been read.
+    void finish() const {
+        for (const auto& [key, value] : table_)
+            if (!used_.count(std::string(key.str()))) fail(value, std::string(key.str()), "unknown key");
+    }
+    const std::string& what() const { return what_; }
+    const std::string& file() const { return file_; }
+
+private:
+    const toml::table& table_;
+    std::string what_;
+    const std::string& file_;
+    std::vector<SceneWarning>& warnings_;
+    std::set<std::string> used_;
+};
+
+// The array of tables under `key` ([[part]] etc.); empty when absent.
+std::vector<const toml::table*> tables(Table& root, const std::string& key) {
+    std::vector<const toml::table*> out;
+    const toml::node* n = root.node(key);
+    if (!n) return out;
+    const toml::array* a = n->as_array();
+    if (!a) root.fail(*n, key, "expected [[" + key + "]] tables");
+    for (const toml::node& e : *a) {
+        if (!e.is_table()) root.fail(e, key, "expected [[" + key + "]] tables");
+        out.push_back(e.as_table());
+    }
+    return out;
+}
+
+// Mesh input errors stay as they are (they name the mesh file and its line); the scene's
+// line is added so the user knows which part asked for the file.
+TriMesh readPartMesh(Table& t, const std::filesystem::path& base) {
+    const std::string file = t.text("mesh", "");
+    const std::filesystem::path path = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : base / file;
+    const std::size_t line = t.line("mesh");
+    try {
+        return readMesh(path).mesh;
+    } catch (const InputError& e) {
+        throw InputError(t.file(), line, t.what() + ", key 'mesh': " + e.what());
+    }
+}
+
+TriMesh generatePartMesh(Table& t) {
+    const toml::node* n = t.node("generator");
+    if (n->is_string()) {
+        const std::string name(n->value<std::string>().value());
+        if (name == "torus1") return makeTorus1();
+        if (name == "torus2") return makeTorus2();
+        if (name == "heart") return makeHeart();
+        if (name == "container-mouth") return makeContainerMouth();
+        t.fail(*n, "generator", "unknown generator '" + name + "' (expected 'torus1', 'torus2', 'heart', 'container-mouth' or a table)");
+    }
+    if (!n->is_table()) t.fail(*n, "generator", "expected a name or a table");
+    Table g = t.sub("generator");
+    const std::string type = g.text("type", "torus");
+    if (type != "torus" && type != "sphere")
+        g.fail(*g.node("type"), "type", "unknown value '" + type + "' (expected one of 'torus', 'sphere')");
+    TriMesh mesh;
+    if (type == "torus") {
+        const double major = g.positive("major", 10.0), minor = g.positive("minor", 2.5);
+        if (!(minor < major)) g.fail("minor radius must be smaller than the major radius");
+        mesh = makeTorus(major, minor, g.integer("u", 24, 3, 4096), g.integer("v", 24, 3, 4096));
+    } else {
+        mesh = makeIcoSphere(g.positive("radius", 1.0), g.integer("level", 3, 0, 7));
+    }
+    g.finish();
+    return mesh;
+}
+
+Material readMaterial(Table& t) {
+    const toml::node* n = t.node("material");
+    if (!n) return Material::elastic();
+    if (n->is_string()) {
+        const std::string name(n->value<std::string>().value());
+        if (auto preset = materialPreset(name)) return *preset;
+        t.fail(*n, "material", "unknown preset '" + name + "' (expected 'rigid', 'elastic', 'superelastic' or {stiffness, damping})");
+    }
+    if (!n->is_table()) t.fail(*n, "material", "expected a preset name or {stiffness, damping}");
+    Table m = t.sub("material");
+    Material material{m.positive("stiffness", 0.1), m.nonNegative("damping", 0.01)};
+    m.finish();
+    return material;
+}
+
+ScenePart readPart(Table& t, const std::filesystem::path& base) {
+    ScenePart p;
+    p.name = t.requiredText("name");
+    if (t.has("mesh") == t.has("generator")) t.fail("needs exactly one of 'mesh' and 'generator'");
+    TriMesh mesh = t.has("mesh") ? readPartMesh(t, base) : generatePartMesh(t);
+    mesh.name = p.name;
+    PartModelSettings model;
+    model.material = readMaterial(t);
+    model.vertexMass = t.positive("vertex_mass", 1.0);
+
+    p.part.mode = t.choice("mode", PartMode::RigidDeformable);
+    SimulationSettings& sim = p.part.simulation;
+    sim.integrator = t.choice("integrator", Integrator::SemiImplicitEuler);
+    sim.globalDamping = t.nonNegative("global_damping", 0.0);
+    sim.restoration.method = t.choice("restoration", RestorationMethod::Constraint);
+    sim.restoration.constraintFraction = t.positive("constraint_fraction", sim.restoration.constraintFraction);
+    if (sim.restoration.constraintFraction > 1.0) t.fail(*t.node("constraint_fraction"), "constraint_fraction", "must be in (0, 1]");
+    sim.restoration.anchorStiffness = t.nonNegative("anchor_stiffness", sim.restoration.anchorStiffness);
+    sim.restoration.anchorDamping = t.nonNegative("anchor_damping", sim.restoration.anchorDamping);
+    ZoneSettings& z = p.part.zones;
+    z.defaultLevel = t.integer("default_level", z.defaultLevel, 0, 255);
+    z.contactLevel = t.integer("contact_level", z.contactLevel, 0, 255);
+    z.activityThreshold = t.positive("activity_threshold", z.activityThreshold);
+    z.restSpeed = t.positive("rest_speed", z.restSpeed);
+
+    p.body.motion = t.choice("motion", MotionType::Static);
+    p.body.density = t.positive("density", 1.0);
+    p.body.linearVelocity = t.vec3("velocity", Vec3::Zero());
+    p.body.angularVelocity = t.vec3("angular_velocity", Vec3::Zero());
+    p.body.thickness = t.nonNegative("thickness", 0.0);
+    p.body.boundingVolume = t.choice("bounding_volume", BoundingVolumeKind::Aabb);
+    p.pose = t.pose("position", "rotation");
+    t.finish();
+    try {
+        p.model = buildPartModel(std::move(mesh), model);
+    } catch (const InputError& e) {
+        t.fail("invalid part: " + std::string(e.what()));
+    }
+    return p;
+}
+
+BodyId partId(Table& t, const std::string& key, const Scene& scene) {
+    const std::string name = t.requiredText(key);
+    if (auto id = scene.find(name)) return *id;
+    t.fail(*t.node(key), key, "no part named '" + name + "'");
+}
+
+AssemblyVector readVector(Table& t, const std::string& key) {
+    AssemblyVector v;
+    if (!t.has(key)) return v;
+    Table s = t.sub(key);
+    v.origin = s.vec3("origin", v.origin);
+    v.end = s.vec3("end", v.end);
+    s.finish();
+    return v;
+}
+
+AssemblyArea readArea(Table& t) {
+    AssemblyArea a;
+    if (!t.has("area")) return a;
+    Table s = t.sub("area");
+    a.shape = s.choice("shape", AssemblyArea::Shape::Box);
+    a.frame = s.pose("position", "rotation");
+    a.halfExtents = s.vec3("half_extents", a.halfExtents);
+    if (!(a.halfExtents.minCoeff() > 0.0)) s.fail(*s.node("half_extents"), "half_extents", "must be > 0");
+    a.radius = s.positive("radius", a.radius);
+    a.halfHeight = s.positive("half_height", a.halfHeight);
+    s.finish();
+    return a;
+}
+
+AssemblyRule readAssembly(Table& t, const Scene& scene) {
+    AssemblyRule r;
+    r.name = t.text("name", "assembly " + std::to_string(scene.assemblies.size()));
+    r.primary = partId(t, "primary", scene);
+    r.secondary = partId(t, "secondary", scene);
+    if (r.primary == r.secondary) t.fail(*t.node("secondary"), "secondary", "must differ from the primary");
+    r.technique = t.choice("technique", SnapTechnique::ZoneSnap);
+    r.finalRelativePose = t.pose("final_position", "final_rotation");
+    r.snapDuration = t.nonNegative("snap_duration", r.snapDuration);
+    r.distanceTolerance = t.positive("distance_tolerance", r.distanceTolerance);
+    r.angleTolerance = t.positive("angle_tolerance", r.angleTolerance * 180.0 / M_PI) * M_PI / 180.0;
+    r.primaryVector = readVector(t, "primary_vector");
+    r.secondaryVector = readVector(t, "secondary_vector");
+    r.vectorTolerance = t.positive("vector_tolerance", r.vectorTolerance);
+    r.area = readArea(t);
+    t.finish();
+    return r;
+}
+
+void checkIndices(Table& t, const std::string& key, const std::vector<Index>& indices, std::size_t count) {
+    for (Index i : indices)
+        if (i >= count) t.fail(*t.node(key), key, "index " + std::to_string(i) + " out of range (the part has " + std::to_string(count) + ")");
+}
+
+SceneAction readAction(Table& t, const Scene& scene) {
+    using Kind = SceneAction::Kind;
+    SceneAction a;
+    a.line = t.line();
+    if (!t.has("time")) t.fail("missing key 'time'");
+    a.time = t.nonNegative("time", 0.0);
+    if (!t.has("type")) t.fail("missing key 'type'");
+    a.kind = t.choice("type", Kind::Push);
+    a.body = partId(t, "part", scene);
+    const ScenePart& part = scene.parts[a.body];
+    switch (a.kind) {
+        case Kind::Grab:
+            a.grab.frequency = t.positive("frequency", a.grab.frequency);
+            a.grab.stiffness = t.nonNegative("stiffness", 0.0);
+            a.grab.damping = t.number("damping", -1.0);
+            a.grab.angularStiffness = t.nonNegative("angular_stiffness", 0.0);
+            a.grab.angularDamping = t.number("angular_damping", -1.0);
+            if (part.body.motion == MotionType::Static) t.fail(*t.node("part"), "part", "a static part cannot be grabbed");
+            break;
+        case Kind::Move:
+            if (!t.has("position")) t.fail("missing key 'position'");
+            a.target = t.pose("position", "rotation");
+            a.duration = t.nonNegative("duration", 0.0);
+            break;
+        case Kind::Release: break;
+        case Kind::Push:
+            if (!t.has("force")) t.fail("missing key 'force'");
+            a.force = t.vec3("force", Vec3::Zero());
+            a.duration = t.nonNegative("duration", 0.0);
+            break;
+        case Kind::Force:
+            if (!t.has("force")) t.fail("missing key 'force'");
+            a.force = t.vec3("force", Vec3::Zero());
+            a.duration = t.nonNegative("duration", 0.0);
+            a.masses = t.indices("masses");
+            a.faces = t.indices("faces");
+            if (a.masses.empty() && a.faces.empty()) t.fail("a force needs 'masses' or 'faces'");
+            checkIndices(t, "masses", a.masses, part.model->massCount());
+            checkIndices(t, "faces", a.faces, part.model->faceCount());
+            break;
+        case Kind::Velocity:
+            a.linear = t.vec3("linear", Vec3::Zero());
+            a.angular = t.vec3("angular", Vec3::Zero());
+            break;
+    }
+    t.finish();
+    return a;
+}
+
+// Moves and releases need the part to be held at that time.
+void checkOperatorScript(const Scene& scene) {
+    std::optional<BodyId> held;
+    for (const SceneAction& a : scene.actions) {
+        using Kind = SceneAction::Kind;
+        if (a.kind == Kind::Grab) held = a.body;
+        if ((a.kind == Kind::Move || a.kind == Kind::Release) && held != a.body)
+            throw InputError(scene.source, a.line, std::string("action '") + toString(a.kind) + "': part '" + scene.parts[a.body].name +
+                                                       "' is not grabbed at that time");
+        if (a.kind == Kind::Release) held.reset();
+    }
+}
+
+void readWorld(Table& root, Scene& scene) {
+    if (!root.has("world")) return;
+    Table w = root.sub("world");
+    WorldSettings& s = scene.world;
+    s.timeStep = w.positive("time_step", s.timeStep);
+    s.gravity = w.vec3("gravity", s.gravity);
+    scene.duration = w.positive("duration", scene.duration);
+    s.maxTravelFraction = w.positive("max_travel_fraction", s.maxTravelFraction);
+    if (s.maxTravelFraction > 1.0) w.fail(*w.node("max_travel_fraction"), "max_travel_fraction", "must be in (0, 1]");
+    s.maxSubsteps = w.integer("max_substeps", s.maxSubsteps, 1, 1 << 20);
+    s.contactIterations = w.integer("contact_iterations", s.contactIterations, 1, 1000);
+    s.collision.exactTest = w.choice("exact_test", ExactTest::TriangleTriangle);
+    s.collision.rigidDeformable = w.choice("rigid_deformable_query", RigidDeformableQuery::Faces);
+    w.finish();
+    try {
+        validateSettings(s);
+    } catch (const InputError& e) {
+        w.fail(e.problem());
+    }
+}
+
+}  // namespace
+
+Scene parseScene(std::string_view text, const std::string& source, const std::filesystem::path& baseDirectory) {
+    toml::table document;
+    try {
+        document = toml::parse(text, source);
+    } catch (const toml::parse_error& e) {
+        throw InputError(source, e.source().begin.line, "TOML syntax: " + std::string(e.description()));
+    }
+    Scene scene;
+    scene.source = source;
+    Table root(document, "scene", scene.source, scene.warnings);
+    readWorld(root, scene);
+    for (const toml::table* t : tables(root, "part")) {
+        Table part(*t, "part " + std::to_string(scene.parts.size() + 1), scene.source, scene.warnings);
+        ScenePart p = readPart(part, baseDirectory);
+        if (scene.find(p.name)) part.fail(*t->get("name"), "name", "duplicate part name '" + p.name + "'");
+        scene.parts.push_back(std::move(p));
+    }
+    if (scene.parts.empty()) root.fail("no [[part]]: a scene needs at least one part");
+    for (const toml::table* t : tables(root, "assembly")) {
+        Table a(*t, "assembly " + std::to_string(scene.assemblies.size() + 1), scene.source, scene.warnings);
+        scene.assemblies.push_back(readAssembly(a, scene));
+    }
+    for (const toml::table* t : tables(root, "action")) {
+        Table a(*t, "action " + std::to_string(scene.actions.size() + 1), scene.source, scene.warnings);
+        scene.actions.push_back(readAction(a, scene));
+    }
+    std::stable_sort(scene.actions.begin(), scene.actions.end(), [](const SceneAction& a, const SceneAction& b) { return a.time < b.time; });
+    checkOperatorScript(scene);
+    if (root.has("output")) {
+        Table o = root.sub("output");
+        scene.objEvery = o.nonNegative("obj_every", 0.0);
+        o.finish();
+    }
+    root.finish();
+    return scene;
+}
+
+Scene loadScene(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(file.string(), 0, "cannot open the scene file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parseScene(text.str(), file.string(), file.parent_path());
+}
+
+}  // namespace flexfit

@@ -1,0 +1,53 @@
+// Bodies and their mass properties (body.hpp, bodies.hpp).
+#include "bodies.hpp"
+
+#include "flexfit/mass_properties.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace flexfit {
+
+RigidBody makeRigidBody(const PartModel& model, const BodySettings& settings) {
+    const std::string source = "world";
+    if (!(settings.density > 0.0) || !std::isfinite(settings.density))
+        throw InputError(source, 0, "body density must be finite and > 0");
+    if (!(settings.thickness >= 0.0) || !std::isfinite(settings.thickness) || !settings.linearVelocity.allFinite() ||
+        !settings.angularVelocity.allFinite())
+        throw InputError(source, 0, "body thickness and velocities must be finite");
+    RigidBody body;
+    body.motion = settings.motion;
+    const Eigen::AlignedBox3d box = boundingBox(model.mesh);
+    body.thickness = settings.thickness > 0.0 ? settings.thickness : 0.5 * box.sizes().minCoeff();
+    body.centreOfMass = box.center();
+    if (settings.motion == MotionType::Dynamic) {
+        const MassProperties mp = computeMassProperties(model.mesh, model.name);
+        body.mass = settings.density * mp.volume;
+        body.inverseMass = 1.0 / body.mass;
+        body.centreOfMass = mp.centroid;
+        body.inverseInertia = (settings.density * mp.inertia).inverse();
+    }
+    for (const Vec3& p : model.restPositions) body.boundingRadius = std::max(body.boundingRadius, (p - body.centreOfMass).norm());
+    body.linearVelocity = settings.linearVelocity;
+    body.angularVelocity = settings.angularVelocity;
+    return body;
+}
+
+namespace detail {
+
+BodyId Bodies::add(std::unique_ptr<Part> part, const RigidBody& body) {
+    massAdr.push_back(massAdr.back() + Index(part->model().massCount()));
+    parts.push_back(std::move(part));
+    rigid.push_back(body);
+    kinematicTargets.emplace_back();
+    return BodyId(parts.size() - 1);
+}
+
+double Bodies::minimumThickness() const {
+    double thinnest = std::numeric_limits<double>::infinity();
+    for (const RigidBody& b : rigid) thinnest = std::min(thinnest, b.thickness);
+    return thinnest;
+}
+
+}  // namespace detail
+}  // namespace flexfit

@@ -1,0 +1,33 @@
+// Internal to src/world: the one registry of a world's bodies. Body `id` is parts[id] with
+// rigid[id]; the collision world registers the same ids (collision_world.hpp).
+#pragma once
+
+#include "flexfit/body.hpp"
+#include "flexfit/part.hpp"
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace flexfit::detail {
+
+struct Bodies {
+    std::vector<std::unique_ptr<Part>> parts;           // (nbody) owned here, stable addresses
+    std::vector<RigidBody> rigid;                       // (nbody)
+    std::vector<std::optional<Pose>> kinematicTargets;  // (nbody) pose to reach in the next step
+    // (nbody + 1) the world's mass numbering: body b's masses are massAdr[b] .. massAdr[b+1]-1,
+    // so per-mass scratch of the contact response spans every body.
+    std::vector<Index> massAdr{0};
+
+    std::size_t size() const { return parts.size(); }
+    Index massCount() const { return massAdr.back(); }
+    Index worldMass(BodyId body, Index mass) const { return massAdr[body] + mass; }
+
+    BodyId add(std::unique_ptr<Part> part, const RigidBody& body);
+    // World position of a body's centre of mass.
+    Vec3 centreOfMass(BodyId id) const { return parts[id]->pose().apply(rigid[id].centreOfMass); }
+    // The thinnest body's thickness (the no-tunnelling bound's scale).
+    double minimumThickness() const;
+};
+
+}  // namespace flexfit::detail

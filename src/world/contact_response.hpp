@@ -1,0 +1,70 @@
+// Internal to src/world: every response to contacts (world.hpp), in one stage.
+//
+// Deformable parts: a deformable part in contact gets a zone at each contacted face (its
+// contactLevel), and the face's masses (or the one mass of a point-shell contact) are pushed
+// out along the contact normal by the depth, their velocity into the contact removed. When both
+// parts deform the depth is split by stiffness: part A takes kB / (kA + kB) of it, with k the
+// part's effective contact stiffness (effectiveContactStiffness). Each mass moves once, by its
+// deepest push.
+//
+// Reactions: a dynamic body pressing a deformable part feels the springs it displaced. The
+// contacted masses sit at x, pushed from their rest positions; the part pulls them back with
+// k_eff (rest - x), and through the contact the body receives that force, for the next step. A
+// weak push is stopped by a stiff rim; a strong one deforms it and passes.
+//
+// Rigid contacts: a dynamic body's contacts with rigid parts are resolved by projection, inside
+// the rigid motion's sub-steps: the body moves out along the contact normals (Gauss-Seidel over
+// their depths) and loses the velocity into them (inelastic, no friction yet).
+#pragma once
+
+#include "bodies.hpp"
+#include "flexfit/collision.hpp"
+#include "flexfit/index_set.hpp"
+
+#include <span>
+#include <vector>
+
+namespace flexfit::detail {
+
+// The stiffness a deformable part opposes to a contact: its mean spring stiffness plus its
+// restoration's (k_a for anchors, c m / h^2 for the constraint at the world's step h).
+double effectiveContactStiffness(const Part& part, double timeStep);
+
+struct ResponseStats {
+    std::size_t contacts = 0;         // contacts that moved a deformable part
+    std::size_t displacedMasses = 0;
+    double maxDisplacement = 0.0;
+};
+
+struct ContactResponse {
+    std::vector<double> stiffness;  // (nbody) effective contact stiffness
+    ResponseStats stats;            // of the last respondToContacts()
+
+    // Scratch, over the world's masses (Bodies::worldMass): the deepest push of each mass, in
+    // first-contact order, and the masses whose reaction a body feels.
+    struct Push {
+        BodyId body;
+        Index mass;
+        Vec3 displacement;
+    };
+    IndexSet pushed;
+    std::vector<Push> pushes;  // parallel to pushed's members
+    IndexSet reacting;
+    std::vector<BodyId> reactionOwner;  // (world masses) the body that last counted each
+    struct Reaction {
+        BodyId body, part;
+        Index mass;
+    };
+    std::vector<Reaction> reactions;
+    std::vector<std::pair<Vec3, double>> projections;  // a body's rigid contacts: direction out, depth
+};
+
+// Deformable pushes, then the reactions dynamic bodies feel, for the contacts of this step.
+void respondToContacts(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response);
+
+// Projects body `id` out of its contacts with rigid parts (Gauss-Seidel) and removes its
+// velocity into them. Returns the length of the correction, or a negative number when there
+// was no such contact.
+double projectRigidContacts(BodyId id, std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response);
+
+}  // namespace flexfit::detail

@@ -1,0 +1,17 @@
+// Internal to src/world: the deformable parts' stages (world.hpp).
+#pragma once
+
+#include "bodies.hpp"
+
+namespace flexfit::detail {
+
+// Zone dynamics: every part's moving masses by one step (restoration included). Zone masses
+// feel no gravity in a world: a part's rest shape is its shape under its own weight, and in a
+// falling body's frame its masses feel none, so zones deform from contacts and forces only.
+void advanceZones(const StepContext& step, Bodies& bodies);
+
+// Zone retirement: every part retires its zones at rest (Part::retireRestingZones), their
+// masses exactly back at rest.
+void retireZones(Bodies& bodies);
+
+}  // namespace flexfit::detail

@@ -1,0 +1,61 @@
+// The broad phase (broad_phase.cpp): candidate pairs against brute-force sphere pairs, refit
+// against rebuild.
+#include "flexfit/flexfit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+
+using namespace flexfit;
+
+TEST(BroadPhase, EqualsBruteForceAndRefitEqualsRebuild) {
+    std::mt19937 rng(20);
+    std::uniform_real_distribution<double> u(-12, 12);
+    const auto model = buildPartModel(makeIcoSphere(2.0, 1));
+    std::vector<std::unique_ptr<Part>> parts;
+    CollisionWorld refit(CollisionSettings{ExactTest::TriangleTriangle, BroadPhaseUpdate::Refit}),
+        rebuild(CollisionSettings{ExactTest::TriangleTriangle, BroadPhaseUpdate::Rebuild});
+    for (BodyId i = 0; i < 40; ++i) {
+        parts.push_back(std::make_unique<Part>(model));
+        parts.back()->translate(Vec3(u(rng), u(rng), u(rng)));
+        refit.add(i, *parts.back());
+        rebuild.add(i, *parts.back());
+    }
+    for (int round = 0; round < 5; ++round) {
+        for (auto& p : parts) p->translate(Vec3(u(rng), u(rng), u(rng)) * 0.2);
+        refit.update();
+        rebuild.update();
+        std::set<std::pair<BodyId, BodyId>> expected;
+        for (BodyId i = 0; i < parts.size(); ++i)
+            for (BodyId j = i + 1; j < parts.size(); ++j) {
+                const Sphere a = refit.collider(i).worldSphere(*parts[i]), b = refit.collider(j).worldSphere(*parts[j]);
+                if ((a.centre - b.centre).norm() <= a.radius + b.radius) expected.insert({i, j});
+            }
+        using PairSet = std::set<std::pair<BodyId, BodyId>>;
+        const auto& got = refit.candidatePairs();
+        EXPECT_EQ(PairSet(got.begin(), got.end()), expected);
+        EXPECT_EQ(refit.candidatePairs(), rebuild.candidatePairs());
+        EXPECT_FALSE(expected.empty());
+    }
+}
+
+TEST(BroadPhase, ADeformedPartsSphereGrowsByItsLargestDisplacement) {
+    const auto model = buildPartModel(makeTorus1());
+    PartSettings loose;
+    loose.simulation.restoration.method = RestorationMethod::None;
+    Part part(model, loose);
+    CollisionWorld world;
+    world.add(0, part);
+    world.update();
+    const double rest = world.collider(0).localSphere().radius;
+    for (int i = 0; i < 200; ++i) {
+        part.applyForce(0, Vec3(-20.0, 0.0, 0.0));
+        part.step();
+    }
+    double largest = 0.0;
+    for (Index m : part.movingMasses()) largest = std::max(largest, (part.state().positions[m] - model->restPositions[m]).norm());
+    ASSERT_GT(largest, 0.1);
+    world.update();
+    EXPECT_NEAR(world.collider(0).localSphere().radius, rest + largest, 1e-12);
+}

@@ -1,0 +1,137 @@
+// The narrow phase (narrow_phase.cpp): its contacts against the pairwise queries it stands
+// for, one body's contacts against the whole narrow phase, and the hierarchies refitted only
+// when a query needs them, never by reading them.
+#include "flexfit/flexfit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+#include <tuple>
+
+using namespace flexfit;
+
+namespace {
+
+using ContactKey = std::tuple<BodyId, BodyId, Index, Index>;
+
+std::set<ContactKey> keysOf(const std::vector<Contact>& contacts) {
+    std::set<ContactKey> keys;
+    for (const Contact& c : contacts) keys.insert({c.partA, c.partB, c.faceA, c.faceB});
+    return keys;
+}
+
+PartSettings rigid() {
+    PartSettings s;
+    s.mode = PartMode::Rigid;
+    return s;
+}
+
+// Unit spheres scattered in a small box, registered in order; isRigid(i) picks each mode.
+struct Heap {
+    std::vector<std::unique_ptr<Part>> parts;
+    CollisionWorld world;
+
+    Heap(BodyId count, unsigned seed, bool (*isRigid)(BodyId)) {
+        std::mt19937 rng(seed);
+        std::uniform_real_distribution<double> u(-1.6, 1.6);
+        const auto model = buildPartModel(makeIcoSphere(1.0, 2));
+        for (BodyId i = 0; i < count; ++i) {
+            parts.push_back(std::make_unique<Part>(model, isRigid(i) ? rigid() : PartSettings{}));
+            parts.back()->translate(Vec3(u(rng), u(rng), u(rng)));
+            world.add(i, *parts.back());
+        }
+    }
+};
+
+}  // namespace
+
+TEST(NarrowPhase, ContactsAreThePairwiseQueriesOfTheCandidatePairs) {
+    // Five spheres in a loose heap, some rigid, some deformable: every candidate pair queried
+    // with its pressing part first gives exactly the narrow phase's contacts.
+    Heap heap(5, 3, [](BodyId i) { return i % 2 == 1; });
+    auto& [parts, world] = heap;
+    const std::vector<Contact> contacts = world.findContacts();
+    std::vector<Contact> expected;
+    for (auto [a, b] : world.candidatePairs()) {
+        const bool da = parts[a]->mode() != PartMode::Rigid, db = parts[b]->mode() != PartMode::Rigid;
+        if (da && !db) std::swap(a, b);  // the rigid part presses
+        QueryStats stats;
+        queryPair(a, *parts[a], world.collider(a), b, *parts[b], world.collider(b), ExactTest::TriangleTriangle, expected, stats);
+    }
+    ASSERT_FALSE(contacts.empty());
+    EXPECT_EQ(keysOf(contacts), keysOf(expected));
+    EXPECT_EQ(contacts.size(), expected.size());
+}
+
+TEST(NarrowPhase, OneBodysContactsAreItsShareOfTheNarrowPhase) {
+    Heap heap(6, 8, [](BodyId i) { return i != 2; });
+    auto& [parts, world] = heap;
+    const std::vector<Contact> all = world.findContacts();
+    for (BodyId id = 0; id < 6; ++id) {
+        std::set<ContactKey> share, rigidShare;
+        for (const Contact& c : all) {
+            if (c.partA != id && c.partB != id) continue;
+            share.insert({c.partA, c.partB, c.faceA, c.faceB});
+            const BodyId other = c.partA == id ? c.partB : c.partA;
+            if (parts[other]->mode() == PartMode::Rigid) rigidShare.insert({c.partA, c.partB, c.faceA, c.faceB});
+        }
+        EXPECT_EQ(keysOf(world.contactsOf(id)), share) << "body " << id;
+        EXPECT_EQ(keysOf(world.contactsOf(id, true)), rigidShare) << "body " << id;
+    }
+}
+
+TEST(NarrowPhase, HierarchiesRefitWhenAQueryNeedsThemAndNotWhenRead) {
+    // A deformable torus pressed by a force and a probe sphere at its rim. Noting the changed
+    // masses leaves the hierarchy as it was (reading it changes nothing); the next face query
+    // refits it, and then gives the contacts of a hierarchy rebuilt from scratch.
+    const auto torusModel = buildPartModel(makeTorus1());
+    Part torus(torusModel);
+    Part probe(buildPartModel(makeIcoSphere(3.0, 3)), rigid());
+    probe.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(12.0, 0.5, 0.0)});
+    CollisionWorld world;
+    world.add(0, probe);
+    world.add(1, torus);
+    for (int i = 0; i < 300; ++i) {
+        torus.applyForce(0, Vec3(-40.0, 5.0, 0.0));
+        torus.step();
+    }
+    const std::size_t refitsBefore = world.collider(1).refitNodeCount();
+    world.noteShapeChanges(1, torus.changedMasses());
+    torus.clearChangedMasses();
+    EXPECT_FALSE(world.collider(1).upToDate());
+    EXPECT_EQ(world.collider(1).refitNodeCount(), refitsBefore);  // noted, not refitted
+    const std::vector<Contact> contacts = world.findContacts();
+    EXPECT_TRUE(world.collider(1).upToDate());
+    EXPECT_GT(world.collider(1).refitNodeCount(), refitsBefore);
+
+    const PartCollider rebuilt(torus, BoundingVolumeKind::Aabb), probeCollider(probe, BoundingVolumeKind::Aabb);
+    std::vector<Contact> expected;
+    QueryStats stats;
+    queryPair(0, probe, probeCollider, 1, torus, rebuilt, ExactTest::TriangleTriangle, expected, stats);
+    ASSERT_FALSE(expected.empty());
+    EXPECT_EQ(keysOf(contacts), keysOf(expected));
+}
+
+TEST(NarrowPhase, PointShellPairsNeedNoRefit) {
+    // Under the point-shell query a deformable part met only by a closed rigid part is tested
+    // mass by mass: its face hierarchy is never refitted.
+    CollisionSettings settings;
+    settings.rigidDeformable = RigidDeformableQuery::PointShell;
+    Part ball(buildPartModel(makeIcoSphere(3.0, 2)), rigid());
+    ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(12.0, 0.5, 0.0)});
+    Part torus(buildPartModel(makeTorus1()));
+    CollisionWorld world(settings);
+    world.add(0, ball);
+    world.add(1, torus);
+    for (int i = 0; i < 100; ++i) {
+        torus.applyForce(0, Vec3(-10.0, 0.0, 0.0));
+        torus.step();
+    }
+    world.noteShapeChanges(1, torus.changedMasses());
+    const std::vector<Contact> contacts = world.findContacts();
+    ASSERT_FALSE(contacts.empty());
+    for (const Contact& c : contacts) EXPECT_NE(c.massB, kNoMass);  // point-shell contacts
+    EXPECT_FALSE(world.collider(1).upToDate());
+    EXPECT_EQ(world.collider(1).refitNodeCount(), 0u);
+}

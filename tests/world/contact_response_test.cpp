@@ -1,0 +1,182 @@
+// The contact response stage (src/world/contact_response.cpp): a rigid torus pressed into a
+// rigid-deformable torus and withdrawn, checked against the analytic torus; two deformable
+// parts sharing a penetration by stiffness; the reaction a dynamic body feels; the rigid
+// projection against its analytic result.
+#include "flexfit/flexfit.hpp"
+#include "world/contact_response.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace flexfit;
+using detail::Bodies;
+using detail::ContactResponse;
+
+namespace {
+
+// Signed distance to a torus of radii (R, r) around its own y axis (negative inside).
+double torusDistance(const Vec3& p, double R, double r) {
+    const double ring = std::hypot(p.x(), p.z()) - R;
+    return std::hypot(ring, p.y()) - r;
+}
+
+PartSettings deformableSettings() {
+    PartSettings s;
+    s.simulation.timeStep = 1e-3;
+    s.simulation.globalDamping = 0.5;
+    s.simulation.restoration = {RestorationMethod::Constraint, 0.0, 0.0, 2e-3};
+    s.zones.contactLevel = 3;
+    s.zones.restSpeed = 1e-2;
+    return s;
+}
+
+PartSettings rigidSettings() {
+    PartSettings s;
+    s.mode = PartMode::Rigid;
+    return s;
+}
+
+// Bodies and their collision views, as a world registers them: the stage's test bench.
+struct Bench {
+    Bodies bodies;
+    CollisionWorld collision;
+    ContactResponse response;
+
+    BodyId add(std::shared_ptr<const PartModel> model, const PartSettings& part, MotionType motion = MotionType::Static) {
+        BodySettings body;
+        body.motion = motion;
+        const RigidBody rigid = makeRigidBody(*model, body);
+        const BodyId id = bodies.add(std::make_unique<Part>(std::move(model), part), rigid);
+        collision.add(id, *bodies.parts[id]);
+        response.stiffness.push_back(detail::effectiveContactStiffness(*bodies.parts[id], 1e-3));
+        return id;
+    }
+    Part& part(BodyId id) { return *bodies.parts[id]; }
+    // The world's order: shape changes handed over, contacts found, the response.
+    const std::vector<Contact>& respond() {
+        for (BodyId id = 0; id < bodies.size(); ++id) {
+            collision.noteShapeChanges(id, part(id).changedMasses());
+            part(id).clearChangedMasses();
+        }
+        const std::vector<Contact>& contacts = collision.findContacts();
+        detail::respondToContacts(contacts, bodies, response);
+        return contacts;
+    }
+};
+
+}  // namespace
+
+TEST(ContactResponse, RigidTorusPressedIntoDeformableTorusAndWithdrawn) {
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}});
+    Bench s;
+    const BodyId rigid = s.add(model, rigidSettings()), soft = s.add(model, deformableSettings());
+    // The rigid torus stands upright (axis z, its ring in the xy plane) beside the soft one and
+    // moves along -x into its outer rim.
+    s.part(rigid).setPose(Pose{Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX())), Vec3(25.5, 0, 0)});
+    double deepestAfterResponse = 0.0;
+    std::size_t maxMoving = 0;
+    const int pressSteps = 2000, holdSteps = 500, withdrawSteps = 2000;
+    for (int step = 0; step < pressSteps + holdSteps + withdrawSteps + 30000; ++step) {
+        if (step < pressSteps) s.part(rigid).translate(Vec3(-1e-3, 0, 0));  // 2 units in 2 s: 1.5 units of overlap
+        else if (step >= pressSteps + holdSteps && step < pressSteps + holdSteps + withdrawSteps) s.part(rigid).translate(Vec3(2e-3, 0, 0));
+        for (const Contact& c : s.respond()) {
+            EXPECT_EQ(c.partA, rigid);  // the rigid part presses
+            EXPECT_EQ(c.partB, soft);
+        }
+        // After the response, no soft mass is inside the rigid torus beyond the tolerance.
+        const Part& p = s.part(soft);
+        for (Index m : p.movingMasses()) {
+            const double d = torusDistance(s.part(rigid).pose().applyInverse(p.worldPosition(m)), 10.0, 2.5);
+            deepestAfterResponse = std::max(deepestAfterResponse, -d);
+        }
+        maxMoving = std::max(maxMoving, p.movingMasses().size());
+        s.part(soft).step();
+        if (step > pressSteps + holdSteps + withdrawSteps && p.zoneCount() == 0) break;
+    }
+    EXPECT_GT(maxMoving, 10u);       // the press deformed the soft torus locally...
+    EXPECT_LT(maxMoving, 576u / 2);  // ...and only locally
+    // Tolerance: the mesh's chord error against the analytic torus (flat faces cut inside the
+    // round tube by up to r (1 - cos(pi/24)) = 0.021, more across the wider outer faces).
+    EXPECT_LT(deepestAfterResponse, 0.15);
+    EXPECT_EQ(s.part(soft).zoneCount(), 0u);
+    EXPECT_EQ(countActiveSprings(*model, s.part(soft).state().positions, 0.01), 0u);
+    EXPECT_EQ(s.part(soft).state().positions, model->restPositions);
+}
+
+TEST(ContactResponse, BothDeformablePartsShareThePenetrationByStiffness) {
+    const auto softModel = buildPartModel(makeIcoSphere(2.0, 2), {Material{0.1, 0.01}, 1.0, {}, {}});
+    const auto hardModel = buildPartModel(makeIcoSphere(2.0, 2), {Material{3.0, 0.3}, 1.0, {}, {}});
+    PartSettings settings = deformableSettings();
+    settings.simulation.restoration = {RestorationMethod::AnchorSprings, 1.0, 0.1, 0.0};
+    Bench s;
+    const BodyId a = s.add(softModel, settings), b = s.add(hardModel, settings);
+    s.part(b).translate(Vec3(3.7, 0, 0));
+    ASSERT_FALSE(s.respond().empty());
+    double moveA = 0.0, moveB = 0.0;
+    for (Index m : s.part(a).movingMasses()) moveA = std::max(moveA, (s.part(a).state().positions[m] - softModel->restPositions[m]).norm());
+    for (Index m : s.part(b).movingMasses()) moveB = std::max(moveB, (s.part(b).state().positions[m] - hardModel->restPositions[m]).norm());
+    const double ka = s.response.stiffness[a], kb = s.response.stiffness[b];
+    EXPECT_NEAR(ka, 0.1 + 1.0, 1e-12);
+    EXPECT_NEAR(kb, 3.0 + 1.0, 1e-12);
+    ASSERT_GT(moveA, 0.0);
+    ASSERT_GT(moveB, 0.0);
+    EXPECT_GT(moveA, moveB);  // the softer part gives way more
+    EXPECT_NEAR(moveA / moveB, kb / ka, 0.35 * kb / ka);
+    EXPECT_EQ(s.response.stats.displacedMasses, s.response.pushes.size());
+}
+
+TEST(ContactResponse, EffectiveStiffnessIsTheMeanSpringPlusTheRestorations) {
+    const auto model = buildPartModel(makeTorus1(), {Material{2.0, 0.1}, 0.5, {}, {}});
+    PartSettings settings;
+    settings.simulation.restoration = {RestorationMethod::Constraint, 0.0, 0.0, 0.01};
+    const Part constraint(model, settings);
+    EXPECT_NEAR(detail::effectiveContactStiffness(constraint, 1e-3), 2.0 + 0.01 * 0.5 / 1e-6, 1e-9);
+    EXPECT_NEAR(detail::effectiveContactStiffness(constraint, 2e-3), 2.0 + 0.01 * 0.5 / 4e-6, 1e-9);  // the world's h
+    settings.simulation.restoration = {RestorationMethod::AnchorSprings, 7.0, 0.1, 0.0};
+    EXPECT_NEAR(detail::effectiveContactStiffness(Part(model, settings), 1e-3), 9.0, 1e-12);
+    settings.simulation.restoration.method = RestorationMethod::None;
+    EXPECT_NEAR(detail::effectiveContactStiffness(Part(model, settings), 1e-3), 2.0, 1e-12);
+}
+
+TEST(ContactResponse, ADynamicBodyFeelsTheSpringsItDisplaced) {
+    // A dynamic ball pressing a deformable torus: after the response it carries the force
+    // -k_eff sum (x - rest) of the masses it pushed, for the next step (computed here by hand
+    // from the part's state).
+    const auto torusModel = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}});
+    PartSettings anchors = deformableSettings();
+    anchors.simulation.restoration = {RestorationMethod::AnchorSprings, 4.0, 0.5, 0.0};
+    Bench s;
+    const BodyId torus = s.add(torusModel, anchors);
+    const BodyId ball = s.add(buildPartModel(makeIcoSphere(2.0, 2)), rigidSettings(), MotionType::Dynamic);
+    s.part(ball).setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(10.0, 4.2, 0.0)});  // into the top of the tube
+    ASSERT_FALSE(s.respond().empty());
+    const Part& t = s.part(torus);
+    Vec3 expected = Vec3::Zero();
+    for (Index m : t.movingMasses()) expected -= s.response.stiffness[torus] * t.pose().rotate(t.state().positions[m] - torusModel->restPositions[m]);
+    ASSERT_GT(expected.norm(), 0.0);
+    EXPECT_GT(expected.y(), 0.0);  // pushed down, the rim pushes the ball up
+    EXPECT_LT((s.bodies.rigid[ball].force - expected).norm(), 1e-9 * expected.norm());
+}
+
+TEST(ContactResponse, RigidProjectionTakesTheBodyOutAlongTheCommonDirection) {
+    // Two contacts of depth 0.3 along normals tilted +-45 degrees from +y (a ball in a V):
+    // Gauss-Seidel moves the body 0.3 sqrt(2) up, not sideways, and removes the velocity into
+    // the contacts.
+    Bench s;
+    const BodyId floor = s.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidSettings());
+    const BodyId body = s.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidSettings(), MotionType::Dynamic);
+    s.bodies.rigid[body].linearVelocity = Vec3(0.5, -2.0, 0.0);
+    const Vec3 n1 = Vec3(1, 1, 0).normalized(), n2 = Vec3(-1, 1, 0).normalized();
+    std::vector<Contact> contacts(2);
+    contacts[0].partA = body, contacts[0].partB = floor, contacts[0].normal = n1, contacts[0].depth = 0.3;
+    contacts[1].partA = floor, contacts[1].partB = body, contacts[1].normal = -n2, contacts[1].depth = 0.3;  // B's side
+    const Vec3 before = s.part(body).pose().translation;
+    const double moved = detail::projectRigidContacts(body, contacts, s.bodies, s.response);
+    const Vec3 correction = s.part(body).pose().translation - before;
+    EXPECT_NEAR(moved, 0.3 * std::sqrt(2.0), 1e-12);
+    EXPECT_NEAR(correction.x(), 0.0, 1e-12);
+    EXPECT_NEAR(correction.y(), 0.3 * std::sqrt(2.0), 1e-12);
+    const Vec3 v = s.bodies.rigid[body].linearVelocity;
+    EXPECT_GE(v.dot(n1), -1e-12);
+    EXPECT_GE(v.dot(n2), -1e-12);
+    EXPECT_LT(detail::projectRigidContacts(body, {}, s.bodies, s.response), 0.0);  // no contact
+}
