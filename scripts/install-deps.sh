@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev                        # linear algebra
   libassimp-dev                        # mesh import (OBJ, STL, PLY, OFF, glTF)
   libcli11-dev                         # command line
-  libspdlog-dev libfmt-dev             # logging and formatting
+  libfmt-dev                           # formatting of the command-line output
   libgtest-dev libgmock-dev            # tests
   libbenchmark-dev                     # benchmarks
   libtomlplusplus-dev                  # scene files (TOML, with the line of every key)

@@ -38,6 +38,7 @@ struct AssemblyArea {
     double halfHeight = 1.0;          // cylinder, along y
     bool contains(const Vec3& pointInPart) const;
 };
+const char* toString(AssemblyArea::Shape shape);
 
 struct AssemblyRule {
     std::string name;

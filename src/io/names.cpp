@@ -160,6 +160,7 @@ const char* toString(BoundingVolumeKind v) { return nameOf(v); }
 const char* toString(BroadPhaseUpdate v) { return nameOf(v); }
 const char* toString(RigidDeformableQuery v) { return nameOf(v); }
 const char* toString(SnapTechnique v) { return nameOf(v); }
+const char* toString(AssemblyArea::Shape v) { return nameOf(v); }
 const char* toString(SceneAction::Kind v) { return nameOf(v); }
 const char* toString(Stage v) { return nameOf(v); }
 

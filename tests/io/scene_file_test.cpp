@@ -74,7 +74,7 @@ std::string withLine(const std::string& after, const std::string& line) {
 
 }  // namespace
 
-TEST(Scene, ParsesEveryValueItStates) {
+TEST(SceneFile, ParsesEveryValueItStates) {
     const Scene s = parseScene(kBall, "scene.toml", ".");
     EXPECT_EQ(s.world.timeStep, 0.002);
     EXPECT_EQ(s.duration, 2.5);
@@ -100,36 +100,36 @@ TEST(Scene, ParsesEveryValueItStates) {
     EXPECT_EQ(s.actions[1].line, 32u);  // the [[action]] header
 }
 
-TEST(Scene, SyntaxErrorNamesTheLine) {
+TEST(SceneFile, SyntaxErrorNamesTheLine) {
     EXPECT_NE(errorOf(withLine("[world]", "time_step = = 3")).find("scene.toml:3: TOML syntax"), std::string::npos)
         << errorOf(withLine("[world]", "time_step = = 3"));
 }
 
-TEST(Scene, UnknownKeyIsReported) {
+TEST(SceneFile, UnknownKeyIsReported) {
     const std::string e = errorOf(withLine("name = \"ball\"", "densty = 2"));
     EXPECT_NE(e.find("scene.toml:18: part 2, key 'densty': unknown key"), std::string::npos) << e;
 }
 
-TEST(Scene, WrongTypeIsReported) {
+TEST(SceneFile, WrongTypeIsReported) {
     const std::string e = errorOf(withLine("name = \"ball\"", "vertex_mass = \"heavy\""));
     EXPECT_NE(e.find(":18: part 2, key 'vertex_mass': expected a number"), std::string::npos) << e;
 }
 
-TEST(Scene, OutOfRangeValueIsReported) {
+TEST(SceneFile, OutOfRangeValueIsReported) {
     const std::string e = errorOf(withLine("name = \"ball\"", "vertex_mass = -1"));
     EXPECT_NE(e.find(":18: part 2, key 'vertex_mass': must be > 0"), std::string::npos) << e;
     const std::string level = errorOf(withLine("name = \"ball\"", "contact_level = 300"));
     EXPECT_NE(level.find("key 'contact_level': must be in [0, 255]"), std::string::npos) << level;
 }
 
-TEST(Scene, UnknownChoiceListsTheOptions) {
+TEST(SceneFile, UnknownChoiceListsTheOptions) {
     const std::string e = errorOf(withLine("name = \"ball\"", "bounding_volume = \"capsule\""));
     EXPECT_NE(e.find(":18: part 2, key 'bounding_volume': unknown value 'capsule' (expected one of 'sphere', 'aabb')"),
               std::string::npos)
         << e;
 }
 
-TEST(Scene, ContactQueryIsAChoice) {
+TEST(SceneFile, ContactQueryIsAChoice) {
     EXPECT_EQ(parseScene(kBall, "scene.toml", ".").world.collision.rigidDeformable, RigidDeformableQuery::Faces);  // default
     const std::string text = withLine("duration = 2.5", "rigid_deformable_query = \"point-shell\"");
     EXPECT_EQ(parseScene(text, "scene.toml", ".").world.collision.rigidDeformable, RigidDeformableQuery::PointShell);
@@ -139,38 +139,38 @@ TEST(Scene, ContactQueryIsAChoice) {
         << e;
 }
 
-TEST(Scene, VectorNeedsThreeNumbers) {
+TEST(SceneFile, VectorNeedsThreeNumbers) {
     const std::string e = errorOf(withLine("name = \"ball\"", "velocity = [1, 2]"));
     EXPECT_NE(e.find(":18: part 2, key 'velocity': expected an array of 3 numbers"), std::string::npos) << e;
 }
 
-TEST(Scene, MissingKeyNamesTheTable) {
+TEST(SceneFile, MissingKeyNamesTheTable) {
     std::string text = kBall;
     text.replace(text.find("name = \"mouth\""), 14, "");
     const std::string e = errorOf(text);
     EXPECT_NE(e.find("scene.toml:7: part 1: missing key 'name'"), std::string::npos) << e;
 }
 
-TEST(Scene, UnknownPartReference) {
+TEST(SceneFile, UnknownPartReference) {
     std::string text = kBall;
     text.replace(text.find("secondary = \"mouth\""), 19, "secondary = \"mug\"");
     const std::string e = errorOf(text);
     EXPECT_NE(e.find(":27: assembly 1, key 'secondary': no part named 'mug'"), std::string::npos) << e;
 }
 
-TEST(Scene, DuplicatePartName) {
+TEST(SceneFile, DuplicatePartName) {
     std::string text = kBall;
     text.replace(text.find("name = \"ball\""), 13, "name = \"mouth\"");
     const std::string e = errorOf(text);
     EXPECT_NE(e.find(":17: part 2, key 'name': duplicate part name 'mouth'"), std::string::npos) << e;
 }
 
-TEST(Scene, MeshAndGeneratorAreExclusive) {
+TEST(SceneFile, MeshAndGeneratorAreExclusive) {
     const std::string e = errorOf(withLine("name = \"ball\"", "mesh = \"ball.tri\""));
     EXPECT_NE(e.find(":16: part 2: needs exactly one of 'mesh' and 'generator'"), std::string::npos) << e;
 }
 
-TEST(Scene, MissingMeshFileNamesBothFiles) {
+TEST(SceneFile, MissingMeshFileNamesBothFiles) {
     std::string text = kBall;
     text.replace(text.find("generator = \"container-mouth\""), 29, "mesh = \"no_such_mouth.tri\"");
     const std::string e = errorOf(text);
@@ -178,27 +178,42 @@ TEST(Scene, MissingMeshFileNamesBothFiles) {
     EXPECT_NE(e.find("no_such_mouth.tri"), std::string::npos) << e;
 }
 
-TEST(Scene, OperatorScriptMustHoldThePart) {
+TEST(SceneFile, OperatorScriptMustHoldThePart) {
     const std::string e = errorOf(std::string(kBall) + "\n[[action]]\ntime = 0.05\ntype = \"move\"\npart = \"ball\"\nposition = [0, 0, 0]\n");
     EXPECT_NE(e.find("scene.toml:44: action 'move': part 'ball' is not grabbed at that time"), std::string::npos) << e;
 }
 
-TEST(Scene, ActionIndicesAreChecked) {
+TEST(SceneFile, ActionIndicesAreChecked) {
     const std::string e =
         errorOf(std::string(kBall) + "\n[[action]]\ntime = 1\ntype = \"force\"\npart = \"ball\"\nforce = [1, 0, 0]\nfaces = [0, 100000]\n");
     EXPECT_NE(e.find(":49: action 3, key 'faces': index 100000 out of range (the part has 320)"), std::string::npos) << e;
 }
 
-TEST(Scene, StaticPartCannotBeGrabbed) {
+TEST(SceneFile, StaticPartCannotBeGrabbed) {
     const std::string e = errorOf(std::string(kBall) + "\n[[action]]\ntime = 1\ntype = \"grab\"\npart = \"mouth\"\n");
     EXPECT_NE(e.find(":47: action 3, key 'part': a static part cannot be grabbed"), std::string::npos) << e;
 }
 
-TEST(Scene, EmptySceneIsRefused) {
+TEST(SceneFile, EmptySceneIsRefused) {
     const std::string e = errorOf("[world]\ntime_step = 0.001\n");
     EXPECT_NE(e.find("scene.toml:1: scene: no [[part]]"), std::string::npos) << e;
 }
 
-TEST(Scene, UnreadableFileIsReported) {
+TEST(SceneFile, UnreadableFileIsReported) {
     EXPECT_THROW(loadScene("/no/such/scene.toml"), InputError);
+}
+
+TEST(SceneFile, OldSpellingsAreReadWithAWarningNamingTheNewOne) {
+    std::string text = kBall;
+    text.replace(text.find("mode = \"rigid-deformable\""), std::string("mode = \"rigid-deformable\"").size(), "mode = \"zones\"");
+    text.replace(text.find("restoration = \"anchors\""), std::string("restoration = \"anchors\"").size(), "restoration = \"anchor\"");
+    const Scene s = parseScene(text, "scene.toml", ".");
+    EXPECT_EQ(s.parts[0].part.mode, PartMode::RigidDeformable);
+    EXPECT_EQ(s.parts[0].part.simulation.restoration.method, RestorationMethod::AnchorSprings);
+    ASSERT_EQ(s.warnings.size(), 2u);
+    EXPECT_EQ(s.warnings[0].line, 10u);
+    EXPECT_EQ(s.warnings[0].message, "part 1, key 'mode': 'zones' is deprecated: write 'rigid-deformable'");
+    EXPECT_EQ(s.warnings[1].line, 12u);
+    EXPECT_EQ(s.warnings[1].message, "part 1, key 'restoration': 'anchor' is deprecated: write 'anchors'");
+    EXPECT_TRUE(parseScene(kBall, "scene.toml", ".").warnings.empty());
 }

@@ -1,0 +1,36 @@
+// Bodies the world tests share: rigid parts, dynamic bodies, and a ball over the thesis's
+// container mouth (outer diameter 25, opening 15).
+#pragma once
+
+#include "flexfit/world.hpp"
+#include "flexfit/generators.hpp"
+
+namespace flexfit::testing {
+
+inline PartSettings rigidPart() {
+    PartSettings s;
+    s.mode = PartMode::Rigid;
+    return s;
+}
+
+inline BodySettings dynamicBody(Vec3 velocity = Vec3::Zero()) {
+    BodySettings b;
+    b.motion = MotionType::Dynamic;
+    b.linearVelocity = velocity;
+    return b;
+}
+
+inline Pose at(const Vec3& p) { return Pose{Eigen::Quaterniond::Identity(), p}; }
+
+struct BallTorus {
+    World world;
+    BodyId torus = 0, ball = 0;
+    BallTorus(double diameter, double dt, Vec3 velocity, double startHeight = 12.0)
+        : world(WorldSettings{dt, Vec3(0, -9.81, 0), {}, 0.25, 4096, 4}) {
+        torus = world.add(buildPartModel(makeContainerMouth()), rigidPart(), BodySettings{}, Pose{});
+        ball = world.add(buildPartModel(makeIcoSphere(diameter / 2, 3)), rigidPart(), dynamicBody(velocity), at(Vec3(0, startHeight, 0)));
+    }
+    double ballHeight() const { return world.centreOfMass(ball).y(); }
+};
+
+}  // namespace flexfit::testing
