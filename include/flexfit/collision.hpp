@@ -68,15 +68,9 @@ public:
     ExactTest exactTest() const { return test_; }
     // Rebuilds the hierarchy from the part's current (part-frame) positions.
     void rebuild(const Part& part);
-    // Records that `changedMasses` moved: the faces around them wait for the next refit
-    // (O(changed x valence)). The hierarchy itself is unchanged until refitPending().
-    void noteChanges(const Part& part, std::span<const Index> changedMasses);
-    // Refits the waiting faces from the part's positions, and their ancestors; the hierarchy
-    // then matches the part's shape. CollisionWorld refits in its narrow phase, only the
-    // hierarchies a query needs, so a part met only by point-shell queries never pays for it.
-    void refitPending(const Part& part);
-    bool upToDate() const { return pendingFaces_.empty(); }
-    // noteChanges() then refitPending().
+    // Refits the faces around `changedMasses` from the part's positions, and their ancestors
+    // (O(changed x valence x depth)). CollisionWorld refits in its queries, only the
+    // hierarchies a face query needs, so a part met only by point-shell queries never pays.
     void refit(const Part& part, std::span<const Index> changedMasses);
     // The bounding sphere's growth: the largest displacement of a moving mass from rest
     // (O(moving)).
@@ -109,7 +103,7 @@ private:
     std::variant<Bvh<Sphere>, Bvh<Aabb>> bvh_;
     Sphere restSphere_;
     double maxDisplacement_ = 0.0;
-    IndexSet pendingFaces_;  // (F) faces moved since the last refit
+    IndexSet changedFaces_;  // (F) scratch of refit()
     Bvh<Aabb> restPoints_;
 };
 

@@ -14,10 +14,13 @@
 // Part A of a pair is the pressing one: the rigid part when exactly one is deformable, otherwise
 // the lower id. With ExactTest::SphereTriangle A's faces are spheres and B's triangles.
 //
-// Shape changes: a deformed part's hierarchy is refitted only when a face query needs it. The
-// world hands each part's changed masses over (noteShapeChanges) once per step; the narrow
-// phase refits the hierarchies it is about to traverse. collider() never refits: a part met
-// only by point-shell queries keeps the hierarchy of its last refit.
+// Shape changes: a deformed part's hierarchy is refitted only when a face query needs it, from
+// the part's list of changed masses (Part::changedMasses), once per narrowPhase() or
+// contactsOf() call. The collision world never changes a part: refittedBodies() lists the
+// bodies the last call refitted, and their owner clears those parts' lists (the world does
+// after every call; a list left uncleared is refitted again, which is slower, not wrong).
+// collider() never refits: a part met only by point-shell queries keeps the hierarchy of its
+// last refit.
 #pragma once
 
 #include "flexfit/body.hpp"
@@ -56,17 +59,13 @@ public:
     // std::invalid_argument otherwise.
     void add(BodyId id, const Part& part, BoundingVolumeKind kind = BoundingVolumeKind::Aabb);
     std::size_t bodyCount() const { return parts_.size(); }
-    // The body's collider as of its last refit (upToDate() tells whether its part has changed
-    // shape since). Reading it changes nothing.
+    // The body's collider as of its last refit. Reading it changes nothing.
     const PartCollider& collider(BodyId id) const { return colliders_[id]; }
     const CollisionSettings& settings() const { return settings_; }
     // Switches the exact test; the face hierarchies are rebuilt for it.
     void setExactTest(ExactTest test);
 
     // --- Broad phase (broad_phase.cpp) ---
-    // The masses of body `id` that moved since the last call: its hierarchy refits them when a
-    // face query next needs it.
-    void noteShapeChanges(BodyId id, std::span<const Index> changedMasses);
     // Updates every body's bounding sphere, then the broad-phase tree and its pairs.
     void update();
     // Updates every body's bounding sphere (the first half of update()).
@@ -89,11 +88,16 @@ public:
     const std::vector<Contact>& contactsOf(BodyId id, bool rigidPartnersOnly = false);
     const std::vector<Contact>& contacts() const { return contacts_; }  // of the last narrowPhase()
     const QueryStats& stats() const { return stats_; }                  // of the last narrowPhase()
+    // The bodies whose hierarchy the last narrowPhase() or contactsOf() refitted from their
+    // part's changed masses: those parts' lists can be cleared (Part::clearChangedMasses).
+    std::span<const BodyId> refittedBodies() const { return refitted_.members(); }
 
 private:
     bool pressesFirst(BodyId a, BodyId b) const;
     // Contacts of the pair (a presses b) appended to `out`, by the query the settings choose.
     void queryPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats);
+    // Refits the body's hierarchy from its part's changed masses, once per query call.
+    void refitChanged(BodyId id);
 
     CollisionSettings settings_;
     std::vector<const Part*> parts_;                                  // (nbody)
@@ -105,6 +109,7 @@ private:
     std::vector<Contact> contacts_;
     std::vector<Contact> bodyContacts_;  // contactsOf()
     std::vector<std::int32_t> stack_;    // broad-phase traversal
+    IndexSet refitted_;                  // (nbody) refitted by the last query call
     QueryStats stats_;
 };
 

@@ -1,12 +1,14 @@
-// A set of indices in [0, capacity) kept as a compact list: a sparse set (Briggs and Torczon,
-// "An efficient representation for sparse sets", 1993).
+// A set of indices in [0, capacity) kept as a compact list: marks + list + slots.
 //
-// members() lists the indices in the set, and slot[i] says where index i sits in that list.
-// i is a member exactly when slot[i] < size() and members()[slot[i]] == i, so nothing has to be
-// reset: insert, erase, contains and clear are all O(1), and iterating costs the members, not
-// the capacity. This is the active-region pattern (marks + compact list + slots) in one place:
-// the moving masses and computed springs of a part, the masses a contact response pushes, the
-// faces a refit visits, the hierarchy nodes it merges.
+// members() lists the indices in the set; each index has a mark (the pass that inserted it)
+// and a slot (where it sits in the list), in two arrays so that a scan of the marks reads 4
+// bytes an index. clear() starts a new pass by bumping the pass number, so insert, erase,
+// contains and clear are all O(1), membership is one load, and iterating costs the members,
+// not the capacity. After 2^32 - 1 passes the number wraps and the marks are reset once, for
+// real. This is the pattern of every "what was touched" list in Flexfit:
+// the moving masses and computed springs of a part, its changed masses, the masses a contact
+// response pushes, the faces a refit visits, the hierarchy nodes it merges, the masses a
+// k-ring reaches.
 //
 // Order: members stay in insertion order until an erase moves the last member into the hole
 // (swap-remove), so a sequence of operations always gives the same order (determinism).
@@ -17,6 +19,7 @@
 #include "flexfit/core.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -25,42 +28,51 @@ namespace flexfit {
 class IndexSet {
 public:
     IndexSet() = default;
-    explicit IndexSet(std::size_t capacity) : slot_(capacity, 0) {}
+    explicit IndexSet(std::size_t capacity) : mark_(capacity, 0), slot_(capacity, 0) {}
 
     // Empties the set and sets its capacity.
     void reset(std::size_t capacity) {
         members_.clear();
+        mark_.assign(capacity, 0);
         slot_.assign(capacity, 0);
+        pass_ = 1;
     }
     // Grows the capacity to at least `capacity`, keeping the members.
     void growTo(std::size_t capacity) {
-        if (slot_.size() < capacity) slot_.resize(capacity, 0);
+        if (mark_.size() >= capacity) return;
+        mark_.resize(capacity, 0);
+        slot_.resize(capacity, 0);
     }
-    std::size_t capacity() const { return slot_.size(); }
+    std::size_t capacity() const { return mark_.size(); }
     std::size_t size() const { return members_.size(); }
     bool empty() const { return members_.empty(); }
 
-    bool contains(Index i) const {
-        const Index s = slot_[i];
-        return s < members_.size() && members_[s] == i;
-    }
+    bool contains(Index i) const { return mark_[i] == pass_; }
     // Adds i at the end of the list; true when it was not a member.
     bool insert(Index i) {
-        if (contains(i)) return false;
+        if (mark_[i] == pass_) return false;
+        mark_[i] = pass_;
         slot_[i] = Index(members_.size());
         members_.push_back(i);
         return true;
     }
     // Removes i, moving the last member into its place; true when it was a member.
     bool erase(Index i) {
-        if (!contains(i)) return false;
+        if (mark_[i] != pass_) return false;
+        mark_[i] = 0;
         const Index s = slot_[i], last = members_.back();
         members_[s] = last;
         slot_[last] = s;
         members_.pop_back();
         return true;
     }
-    void clear() { members_.clear(); }
+    void clear() {
+        members_.clear();
+        if (++pass_ == 0) {  // wrapped: forget every mark for real, once in 2^32 - 1 passes
+            std::fill(mark_.begin(), mark_.end(), 0u);
+            pass_ = 1;
+        }
+    }
     // Where a member sits in members(): values kept beside the list are indexed by it.
     Index slotOf(Index member) const { return slot_[member]; }
     // Orders the members by index (O(size log size)), for passes that need them sorted.
@@ -75,8 +87,10 @@ public:
     Index operator[](std::size_t s) const { return members_[s]; }
 
 private:
-    std::vector<Index> members_;  // the set, compact
-    std::vector<Index> slot_;     // (capacity) position in members_; stale for non-members
+    std::vector<Index> members_;       // the set, compact
+    std::vector<std::uint32_t> mark_;  // (capacity) the pass that inserted each index; 0 = none
+    std::vector<Index> slot_;          // (capacity) position in members_ of each member
+    std::uint32_t pass_ = 1;           // the current pass, never 0
 };
 
 }  // namespace flexfit

@@ -6,10 +6,6 @@
 
 namespace flexfit {
 
-void CollisionWorld::noteShapeChanges(BodyId id, std::span<const Index> changedMasses) {
-    if (!changedMasses.empty()) colliders_[id].noteChanges(*parts_[id], changedMasses);
-}
-
 void CollisionWorld::updateBounds() {
     for (std::size_t i = 0; i < parts_.size(); ++i) {
         colliders_[i].updateDisplacementBound(*parts_[i]);

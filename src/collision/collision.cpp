@@ -1,7 +1,6 @@
 #include "flexfit/collision.hpp"
 
 #include "collision/triangle_queries.hpp"
-#include "core/epoch_marks.hpp"
 #include "flexfit/distance_field.hpp"
 
 #include <stdexcept>
@@ -97,7 +96,7 @@ Aabb faceSphereBox(std::span<const Vec3> positions, const Face& face) {
 PartCollider::PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest test) : kind_(kind), test_(test) {
     if (kind == BoundingVolumeKind::Aabb) bvh_.emplace<Bvh<Aabb>>();
     restSphere_ = Sphere::around(part.model().restPositions);
-    pendingFaces_.reset(part.model().faceCount());
+    changedFaces_.reset(part.model().faceCount());
     const auto& rest = part.model().restPositions;
     restPlanes_.reserve(part.model().faceCount());
     for (const Face& f : part.model().mesh.faces) {
@@ -115,7 +114,6 @@ PartCollider::PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest 
 }
 
 void PartCollider::rebuild(const Part& part) {
-    pendingFaces_.clear();
     std::visit([&](auto& bvh) { buildHierarchy(bvh, part, test_); }, bvh_);
     updateDisplacementBound(part);
 }
@@ -126,27 +124,18 @@ void PartCollider::updateDisplacementBound(const Part& part) {
         maxDisplacement_ = std::max(maxDisplacement_, (part.state().positions[m] - part.model().restPositions[m]).norm());
 }
 
-void PartCollider::noteChanges(const Part& part, std::span<const Index> changedMasses) {
-    for (Index m : changedMasses)
-        for (Index f : part.model().topology.facesOf(m)) pendingFaces_.insert(f);
-}
-
-void PartCollider::refitPending(const Part& part) {
-    if (pendingFaces_.empty()) return;
+void PartCollider::refit(const Part& part, std::span<const Index> changedMasses) {
     const PartModel& model = part.model();
+    changedFaces_.clear();
+    for (Index m : changedMasses)
+        for (Index f : model.topology.facesOf(m)) changedFaces_.insert(f);
     const std::span<const Vec3> positions = part.state().positions;
     std::visit(
         [&](auto& bvh) {
             using BV = std::decay_t<decltype(bvh.rootVolume())>;
-            bvh.refit(pendingFaces_.members(), [&](Index f) { return leafVolume((const BV*)nullptr, positions, model.mesh.faces[f], test_); });
+            bvh.refit(changedFaces_.members(), [&](Index f) { return leafVolume((const BV*)nullptr, positions, model.mesh.faces[f], test_); });
         },
         bvh_);
-    pendingFaces_.clear();
-}
-
-void PartCollider::refit(const Part& part, std::span<const Index> changedMasses) {
-    noteChanges(part, changedMasses);
-    refitPending(part);
     updateDisplacementBound(part);
 }
 
@@ -236,10 +225,10 @@ private:
     const PartCollider& collider_;
     const RelativePose& bInA_;
     static thread_local std::vector<std::array<Eigen::Vector4d, 4>> planesInB_;
-    static thread_local EpochMarks movedPlanes_;  // faces whose planes are in planesInB_ for this query
+    static thread_local IndexSet movedPlanes_;  // faces whose planes are in planesInB_ for this query
 };
 thread_local std::vector<std::array<Eigen::Vector4d, 4>> RestPlaneFilter::planesInB_;
-thread_local EpochMarks RestPlaneFilter::movedPlanes_;
+thread_local IndexSet RestPlaneFilter::movedPlanes_;
 
 void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
                const PartCollider& colliderB, ExactTest test, std::vector<Contact>& contacts, QueryStats& stats,

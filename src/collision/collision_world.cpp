@@ -36,6 +36,7 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     fields_.push_back(pointShell && !deformable(part) ? buildDistanceField(part) : nullptr);
     if (pointShell && deformable(part)) colliders_.back().buildRestPointTree(part);
     partSpheres_.push_back(colliders_.back().worldSphere(part));
+    refitted_.growTo(parts_.size());
     broadPhase_.build(partSpheres_);  // the tree's shape changes with the set of parts
 }
 

@@ -12,6 +12,7 @@ bool deformable(const Part& p) { return p.mode() != PartMode::Rigid; }
 }  // namespace
 
 const std::vector<Contact>& CollisionWorld::narrowPhase() {
+    refitted_.clear();
     contacts_.clear();
     stats_ = {};
     for (auto [i, j] : pairs_) {
@@ -28,6 +29,7 @@ const std::vector<Contact>& CollisionWorld::findContacts() {
 
 const std::vector<Contact>& CollisionWorld::contactsOf(BodyId id, bool rigidPartnersOnly) {
     updateBounds();
+    refitted_.clear();
     bodyContacts_.clear();
     const RelativePose identity;
     // Other bodies in ascending id: the same pairs, in the same order, as the broad phase gives.
@@ -46,9 +48,16 @@ void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, Qu
     // A field exists only for a rigid part under the point-shell setting.
     if (const SignedDistanceField* field = fields_[a].get(); field != nullptr && deformable(*parts_[b]))
         return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(), out, stats);
-    colliders_[a].refitPending(*parts_[a]);
-    colliders_[b].refitPending(*parts_[b]);
+    refitChanged(a);
+    refitChanged(b);
     flexfit::queryPair(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, out, stats);
+}
+
+void CollisionWorld::refitChanged(BodyId id) {
+    const std::span<const Index> changed = parts_[id]->changedMasses();
+    if (changed.empty() || refitted_.contains(id)) return;
+    colliders_[id].refit(*parts_[id], changed);
+    refitted_.insert(id);
 }
 
 }  // namespace flexfit

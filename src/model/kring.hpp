@@ -1,11 +1,11 @@
 // k-rings over the mass graph (CSR neighbourhoods) by breadth-first search.
 //
-// Visited marks are epoch-stamped: a query bumps the epoch instead of clearing the marks, so
-// after the first queries have sized the queue, a query allocates nothing and costs only
-// what it visits, whatever the mesh size.
+// The visited masses are an IndexSet: a query clears it in O(1), so after the first queries
+// have sized the queue, a query allocates nothing and costs only what it visits, whatever the
+// mesh size.
 #pragma once
 
-#include "core/epoch_marks.hpp"
+#include "flexfit/index_set.hpp"
 #include "flexfit/topology.hpp"
 
 #include <cstdint>
@@ -29,7 +29,7 @@ public:
     std::size_t lastVisited() const { return lastVisited_; }  // masses touched by the last query
 
 private:
-    EpochMarks visited_;  // (V)
+    IndexSet visited_;  // (V)
     std::size_t lastVisited_ = 0;
 };
 

@@ -49,5 +49,9 @@ double Bodies::minimumThickness() const {
     return thinnest;
 }
 
+void clearRefittedChanges(const CollisionWorld& collision, Bodies& bodies) {
+    for (BodyId id : collision.refittedBodies()) bodies.parts[id]->clearChangedMasses();
+}
+
 }  // namespace detail
 }  // namespace flexfit

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "flexfit/body.hpp"
+#include "flexfit/collision_world.hpp"
 #include "flexfit/part.hpp"
 
 #include <memory>
@@ -29,5 +30,8 @@ struct Bodies {
     // The thinnest body's thickness (the no-tunnelling bound's scale).
     double minimumThickness() const;
 };
+
+// After a collision query: the parts whose hierarchy it refitted forget the changes it used.
+void clearRefittedChanges(const CollisionWorld& collision, Bodies& bodies);
 
 }  // namespace flexfit::detail

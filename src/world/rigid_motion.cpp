@@ -39,6 +39,7 @@ void resolveRigidContacts(BodyId id, int iterations, Bodies& bodies, CollisionWo
         const Stage outer = profiler.running();
         profiler.enter(Stage::NarrowPhase);
         const std::vector<Contact>& contacts = collision.contactsOf(id, true);  // pairs with rigid parts
+        clearRefittedChanges(collision, bodies);
         profiler.enter(Stage::ContactResponse);
         const double correction = projectRigidContacts(id, contacts, bodies, response);
         profiler.enter(outer);

@@ -16,17 +16,6 @@ namespace {
 
 const std::string kSource = "world";
 
-// This step's deformation, handed to the colliders for the next step's queries (each part's
-// change list is consumed once).
-void handOverShapeChanges(detail::Bodies& bodies, CollisionWorld& collision) {
-    for (BodyId id = 0; id < bodies.size(); ++id) {
-        Part& part = *bodies.parts[id];
-        if (part.changedMasses().empty()) continue;
-        collision.noteShapeChanges(id, part.changedMasses());
-        part.clearChangedMasses();
-    }
-}
-
 }  // namespace
 
 void validateSettings(const WorldSettings& settings) {
@@ -168,15 +157,14 @@ void World::step() {
     profiler.enter(Stage::BroadPhase);
     d.collision.update();                                          // spheres, candidate pairs
     profiler.enter(Stage::NarrowPhase);
-    const std::vector<Contact>& contacts = d.collision.narrowPhase();
+    const std::vector<Contact>& contacts = d.collision.narrowPhase();  // refits deformed hierarchies it needs
+    detail::clearRefittedChanges(d.collision, d.bodies);
     profiler.enter(Stage::ContactResponse);
     detail::respondToContacts(contacts, d.bodies, d.response);     // deformable pushes, reactions
     profiler.enter(Stage::ZoneDynamics);
     detail::advanceZones(step, d.bodies);                          // moving masses, restoration
     profiler.enter(Stage::ZoneRetirement);
     detail::retireZones(d.bodies);                                 // zones at rest back to rest
-    profiler.enter(Stage::BroadPhase);
-    handOverShapeChanges(d.bodies, d.collision);                   // for the next step's queries
     profiler.enter(Stage::Assembly);
     detail::assemble(step, contacts, d.assembly, d.bodies, d.op);  // snapping rules
     profiler.finish();

@@ -82,9 +82,10 @@ TEST(NarrowPhase, OneBodysContactsAreItsShareOfTheNarrowPhase) {
 }
 
 TEST(NarrowPhase, HierarchiesRefitWhenAQueryNeedsThemAndNotWhenRead) {
-    // A deformable torus pressed by a force and a probe sphere at its rim. Noting the changed
-    // masses leaves the hierarchy as it was (reading it changes nothing); the next face query
-    // refits it, and then gives the contacts of a hierarchy rebuilt from scratch.
+    // A deformable torus pressed by a force and a probe sphere at its rim. Reading the
+    // collider changes nothing; the next face query refits it from the part's changed masses,
+    // once, lists the body as refitted, and gives the contacts of a hierarchy rebuilt from
+    // scratch.
     const auto torusModel = buildPartModel(makeTorus1());
     Part torus(torusModel);
     Part probe(buildPartModel(makeIcoSphere(3.0, 3)), rigid());
@@ -97,13 +98,11 @@ TEST(NarrowPhase, HierarchiesRefitWhenAQueryNeedsThemAndNotWhenRead) {
         torus.step();
     }
     const std::size_t refitsBefore = world.collider(1).refitNodeCount();
-    world.noteShapeChanges(1, torus.changedMasses());
-    torus.clearChangedMasses();
-    EXPECT_FALSE(world.collider(1).upToDate());
-    EXPECT_EQ(world.collider(1).refitNodeCount(), refitsBefore);  // noted, not refitted
+    EXPECT_EQ(world.collider(1).refitNodeCount(), refitsBefore);  // read, not refitted
     const std::vector<Contact> contacts = world.findContacts();
-    EXPECT_TRUE(world.collider(1).upToDate());
     EXPECT_GT(world.collider(1).refitNodeCount(), refitsBefore);
+    ASSERT_EQ(world.refittedBodies().size(), 1u);
+    EXPECT_EQ(world.refittedBodies()[0], 1u);
 
     const PartCollider rebuilt(torus, BoundingVolumeKind::Aabb), probeCollider(probe, BoundingVolumeKind::Aabb);
     std::vector<Contact> expected;
@@ -111,6 +110,12 @@ TEST(NarrowPhase, HierarchiesRefitWhenAQueryNeedsThemAndNotWhenRead) {
     queryPair(0, probe, probeCollider, 1, torus, rebuilt, ExactTest::TriangleTriangle, expected, stats);
     ASSERT_FALSE(expected.empty());
     EXPECT_EQ(keysOf(contacts), keysOf(expected));
+    // With the part's list cleared, the next query has nothing to refit.
+    torus.clearChangedMasses();
+    const std::size_t refitsAfter = world.collider(1).refitNodeCount();
+    world.findContacts();
+    EXPECT_EQ(world.collider(1).refitNodeCount(), refitsAfter);
+    EXPECT_TRUE(world.refittedBodies().empty());
 }
 
 TEST(NarrowPhase, PointShellPairsNeedNoRefit) {
@@ -128,10 +133,9 @@ TEST(NarrowPhase, PointShellPairsNeedNoRefit) {
         torus.applyForce(0, Vec3(-10.0, 0.0, 0.0));
         torus.step();
     }
-    world.noteShapeChanges(1, torus.changedMasses());
     const std::vector<Contact> contacts = world.findContacts();
     ASSERT_FALSE(contacts.empty());
     for (const Contact& c : contacts) EXPECT_NE(c.massB, kNoMass);  // point-shell contacts
-    EXPECT_FALSE(world.collider(1).upToDate());
+    EXPECT_TRUE(world.refittedBodies().empty());
     EXPECT_EQ(world.collider(1).refitNodeCount(), 0u);
 }

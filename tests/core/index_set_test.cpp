@@ -18,7 +18,7 @@ TEST(IndexSet, InsertEraseContainsAndClear) {
     EXPECT_TRUE(set.insert(1));
     EXPECT_FALSE(set.insert(4));
     EXPECT_TRUE(set.contains(4));
-    EXPECT_FALSE(set.contains(0));  // slot 0 is stale-valid for index 0: members[0] is 4, not 0
+    EXPECT_FALSE(set.contains(0));
     EXPECT_EQ(std::vector<Index>(set.begin(), set.end()), (std::vector<Index>{4, 1}));
     EXPECT_EQ(set.slotOf(1), 1u);
     EXPECT_TRUE(set.erase(4));  // the last member takes its slot
@@ -73,4 +73,18 @@ TEST(IndexSet, MatchesAHandKeptListOverRandomOperations) {
             ASSERT_EQ(set[set.slotOf(k)], k);
         }
     }
+}
+
+TEST(IndexSet, GrowingKeepsMembersAndAddsNone) {
+    IndexSet set(2);
+    set.insert(1);
+    set.growTo(10);
+    EXPECT_TRUE(set.contains(1));
+    for (Index i = 2; i < 10; ++i) EXPECT_FALSE(set.contains(i));
+    set.growTo(4);  // never shrinks
+    EXPECT_EQ(set.capacity(), 10u);
+    set.reset(3);
+    EXPECT_TRUE(set.empty());
+    EXPECT_EQ(set.capacity(), 3u);
+    EXPECT_FALSE(set.contains(1));
 }

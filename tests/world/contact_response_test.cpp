@@ -51,13 +51,11 @@ struct Bench {
         return id;
     }
     Part& part(BodyId id) { return *bodies.parts[id]; }
-    // The world's order: shape changes handed over, contacts found, the response.
+    // The world's order: contacts found (refitting deformed hierarchies), the changes they
+    // used cleared, the response.
     const std::vector<Contact>& respond() {
-        for (BodyId id = 0; id < bodies.size(); ++id) {
-            collision.noteShapeChanges(id, part(id).changedMasses());
-            part(id).clearChangedMasses();
-        }
         const std::vector<Contact>& contacts = collision.findContacts();
+        detail::clearRefittedChanges(collision, bodies);
         detail::respondToContacts(contacts, bodies, response);
         return contacts;
     }
