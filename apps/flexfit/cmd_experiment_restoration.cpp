@@ -88,7 +88,9 @@ std::vector<std::pair<std::string, double>> measureRestorationCost(const Experim
             const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             best[k] = std::max(best[k], kSteps / seconds);
         }
-    return {{"none", best[0]}, {"anchor", best[1]}, {"constraint", best[2]}};
+    std::vector<std::pair<std::string, double>> cost;
+    for (int k = 0; k < 3; ++k) cost.emplace_back(toString(methods[k]), best[k]);
+    return cost;
 }
 
 std::string restorationText(const ActivityTracker& t) {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 namespace flexfit::viewer {
 namespace {
@@ -119,6 +120,10 @@ void App::load(const std::filesystem::path& scene) {
     selection_.reset();
     rebuildMeshes();
     camera_ = initialCamera(session_->world(), renderer_->width(), renderer_->height());
+    for (const SceneWarning& w : session_->scene().warnings) {  // old spellings: on stderr and in the panel
+        message_ = "warning: " + scene.string() + ":" + std::to_string(w.line) + ": " + w.message;
+        std::fprintf(stderr, "%s\n", message_.c_str());
+    }
     for (const ScenePart& part : session_->scene().parts)
         if (part.part.mode != PartMode::Rigid) {  // the panel starts from the first deformable part
             contactLevel_ = part.part.zones.contactLevel;
@@ -135,6 +140,7 @@ void App::rebuildMeshes() {
     normals_.clear();
     for (BodyId id = 0; id < w.bodyCount(); ++id) normals_.emplace_back(w.part(id));
     dirty_.assign(w.bodyCount(), true);
+    hierarchies_.clear();
 }
 
 void App::frame(double frameSeconds) {
@@ -221,6 +227,11 @@ void App::drawScene() {
         dirty_[id] = false;  // while masses move (and the frame after), update() reports the change
         renderer_->drawPart(id, part.pose());
     }
+    if (overlays.hierarchy) {  // the viewer's own copies, in step with the parts' shapes
+        if (hierarchies_.empty())
+            for (BodyId id = 0; id < w.bodyCount(); ++id) hierarchies_.emplace_back(w.part(id), w.collision().collider(id));
+        for (BodyId id = 0; id < w.bodyCount(); ++id) hierarchies_[id].update(w.part(id));
+    }
     glDisable(GL_DEPTH_TEST);  // overlays stay visible through the parts
     renderer_->drawLines(overlayLines());
     std::vector<LineVertex> points;
@@ -254,7 +265,7 @@ std::vector<LineVertex> App::overlayLines() const {
         }
     if (overlays.hierarchy)
         for (BodyId id = 0; id < w.bodyCount(); ++id) {
-            const PartCollider& collider = w.collision().collider(id);
+            const PartCollider& collider = hierarchies_[id].collider();
             const Pose& pose = w.part(id).pose();
             auto shown = [&](const auto& node) { return node.depth == overlays.hierarchyDepth || (node.isLeaf() && node.depth < overlays.hierarchyDepth); };
             if (const auto* boxes = collider.boxes())

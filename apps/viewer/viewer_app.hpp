@@ -54,6 +54,7 @@ private:
     Camera camera_;
     std::vector<SurfaceNormals> normals_;
     std::vector<bool> dirty_;
+    std::vector<DisplayHierarchy> hierarchies_;  // built when the overlay is first shown
     // Operator state.
     std::optional<Pick> selection_;
     bool dragging_ = false;

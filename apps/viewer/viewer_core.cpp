@@ -191,6 +191,20 @@ bool SurfaceNormals::update(const Part& part) {
     return true;
 }
 
+// --- Hierarchies for drawing ---
+
+DisplayHierarchy::DisplayHierarchy(const Part& part, const PartCollider& like)
+    : collider_(part, like.kind(), like.exactTest()), previouslyMoving_(part.movingMasses().begin(), part.movingMasses().end()) {}
+
+void DisplayHierarchy::update(const Part& part) {
+    const auto moving = part.movingMasses();
+    if (moving.empty() && previouslyMoving_.empty()) return;
+    changed_.assign(moving.begin(), moving.end());
+    changed_.insert(changed_.end(), previouslyMoving_.begin(), previouslyMoving_.end());
+    collider_.refit(part, changed_);
+    previouslyMoving_.assign(moving.begin(), moving.end());
+}
+
 // --- Session ---
 
 Session::Session(Scene scene) : scene_(std::move(scene)) { reset(); }

@@ -99,6 +99,23 @@ private:
     std::size_t recomputed_ = 0;
 };
 
+// A part's face hierarchy for drawing, kept in step with the part's shape by the viewer: the
+// world refits its own hierarchies only when a face query needs them (never for a part met
+// only by point-shell queries, or alone), and drawing must not change the world. Built like the
+// world's collider of the part; each update refits the faces around the masses that move or
+// have just stopped (O(those masses)).
+class DisplayHierarchy {
+public:
+    DisplayHierarchy(const Part& part, const PartCollider& like);
+    void update(const Part& part);
+    const PartCollider& collider() const { return collider_; }
+
+private:
+    PartCollider collider_;
+    std::vector<Index> previouslyMoving_;
+    std::vector<Index> changed_;  // scratch
+};
+
 class Session {
 public:
     explicit Session(Scene scene);

@@ -15,6 +15,7 @@
 // interpolated linearly, rotation by slerp), not in one jump, and reports an event.
 #pragma once
 
+#include "flexfit/names.hpp"
 #include "flexfit/pose.hpp"
 
 #include <optional>
@@ -23,7 +24,16 @@
 namespace flexfit {
 
 enum class SnapTechnique { CollisionSnap, ProximitySnap, VectorSnap, ZoneSnap };
-const char* toString(SnapTechnique technique);
+// Its names (names.hpp).
+inline constexpr EnumName<SnapTechnique> kSnapTechniqueNames[] = {
+    {SnapTechnique::CollisionSnap, "collision", "collision snapping"},
+    {SnapTechnique::ProximitySnap, "proximity", "proximity snapping"},
+    {SnapTechnique::VectorSnap, "vector", "improved snap-fitting"},
+    {SnapTechnique::ZoneSnap, "zone", "zone snap-fitting"},
+};
+template <>
+inline constexpr std::span<const EnumName<SnapTechnique>> kEnumNames<SnapTechnique> = kSnapTechniqueNames;
+inline const char* toString(SnapTechnique technique) { return nameOf(technique); }
 
 struct AssemblyVector {
     Vec3 origin = Vec3::Zero();  // part frame
@@ -38,7 +48,15 @@ struct AssemblyArea {
     double halfHeight = 1.0;          // cylinder, along y
     bool contains(const Vec3& pointInPart) const;
 };
-const char* toString(AssemblyArea::Shape shape);
+// Its names (names.hpp).
+inline constexpr EnumName<AssemblyArea::Shape> kAreaShapeNames[] = {
+    {AssemblyArea::Shape::Box, "box", "box"},
+    {AssemblyArea::Shape::Sphere, "sphere", "sphere"},
+    {AssemblyArea::Shape::Cylinder, "cylinder", "cylinder"},
+};
+template <>
+inline constexpr std::span<const EnumName<AssemblyArea::Shape>> kEnumNames<AssemblyArea::Shape> = kAreaShapeNames;
+inline const char* toString(AssemblyArea::Shape shape) { return nameOf(shape); }
 
 struct AssemblyRule {
     std::string name;

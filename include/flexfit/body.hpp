@@ -7,6 +7,7 @@
 // 2, ... in the order added: the world and its collision side use the same id.
 #pragma once
 
+#include "flexfit/names.hpp"
 #include "flexfit/bounding_volume.hpp"
 #include "flexfit/part_model.hpp"
 
@@ -14,10 +15,16 @@
 
 namespace flexfit {
 
-using BodyId = std::uint32_t;
-
 enum class MotionType { Static, Kinematic, Dynamic };
-const char* toString(MotionType motion);
+// Its names (names.hpp).
+inline constexpr EnumName<MotionType> kMotionTypeNames[] = {
+    {MotionType::Static, "static", "static"},
+    {MotionType::Kinematic, "kinematic", "kinematic"},
+    {MotionType::Dynamic, "dynamic", "dynamic"},
+};
+template <>
+inline constexpr std::span<const EnumName<MotionType>> kEnumNames<MotionType> = kMotionTypeNames;
+inline const char* toString(MotionType motion) { return nameOf(motion); }
 
 struct BodySettings {
     MotionType motion = MotionType::Static;

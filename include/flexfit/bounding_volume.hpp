@@ -6,6 +6,7 @@
 // boxes (Gottschalk et al., 15 axes), since each box is aligned only in its own frame.
 #pragma once
 
+#include "flexfit/names.hpp"
 #include "flexfit/core.hpp"
 
 #include <algorithm>
@@ -15,7 +16,14 @@
 namespace flexfit {
 
 enum class BoundingVolumeKind { Sphere, Aabb };
-const char* toString(BoundingVolumeKind kind);
+// Its names (names.hpp).
+inline constexpr EnumName<BoundingVolumeKind> kBoundingVolumeKindNames[] = {
+    {BoundingVolumeKind::Sphere, "sphere", "spheres"},
+    {BoundingVolumeKind::Aabb, "aabb", "axis-aligned boxes"},
+};
+template <>
+inline constexpr std::span<const EnumName<BoundingVolumeKind>> kEnumNames<BoundingVolumeKind> = kBoundingVolumeKindNames;
+inline const char* toString(BoundingVolumeKind kind) { return nameOf(kind); }
 
 struct Sphere {
     Vec3 centre = Vec3::Zero();

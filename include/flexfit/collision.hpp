@@ -16,6 +16,8 @@
 // the opposite) separates the pair.
 #pragma once
 
+#include "flexfit/names.hpp"
+
 #include <array>
 #include <limits>
 #include <span>
@@ -28,7 +30,14 @@
 namespace flexfit {
 
 enum class ExactTest { SphereTriangle, TriangleTriangle };
-const char* toString(ExactTest test);
+// Its names (names.hpp).
+inline constexpr EnumName<ExactTest> kExactTestNames[] = {
+    {ExactTest::SphereTriangle, "sphere", "face sphere against triangle"},
+    {ExactTest::TriangleTriangle, "triangle", "triangle against triangle"},
+};
+template <>
+inline constexpr std::span<const EnumName<ExactTest>> kEnumNames<ExactTest> = kExactTestNames;
+inline const char* toString(ExactTest test) { return nameOf(test); }
 
 inline constexpr Index kNoMass = std::numeric_limits<Index>::max();
 

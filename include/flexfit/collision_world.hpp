@@ -19,11 +19,10 @@
 // contactsOf() call. The collision world never changes a part: refittedBodies() lists the
 // bodies the last call refitted, and their owner clears those parts' lists (the world does
 // after every call; a list left uncleared is refitted again, which is slower, not wrong).
-// collider() never refits: a part met only by point-shell queries keeps the hierarchy of its
-// last refit.
+// collider() never refits: a part met by no face query (point shell only, or alone) keeps the
+// hierarchy of its last refit.
 #pragma once
 
-#include "flexfit/body.hpp"
 #include "flexfit/collision.hpp"
 #include "flexfit/distance_field.hpp"
 
@@ -32,7 +31,14 @@
 namespace flexfit {
 
 enum class BroadPhaseUpdate { Refit, Rebuild };
-const char* toString(BroadPhaseUpdate update);
+// Its names (names.hpp).
+inline constexpr EnumName<BroadPhaseUpdate> kBroadPhaseUpdateNames[] = {
+    {BroadPhaseUpdate::Refit, "refit", "refit"},
+    {BroadPhaseUpdate::Rebuild, "rebuild", "rebuild"},
+};
+template <>
+inline constexpr std::span<const EnumName<BroadPhaseUpdate>> kEnumNames<BroadPhaseUpdate> = kBroadPhaseUpdateNames;
+inline const char* toString(BroadPhaseUpdate update) { return nameOf(update); }
 
 // How a rigid part and a deformable part are tested. Faces: the two face hierarchies, as for
 // every other pair. PointShell: the deformable part's masses against the rigid part's signed
@@ -42,7 +48,14 @@ const char* toString(BroadPhaseUpdate update);
 // cost follows the masses near the rigid surface, which is what lets a ball press a
 // 7,300-mass rim at haptic rates.
 enum class RigidDeformableQuery { Faces, PointShell };
-const char* toString(RigidDeformableQuery query);
+// Its names (names.hpp).
+inline constexpr EnumName<RigidDeformableQuery> kRigidDeformableQueryNames[] = {
+    {RigidDeformableQuery::Faces, "faces", "face hierarchies"},
+    {RigidDeformableQuery::PointShell, "point-shell", "point shell"},
+};
+template <>
+inline constexpr std::span<const EnumName<RigidDeformableQuery>> kEnumNames<RigidDeformableQuery> = kRigidDeformableQueryNames;
+inline const char* toString(RigidDeformableQuery query) { return nameOf(query); }
 
 struct CollisionSettings {
     ExactTest exactTest = ExactTest::TriangleTriangle;

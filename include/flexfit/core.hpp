@@ -19,6 +19,8 @@ namespace flexfit {
 using Vec3 = Eigen::Vector3d;
 using Index = std::uint32_t;
 using Face = std::array<Index, 3>;
+// A body's id in a world: its index, 0, 1, 2, ... in the order added (body.hpp).
+using BodyId = std::uint32_t;
 
 // Error in user input (a file, a scene description, a parameter). Names the source, the line
 // when there is one (1-based; 0 = none) and the problem. Thrown before anything is built, so

@@ -1,19 +1,15 @@
 // One vocabulary: every enum a user names (in a scene file, on the command line, in JSON
-// output or in the viewer) has one table of names here, and all of them read it.
+// output or in the viewer) has one table of names, and all of them read it.
 //
 // Each value has one name, the spelling users type and read (scene files, CLI options,
 // toString, JSON), and a label, words for prose and the viewer ("anchors" is named so and
 // labelled "anchor springs"). Spellings that older versions accepted stay readable for a
 // while: parseName() maps them to their value and says which name replaces them, so the
 // caller can warn with the file and line.
+//
+// Each enum's header gives its table (kEnumNames<E>, and kDeprecatedNames<E> where old
+// spellings exist) and its toString, which returns the name.
 #pragma once
-
-#include "flexfit/assembly.hpp"
-#include "flexfit/body.hpp"
-#include "flexfit/collision_world.hpp"
-#include "flexfit/part.hpp"
-#include "flexfit/profile.hpp"
-#include "flexfit/simulation.hpp"
 
 #include <optional>
 #include <span>
@@ -36,31 +32,22 @@ struct DeprecatedName {
     Enum value;
 };
 
-// The tables (names.cpp): every value once, in declaration order.
+// The tables: every value once, in declaration order, each specialised in its enum's header
+// right after the enum (so the names stand next to the values they name).
 template <class Enum>
-std::span<const EnumName<Enum>> enumNames();
+inline constexpr std::span<const EnumName<Enum>> kEnumNames{};
+// Old spellings; none unless the enum's header gives some.
 template <class Enum>
-std::span<const DeprecatedName<Enum>> deprecatedNames();
+inline constexpr std::span<const DeprecatedName<Enum>> kDeprecatedNames{};
 
-template <> std::span<const EnumName<PartMode>> enumNames();
-template <> std::span<const EnumName<MotionType>> enumNames();
-template <> std::span<const EnumName<Integrator>> enumNames();
-template <> std::span<const EnumName<RestorationMethod>> enumNames();
-template <> std::span<const EnumName<ExactTest>> enumNames();
-template <> std::span<const EnumName<BoundingVolumeKind>> enumNames();
-template <> std::span<const EnumName<BroadPhaseUpdate>> enumNames();
-template <> std::span<const EnumName<RigidDeformableQuery>> enumNames();
-template <> std::span<const EnumName<SnapTechnique>> enumNames();
-template <> std::span<const EnumName<AssemblyArea::Shape>> enumNames();
-template <> std::span<const EnumName<Stage>> enumNames();
-
-template <> std::span<const DeprecatedName<PartMode>> deprecatedNames();
-template <> std::span<const DeprecatedName<RestorationMethod>> deprecatedNames();
-
-// Enums with no old spellings.
 template <class Enum>
-std::span<const DeprecatedName<Enum>> deprecatedNames() {
-    return {};
+constexpr std::span<const EnumName<Enum>> enumNames() {
+    static_assert(!kEnumNames<Enum>.empty(), "this enum has no table of names");
+    return kEnumNames<Enum>;
+}
+template <class Enum>
+constexpr std::span<const DeprecatedName<Enum>> deprecatedNames() {
+    return kDeprecatedNames<Enum>;
 }
 
 template <class Enum>
@@ -114,6 +101,8 @@ std::vector<std::string> allNames(bool withDeprecated = false) {
 }
 
 // The warning for an old spelling: "'anchor' is deprecated: write 'anchors'".
-std::string deprecationWarning(std::string_view oldName, std::string_view replacement);
+inline std::string deprecationWarning(std::string_view oldName, std::string_view replacement) {
+    return "'" + std::string(oldName) + "' is deprecated: write '" + std::string(replacement) + "'";
+}
 
 }  // namespace flexfit

@@ -34,6 +34,7 @@
 // Known limits: the part's own rigid-body motion (velocities, contacts) belongs to the world.
 #pragma once
 
+#include "flexfit/names.hpp"
 #include "flexfit/active_region.hpp"
 #include "flexfit/pose.hpp"
 #include "flexfit/simulation.hpp"
@@ -45,7 +46,18 @@
 namespace flexfit {
 
 enum class PartMode { Rigid, RigidDeformable, FullDeformable };
-const char* toString(PartMode mode);
+// Its names (names.hpp).
+inline constexpr EnumName<PartMode> kPartModeNames[] = {
+    {PartMode::Rigid, "rigid", "rigid"},
+    {PartMode::RigidDeformable, "rigid-deformable", "rigid-deformable (zones)"},
+    {PartMode::FullDeformable, "full-deformable", "full-deformable"},
+};
+template <>
+inline constexpr std::span<const EnumName<PartMode>> kEnumNames<PartMode> = kPartModeNames;
+inline constexpr DeprecatedName<PartMode> kPartModeOldNames[] = {{"zones", PartMode::RigidDeformable}, {"full", PartMode::FullDeformable}};
+template <>
+inline constexpr std::span<const DeprecatedName<PartMode>> kDeprecatedNames<PartMode> = kPartModeOldNames;
+inline const char* toString(PartMode mode) { return nameOf(mode); }
 
 struct ZoneSettings {
     int defaultLevel = 2;            // level of zones opened by forces
@@ -58,8 +70,8 @@ struct ZoneSettings {
 
 struct PartSettings {
     PartMode mode = PartMode::RigidDeformable;
-    // In a world, simulation.timeStep and simulation.gravity are not used: the world's step
-    // context gives them (world.hpp).
+    // In a world, simulation.timeStep and simulation.gravity are not used (the world's step
+    // context gives them, world.hpp), but they must still be valid: a part can be stepped alone.
     SimulationSettings simulation;
     ZoneSettings zones;
 };
@@ -81,6 +93,8 @@ public:
     // Throws InputError for invalid settings.
     explicit Part(std::shared_ptr<const PartModel> model, const PartSettings& settings = {});
     ~Part();
+    Part(const Part& other);  // an independent copy: same model, settings, pose, state and zones
+    Part& operator=(const Part& other);
     Part(Part&&) noexcept;
     Part& operator=(Part&&) noexcept;
 

@@ -67,8 +67,18 @@ struct SceneAction {
     std::vector<Index> masses, faces;
     Vec3 linear = Vec3::Zero(), angular = Vec3::Zero();
 };
-const char* toString(SceneAction::Kind kind);
-template <> std::span<const EnumName<SceneAction::Kind>> enumNames();
+// Its names (names.hpp).
+inline constexpr EnumName<SceneAction::Kind> kActionKindNames[] = {
+    {SceneAction::Kind::Grab, "grab", "grab"},
+    {SceneAction::Kind::Move, "move", "move"},
+    {SceneAction::Kind::Release, "release", "release"},
+    {SceneAction::Kind::Push, "push", "push"},
+    {SceneAction::Kind::Force, "force", "force"},
+    {SceneAction::Kind::Velocity, "velocity", "velocity"},
+};
+template <>
+inline constexpr std::span<const EnumName<SceneAction::Kind>> kEnumNames<SceneAction::Kind> = kActionKindNames;
+inline const char* toString(SceneAction::Kind kind) { return nameOf(kind); }
 
 // Something the reader accepted but the user should change (an old spelling, for now).
 struct SceneWarning {

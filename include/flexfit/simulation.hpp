@@ -27,6 +27,7 @@
 //                  c for the stiffness wanted (c = 1e-4 at 1 kHz ~ 100 N/m per kg).
 #pragma once
 
+#include "flexfit/names.hpp"
 #include "flexfit/active_region.hpp"
 #include "flexfit/part_state.hpp"
 
@@ -80,7 +81,7 @@ struct StepCounters {
 };
 
 // Advances every mass of the part by one time step. Loads must name masses < massCount.
-// Models with spring blocks (spring_blocks.hpp) are stepped by blocks with the widest kernel
+// Models with spring blocks (PartModel::hasSpringBlocks) are stepped by blocks with the widest kernel
 // the CPU has (scalar, AVX2, AVX-512: the same bits on every CPU); others by a per-mass sweep.
 void stepFullModel(const PartModel& model, const SimulationSettings& settings,
                    std::span<const PointLoad> loads, PartState& state,
@@ -108,7 +109,25 @@ struct StabilityReport {
 
 StabilityReport analyzeStability(const PartModel& model, const SimulationSettings& settings);
 
-const char* toString(Integrator integrator);
-const char* toString(RestorationMethod method);
+// Its names (names.hpp).
+inline constexpr EnumName<Integrator> kIntegratorNames[] = {
+    {Integrator::SemiImplicitEuler, "semi-implicit", "semi-implicit (symplectic) Euler"},
+    {Integrator::ExplicitEuler, "explicit", "explicit Euler"},
+};
+template <>
+inline constexpr std::span<const EnumName<Integrator>> kEnumNames<Integrator> = kIntegratorNames;
+inline const char* toString(Integrator integrator) { return nameOf(integrator); }
+// Its names (names.hpp).
+inline constexpr EnumName<RestorationMethod> kRestorationMethodNames[] = {
+    {RestorationMethod::None, "none", "none"},
+    {RestorationMethod::AnchorSprings, "anchors", "anchor springs"},
+    {RestorationMethod::Constraint, "constraint", "restoration constraint"},
+};
+template <>
+inline constexpr std::span<const EnumName<RestorationMethod>> kEnumNames<RestorationMethod> = kRestorationMethodNames;
+inline constexpr DeprecatedName<RestorationMethod> kRestorationMethodOldNames[] = {{"anchor", RestorationMethod::AnchorSprings}};
+template <>
+inline constexpr std::span<const DeprecatedName<RestorationMethod>> kDeprecatedNames<RestorationMethod> = kRestorationMethodOldNames;
+inline const char* toString(RestorationMethod method) { return nameOf(method); }
 
 }  // namespace flexfit

@@ -7,17 +7,18 @@
 //                        jump to their targets (operator_input.cpp)
 //   2. rigid motion      dynamic bodies integrated in sub-steps, their contacts with rigid
 //                        parts projected out after each sub-step (rigid_motion.cpp)
-//   3. broad phase       shape changes handed to the colliders; bounding spheres, candidate
-//                        pairs (broad_phase.cpp)
-//   4. narrow phase      the contacts of the candidate pairs (narrow_phase.cpp)
+//   3. broad phase       bounding spheres, candidate pairs (broad_phase.cpp)
+//   4. narrow phase      the contacts of the candidate pairs, refitting the deformed
+//                        hierarchies it traverses (narrow_phase.cpp)
 //   5. contact response  deformable parts pushed out of their contacts, their reactions on
 //                        dynamic bodies (contact_response.cpp)
 //   6. zone dynamics     every deformable part's moving masses (zone_dynamics.cpp)
 //   7. zone retirement   zones at rest retired (zone_retirement.cpp)
 //   8. assembly          the snapping rules (assembly.cpp)
-// Each stage receives the step context (time step, gravity, step index, time) and what it
-// reads and writes, nothing else. Parts keep the settings they were given: the world's time
-// step and gravity reach them through the context, never by rewriting their settings.
+// Each stage's signature shows what it reads and writes: the step context (time step, gravity,
+// step index, time) where it needs one, and the pieces of the world it touches. Parts keep the
+// settings they were given: the world's time step and gravity reach them through the context,
+// never by rewriting their settings (a part's own settings must still be valid on their own).
 //
 // Bodies (body.hpp): static, kinematic or dynamic, each a Part, so any motion type combines
 // with any deformation mode. The world owns them; its collision side sees them read-only under
@@ -79,6 +80,7 @@ public:
     // Throws InputError for invalid settings.
     explicit World(WorldSettings settings = {});
     ~World();
+    // A moved-from World holds nothing: it may only be destroyed or assigned to.
     World(World&&) noexcept;
     World& operator=(World&&) noexcept;
 
@@ -88,6 +90,7 @@ public:
     BodyId add(std::shared_ptr<const PartModel> model, const PartSettings& part, const BodySettings& body, const Pose& pose);
 
     std::size_t bodyCount() const;
+    // Read-only views (InputError for a missing body, as every call that names one).
     const Part& part(BodyId id) const;
     const RigidBody& body(BodyId id) const;
     const WorldSettings& settings() const;
@@ -106,6 +109,7 @@ public:
     void applyForceAt(BodyId id, const Vec3& worldForce, const Vec3& worldPoint);  // adds the torque
     void setVelocity(BodyId id, const Vec3& linear, const Vec3& angular);
     // Kinematic bodies: the pose to reach by the end of the next step (velocity derived).
+    // Forces, velocities and poses must be finite (InputError).
     void setKinematicTarget(BodyId id, const Pose& target);
 
     // --- The operator ---
@@ -147,6 +151,7 @@ public:
 
 private:
     void checkBody(BodyId id, const char* what) const;
+    void checkPose(const Pose& pose, const char* what) const;
     std::unique_ptr<detail::WorldData> data_;
 };
 

@@ -5,6 +5,9 @@
 
 #include "flexfit/collision_world.hpp"
 
+#include <cmath>
+#include <string>
+
 namespace flexfit {
 
 struct WorldSettings {
@@ -18,7 +21,15 @@ struct WorldSettings {
 
 // Throws InputError (source "world") for a time step that is not finite and positive,
 // non-finite gravity, a travel fraction outside (0, 1], or sub-steps or iterations below 1.
-void validateSettings(const WorldSettings& settings);
+inline void validateSettings(const WorldSettings& settings) {
+    const std::string source = "world";
+    if (!std::isfinite(settings.timeStep) || settings.timeStep <= 0.0) throw InputError(source, 0, "time step must be finite and > 0");
+    if (!settings.gravity.allFinite()) throw InputError(source, 0, "gravity must be finite");
+    if (!(settings.maxTravelFraction > 0.0 && settings.maxTravelFraction <= 1.0))
+        throw InputError(source, 0, "max travel fraction must be in (0, 1]");
+    if (settings.maxSubsteps < 1 || settings.contactIterations < 1)
+        throw InputError(source, 0, "max substeps and contact iterations must be >= 1");
+}
 
 // The operator's spring-damper coupling. Zero stiffness: the body's mass (and smallest
 // principal inertia) times w^2, w = min(2 pi frequency, 0.4 / dt), so the explicit coupling is

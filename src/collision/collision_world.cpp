@@ -28,16 +28,28 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     if (id != parts_.size())
         throw std::invalid_argument("CollisionWorld::add: body " + std::to_string(id) + " out of order (expected " +
                                     std::to_string(parts_.size()) + ")");
-    parts_.push_back(&part);
-    colliders_.emplace_back(part, kind, settings_.exactTest);
-    // Fields and rest-point trees are built now rather than at the first contact, where they
-    // would stall a haptic loop.
+    // Everything is built before anything is registered: a failure (out of memory) leaves the
+    // collision world as it was. Fields and rest-point trees are built now rather than at the
+    // first contact, where they would stall a haptic loop.
+    PartCollider collider(part, kind, settings_.exactTest);
     const bool pointShell = settings_.rigidDeformable == RigidDeformableQuery::PointShell;
-    fields_.push_back(pointShell && !deformable(part) ? buildDistanceField(part) : nullptr);
-    if (pointShell && deformable(part)) colliders_.back().buildRestPointTree(part);
-    partSpheres_.push_back(colliders_.back().worldSphere(part));
-    refitted_.growTo(parts_.size());
-    broadPhase_.build(partSpheres_);  // the tree's shape changes with the set of parts
+    std::shared_ptr<const SignedDistanceField> field = pointShell && !deformable(part) ? buildDistanceField(part) : nullptr;
+    if (pointShell && deformable(part)) collider.buildRestPointTree(part);
+    std::vector<Sphere> spheres = partSpheres_;
+    spheres.push_back(collider.worldSphere(part));
+    Bvh<Sphere> tree;
+    tree.build(spheres);  // the tree's shape changes with the set of parts
+    const std::size_t n = parts_.size() + 1;
+    parts_.reserve(n);
+    colliders_.reserve(n);
+    fields_.reserve(n);
+    refitted_.growTo(n);
+    // Nothing below throws.
+    parts_.push_back(&part);
+    colliders_.push_back(std::move(collider));
+    fields_.push_back(std::move(field));
+    partSpheres_ = std::move(spheres);
+    broadPhase_ = std::move(tree);
 }
 
 void CollisionWorld::setExactTest(ExactTest test) {

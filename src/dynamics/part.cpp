@@ -51,6 +51,26 @@ Part::~Part() = default;
 Part::Part(Part&&) noexcept = default;
 Part& Part::operator=(Part&&) noexcept = default;
 
+// Everything but the k-ring walker, which is scratch: a copy gets its own.
+Part::Part(const Part& other)
+    : model_(other.model_),
+      settings_(other.settings_),
+      pose_(other.pose_),
+      state_(other.state_),
+      walker_(std::make_unique<KRingWalker>(other.model_->massCount())),
+      zones_(other.zones_),
+      nextZoneId_(other.nextZoneId_),
+      region_(other.region_),
+      lastLoadStep_(other.lastLoadStep_),
+      changed_(other.changed_),
+      allChanged_(other.allChanged_),
+      allMasses_(other.allMasses_) {}
+
+Part& Part::operator=(const Part& other) {
+    if (this != &other) *this = Part(other);
+    return *this;
+}
+
 void Part::setSettings(const PartSettings& settings) {
     if (settings.mode != settings_.mode) throw InputError("part settings", 0, "the mode of a part cannot change");
     validateSettings(settings.simulation);

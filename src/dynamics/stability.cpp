@@ -86,12 +86,12 @@ StabilityReport analyzeStability(const PartModel& model, const SimulationSetting
     report.possiblyUnstable = h > report.safeTimeStep;
     std::ostringstream text;
     if (report.certainlyUnstable) {
-        text << "time step " << h << " s diverges with " << toString(s.integrator) << ": the fastest mode (>= "
+        text << "time step " << h << " s diverges with " << labelOf(s.integrator) << ": the fastest mode (>= "
              << report.omegaLower << " rad/s) is unstable above " << report.unstableTimeStep << " s";
         if (report.unstableTimeStep == 0.0) text << " (explicit Euler always blows up without damping)";
         text << "; use a time step below " << report.safeTimeStep << " s";
     } else if (report.possiblyUnstable) {
-        text << "time step " << h << " s may be unstable with " << toString(s.integrator)
+        text << "time step " << h << " s may be unstable with " << labelOf(s.integrator)
              << ": stability is guaranteed below " << report.safeTimeStep << " s (modes up to " << report.omegaUpper
              << " rad/s)";
     }

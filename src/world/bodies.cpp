@@ -43,6 +43,13 @@ BodyId Bodies::add(std::unique_ptr<Part> part, const RigidBody& body) {
     return BodyId(parts.size() - 1);
 }
 
+void Bodies::reserve(std::size_t count) {
+    parts.reserve(count);
+    rigid.reserve(count);
+    kinematicTargets.reserve(count);
+    massAdr.reserve(count + 1);
+}
+
 double Bodies::minimumThickness() const {
     double thinnest = std::numeric_limits<double>::infinity();
     for (const RigidBody& b : rigid) thinnest = std::min(thinnest, b.thickness);

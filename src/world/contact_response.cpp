@@ -33,16 +33,11 @@ void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactRes
         const double shareA = da && db ? (ka + kb > 0 ? kb / (ka + kb) : 0.5) : (da ? 1.0 : 0.0);
         if (shareA > 0.0) pushFace(c.partA, c.faceA, kNoMass, (c.depth * shareA) * c.normal);
         if (shareA < 1.0) pushFace(c.partB, c.faceB, c.massB, (-c.depth * (1.0 - shareA)) * c.normal);
-        ++r.stats.contacts;
     }
 }
 
-void displacePushedMasses(Bodies& bodies, ContactResponse& r) {
-    for (const ContactResponse::Push& p : r.pushes) {
-        bodies.parts[p.body]->displaceMass(p.mass, p.displacement);
-        r.stats.maxDisplacement = std::max(r.stats.maxDisplacement, p.displacement.norm());
-    }
-    r.stats.displacedMasses = r.pushes.size();
+void displacePushedMasses(Bodies& bodies, const ContactResponse& r) {
+    for (const ContactResponse::Push& p : r.pushes) bodies.parts[p.body]->displaceMass(p.mass, p.displacement);
 }
 
 // Each (body, contacted mass) once, in first-contact order (deterministic); then each body
@@ -88,7 +83,6 @@ double effectiveContactStiffness(const Part& part, double timeStep) {
 }
 
 void respondToContacts(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response) {
-    response.stats = {};
     collectPushes(contacts, bodies, response);
     displacePushedMasses(bodies, response);
     applyDeformableReactions(contacts, bodies, response);

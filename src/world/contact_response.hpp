@@ -30,15 +30,8 @@ namespace flexfit::detail {
 // restoration's (k_a for anchors, c m / h^2 for the constraint at the world's step h).
 double effectiveContactStiffness(const Part& part, double timeStep);
 
-struct ResponseStats {
-    std::size_t contacts = 0;         // contacts that moved a deformable part
-    std::size_t displacedMasses = 0;
-    double maxDisplacement = 0.0;
-};
-
 struct ContactResponse {
     std::vector<double> stiffness;  // (nbody) effective contact stiffness
-    ResponseStats stats;            // of the last respondToContacts()
 
     // Scratch, over the world's masses (Bodies::worldMass): the deepest push of each mass, in
     // first-contact order, and the masses whose reaction a body feels.

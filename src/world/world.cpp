@@ -18,15 +18,6 @@ const std::string kSource = "world";
 
 }  // namespace
 
-void validateSettings(const WorldSettings& settings) {
-    if (!std::isfinite(settings.timeStep) || settings.timeStep <= 0.0) throw InputError(kSource, 0, "time step must be finite and > 0");
-    if (!settings.gravity.allFinite()) throw InputError(kSource, 0, "gravity must be finite");
-    if (!(settings.maxTravelFraction > 0.0 && settings.maxTravelFraction <= 1.0))
-        throw InputError(kSource, 0, "max travel fraction must be in (0, 1]");
-    if (settings.maxSubsteps < 1 || settings.contactIterations < 1)
-        throw InputError(kSource, 0, "max substeps and contact iterations must be >= 1");
-}
-
 World::World(WorldSettings settings) {
     validateSettings(settings);
     data_ = std::make_unique<detail::WorldData>(settings);
@@ -40,27 +31,46 @@ void World::checkBody(BodyId id, const char* what) const {
     if (id >= data_->bodies.size()) throw InputError(kSource, 0, std::string(what) + ": no body " + std::to_string(id));
 }
 
+void World::checkPose(const Pose& pose, const char* what) const {
+    if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite() || !(pose.rotation.norm() > 0.0))
+        throw InputError(kSource, 0, std::string(what) + ": the pose must be finite, with a non-zero rotation quaternion");
+}
+
 // --- Bodies ---
 
 BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& partSettings, const BodySettings& settings,
                   const Pose& pose) {
     detail::WorldData& d = *data_;
+    if (model == nullptr) throw InputError(kSource, 0, "add: no part model");
+    checkPose(pose, "add");
+    // Everything that can fail comes first; then the body is registered everywhere at once.
     const RigidBody body = makeRigidBody(*model, settings);
     auto part = std::make_unique<Part>(std::move(model), partSettings);
     part->setPose(pose);
     const double stiffness = detail::effectiveContactStiffness(*part, d.settings.timeStep);
-    const Part& view = *part;
-    const BodyId id = d.bodies.add(std::move(part), body);
-    d.collision.add(id, view, settings.boundingVolume);
+    const BodyId id = BodyId(d.bodies.size());
+    d.bodies.reserve(id + 1);
+    d.response.stiffness.reserve(id + 1);
+    d.collision.add(id, *part, settings.boundingVolume);  // strong: registers all or nothing
+    d.bodies.add(std::move(part), body);                   // no throw after the reserve
     d.response.stiffness.push_back(stiffness);
     return id;
 }
 
 std::size_t World::bodyCount() const { return data_->bodies.size(); }
-const Part& World::part(BodyId id) const { return *data_->bodies.parts.at(id); }
-const RigidBody& World::body(BodyId id) const { return data_->bodies.rigid.at(id); }
+const Part& World::part(BodyId id) const {
+    checkBody(id, "part");
+    return *data_->bodies.parts[id];
+}
+const RigidBody& World::body(BodyId id) const {
+    checkBody(id, "body");
+    return data_->bodies.rigid[id];
+}
 const WorldSettings& World::settings() const { return data_->settings; }
-Vec3 World::centreOfMass(BodyId id) const { return data_->bodies.centreOfMass(id); }
+Vec3 World::centreOfMass(BodyId id) const {
+    checkBody(id, "centre of mass");
+    return data_->bodies.centreOfMass(id);
+}
 
 void World::setPartSettings(BodyId id, const PartSettings& settings) {
     checkBody(id, "settings");
@@ -106,13 +116,17 @@ void World::setVelocity(BodyId id, const Vec3& linear, const Vec3& angular) {
 
 void World::setKinematicTarget(BodyId id, const Pose& target) {
     checkBody(id, "kinematic target");
+    checkPose(target, "kinematic target");
     if (data_->bodies.rigid[id].motion == MotionType::Kinematic) data_->bodies.kinematicTargets[id] = target;
 }
 
 // --- The operator ---
 
 void World::grab(BodyId id, const GrabSettings& settings) { detail::grab(id, settings, data_->settings.timeStep, data_->bodies, data_->op); }
-void World::setGrabTarget(const Pose& target) { data_->op.target = target; }
+void World::setGrabTarget(const Pose& target) {
+    checkPose(target, "grab target");
+    data_->op.target = target;
+}
 void World::release() { detail::release(data_->op); }
 std::optional<BodyId> World::grabbed() const { return data_->op.grabbed; }
 const Pose& World::grabTarget() const { return data_->op.target; }
@@ -142,7 +156,8 @@ void World::applyFaceForce(BodyId id, Index face, const Vec3& worldForce) {
 std::size_t World::addAssembly(const AssemblyRule& rule) { return detail::addRule(rule, data_->bodies.size(), data_->assembly); }
 const std::vector<AssemblyEvent>& World::assemblyEvents() const { return data_->assembly.events; }
 bool World::assembled(std::size_t rule) const {
-    return data_->assembly.rules.at(rule).phase == detail::RuleState::Phase::Assembled;
+    if (rule >= data_->assembly.rules.size()) throw InputError(kSource, 0, "assembled: no rule " + std::to_string(rule));
+    return data_->assembly.rules[rule].phase == detail::RuleState::Phase::Assembled;
 }
 
 // --- The step ---

@@ -1,6 +1,8 @@
 #!/usr/bin/python3
-"""Runs `flexfit run SCENE` and checks the profile in its summary.json: world_step_seconds is
-there, every stage is named, and the stages add up to the step (0.97 <= sum / total <= 1.0).
+"""Runs `flexfit run SCENE`, echoes its output, and checks the profile in its summary.json:
+world_step_seconds is there, every stage is named, and the stages add up to the step
+(0.97 <= sum / total <= 1.0; the profile partitions the step, so this fails only when a stage
+is missing from stage_seconds or the file is inconsistent).
 
 Usage: check_profile.py FLEXFIT SCENE OUT_DIR [--duration SECONDS]
 """
@@ -16,7 +18,9 @@ STAGES = ["operator_input", "rigid_motion", "broad_phase", "narrow_phase", "cont
 def main():
     flexfit, scene, out = sys.argv[1:4]
     extra = sys.argv[4:]
-    subprocess.run([flexfit, "run", scene, "--out", out, "--no-progress", *extra], check=True, stdout=subprocess.DEVNULL)
+    run = subprocess.run([flexfit, "run", scene, "--out", out, "--no-progress", *extra], check=True,
+                         stdout=subprocess.PIPE, text=True)
+    print(run.stdout, end="")
     summary = json.loads((pathlib.Path(out) / "summary.json").read_text())
     total = summary["world_step_seconds"]
     stages = summary["stage_seconds"]

@@ -349,3 +349,24 @@ TEST(Part, GoldenHashOfAFullDeformablePartInEveryKernel) {
         EXPECT_EQ(flexfit::testing::hex(stateHash(part.state())), "37242833896664d2") << detail::toString(kernel);
     }
 }
+
+TEST(Part, ACopyStepsOnItsOwnLikeTheOriginal) {
+    const auto model = buildPartModel(makeTorus1());
+    Part original(model, zoneSettings());
+    original.openZone(ZoneSeed::mass(30), 3);
+    for (int i = 0; i < 50; ++i) {
+        original.applyForce(30, Vec3(0.3, 0, 0));
+        original.step();
+    }
+    Part copy = original;
+    for (int i = 0; i < 200; ++i) {
+        original.applyForce(30, Vec3(0.3, 0, 0));
+        copy.applyForce(30, Vec3(0.3, 0, 0));
+        original.step();
+        copy.step();
+    }
+    EXPECT_EQ(stateHash(copy.state()), stateHash(original.state()));
+    EXPECT_EQ(copy.zoneIds(), original.zoneIds());
+    copy.openZone(ZoneSeed::mass(200), 2);  // the copy's zones are its own
+    EXPECT_EQ(copy.zoneCount(), original.zoneCount() + 1);
+}

@@ -119,7 +119,6 @@ TEST(ContactResponse, BothDeformablePartsShareThePenetrationByStiffness) {
     ASSERT_GT(moveB, 0.0);
     EXPECT_GT(moveA, moveB);  // the softer part gives way more
     EXPECT_NEAR(moveA / moveB, kb / ka, 0.35 * kb / ka);
-    EXPECT_EQ(s.response.stats.displacedMasses, s.response.pushes.size());
 }
 
 TEST(ContactResponse, EffectiveStiffnessIsTheMeanSpringPlusTheRestorations) {

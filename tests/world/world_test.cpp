@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 
 using namespace flexfit;
@@ -51,6 +52,34 @@ TEST(World, ProfilePartitionsEveryStepAmongTheStages) {
     }
     EXPECT_NEAR(sum, p.totalStepSeconds, 1e-9 * p.totalStepSeconds);
     EXPECT_LE(p.totalStepSeconds, outside);  // measured inside the calls that the clock here surrounds
+}
+
+TEST(World, NoWorkHappensOutsideTheProfiledInterval) {
+    // The stages partition the interval between the step's first and last clock readings, so
+    // they add up to lastStepSeconds by construction. What this checks independently: timed
+    // from outside, a step lasts that interval plus two clock readings and a call, never plus
+    // real work (the median over many steps, so a preemption cannot decide it). A dynamic ball
+    // in sub-steps presses a deformable rim: every stage has work.
+    World world;
+    PartSettings rim;
+    rim.zones.contactLevel = 3;
+    world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}}), rim, BodySettings{}, Pose{});
+    BodySettings heavy = dynamicBody(Vec3(0, -3, 0));
+    heavy.density = 0.01;
+    world.add(buildPartModel(makeIcoSphere(8.5, 2)), rigidPart(), heavy, at(Vec3(0, 4.8, 0)));  // 0.2 above the rim
+    std::vector<double> outsideMinusInside;
+    int inContact = 0;
+    for (int i = 0; i < 300; ++i) {
+        const auto start = std::chrono::steady_clock::now();
+        world.step();
+        const double outside = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        outsideMinusInside.push_back(outside - world.profile().lastStepSeconds);
+        inContact += !world.contacts().empty();
+    }
+    ASSERT_GT(inContact, 150);
+    std::nth_element(outsideMinusInside.begin(), outsideMinusInside.begin() + 150, outsideMinusInside.end());
+    EXPECT_GE(outsideMinusInside[150], 0.0);
+    EXPECT_LT(outsideMinusInside[150], 2e-6) << "work outside the stages";
 }
 
 TEST(World, DeterministicRun) {
@@ -168,7 +197,10 @@ TEST(World, CallsRefuseBodiesThatDoNotExist) {
     EXPECT_THROW(world.openZone(1, ZoneSeed::mass(0), 2), InputError);
     EXPECT_THROW(world.contactStiffness(1), InputError);
     EXPECT_THROW(world.applyMassForce(1, 0, Vec3::UnitX()), InputError);
-    EXPECT_THROW(world.part(1), std::out_of_range);
+    EXPECT_THROW(world.part(1), InputError);
+    EXPECT_THROW(world.body(1), InputError);
+    EXPECT_THROW(world.centreOfMass(1), InputError);
+    EXPECT_THROW(world.assembled(0), InputError);
     EXPECT_THROW(world.applyForce(0, Vec3(NAN, 0, 0)), InputError);  // and forces that are not finite
     EXPECT_THROW(world.setVelocity(0, Vec3(INFINITY, 0, 0), Vec3::Zero()), InputError);
     world.step();

@@ -1,6 +1,6 @@
-// The vocabulary (src/io/names.cpp): every table lists each value of its enum once under a
-// distinct name, every name reads back as its value, toString is the name, and the old
-// spellings read as their values with the new name to write.
+// The vocabulary (names.hpp, and the table beside each enum): every table lists each value of
+// its enum once under a distinct name, every name reads back as its value, toString is the
+// name, and the old spellings read as their values with the new name to write.
 #include "flexfit/flexfit.hpp"
 
 #include <gtest/gtest.h>
