@@ -26,14 +26,10 @@ namespace flexfit {
 enum class SnapTechnique { CollisionSnap, ProximitySnap, VectorSnap, ZoneSnap };
 // Its names (names.hpp).
 inline constexpr EnumName<SnapTechnique> kSnapTechniqueNames[] = {
-    {SnapTechnique::CollisionSnap, "collision", "collision snapping"},
-    {SnapTechnique::ProximitySnap, "proximity", "proximity snapping"},
-    {SnapTechnique::VectorSnap, "vector", "improved snap-fitting"},
-    {SnapTechnique::ZoneSnap, "zone", "zone snap-fitting"},
+    {SnapTechnique::CollisionSnap, "collision", "collision snapping"}, {SnapTechnique::ProximitySnap, "proximity", "proximity snapping"},
+    {SnapTechnique::VectorSnap, "vector", "improved snap-fitting"}, {SnapTechnique::ZoneSnap, "zone", "zone snap-fitting"},
 };
-template <>
-inline constexpr std::span<const EnumName<SnapTechnique>> kEnumNames<SnapTechnique> = kSnapTechniqueNames;
-inline const char* toString(SnapTechnique technique) { return nameOf(technique); }
+template <> inline constexpr std::span<const EnumName<SnapTechnique>> kEnumNames<SnapTechnique> = kSnapTechniqueNames;
 
 struct AssemblyVector {
     Vec3 origin = Vec3::Zero();  // part frame
@@ -54,9 +50,7 @@ inline constexpr EnumName<AssemblyArea::Shape> kAreaShapeNames[] = {
     {AssemblyArea::Shape::Sphere, "sphere", "sphere"},
     {AssemblyArea::Shape::Cylinder, "cylinder", "cylinder"},
 };
-template <>
-inline constexpr std::span<const EnumName<AssemblyArea::Shape>> kEnumNames<AssemblyArea::Shape> = kAreaShapeNames;
-inline const char* toString(AssemblyArea::Shape shape) { return nameOf(shape); }
+template <> inline constexpr std::span<const EnumName<AssemblyArea::Shape>> kEnumNames<AssemblyArea::Shape> = kAreaShapeNames;
 
 struct AssemblyRule {
     std::string name;

@@ -22,9 +22,7 @@ inline constexpr EnumName<MotionType> kMotionTypeNames[] = {
     {MotionType::Kinematic, "kinematic", "kinematic"},
     {MotionType::Dynamic, "dynamic", "dynamic"},
 };
-template <>
-inline constexpr std::span<const EnumName<MotionType>> kEnumNames<MotionType> = kMotionTypeNames;
-inline const char* toString(MotionType motion) { return nameOf(motion); }
+template <> inline constexpr std::span<const EnumName<MotionType>> kEnumNames<MotionType> = kMotionTypeNames;
 
 struct BodySettings {
     MotionType motion = MotionType::Static;

@@ -21,9 +21,7 @@ inline constexpr EnumName<BoundingVolumeKind> kBoundingVolumeKindNames[] = {
     {BoundingVolumeKind::Sphere, "sphere", "spheres"},
     {BoundingVolumeKind::Aabb, "aabb", "axis-aligned boxes"},
 };
-template <>
-inline constexpr std::span<const EnumName<BoundingVolumeKind>> kEnumNames<BoundingVolumeKind> = kBoundingVolumeKindNames;
-inline const char* toString(BoundingVolumeKind kind) { return nameOf(kind); }
+template <> inline constexpr std::span<const EnumName<BoundingVolumeKind>> kEnumNames<BoundingVolumeKind> = kBoundingVolumeKindNames;
 
 struct Sphere {
     Vec3 centre = Vec3::Zero();

@@ -35,9 +35,7 @@ inline constexpr EnumName<ExactTest> kExactTestNames[] = {
     {ExactTest::SphereTriangle, "sphere", "face sphere against triangle"},
     {ExactTest::TriangleTriangle, "triangle", "triangle against triangle"},
 };
-template <>
-inline constexpr std::span<const EnumName<ExactTest>> kEnumNames<ExactTest> = kExactTestNames;
-inline const char* toString(ExactTest test) { return nameOf(test); }
+template <> inline constexpr std::span<const EnumName<ExactTest>> kEnumNames<ExactTest> = kExactTestNames;
 
 inline constexpr Index kNoMass = std::numeric_limits<Index>::max();
 

@@ -36,9 +36,7 @@ inline constexpr EnumName<BroadPhaseUpdate> kBroadPhaseUpdateNames[] = {
     {BroadPhaseUpdate::Refit, "refit", "refit"},
     {BroadPhaseUpdate::Rebuild, "rebuild", "rebuild"},
 };
-template <>
-inline constexpr std::span<const EnumName<BroadPhaseUpdate>> kEnumNames<BroadPhaseUpdate> = kBroadPhaseUpdateNames;
-inline const char* toString(BroadPhaseUpdate update) { return nameOf(update); }
+template <> inline constexpr std::span<const EnumName<BroadPhaseUpdate>> kEnumNames<BroadPhaseUpdate> = kBroadPhaseUpdateNames;
 
 // How a rigid part and a deformable part are tested. Faces: the two face hierarchies, as for
 // every other pair. PointShell: the deformable part's masses against the rigid part's signed
@@ -53,9 +51,7 @@ inline constexpr EnumName<RigidDeformableQuery> kRigidDeformableQueryNames[] = {
     {RigidDeformableQuery::Faces, "faces", "face hierarchies"},
     {RigidDeformableQuery::PointShell, "point-shell", "point shell"},
 };
-template <>
-inline constexpr std::span<const EnumName<RigidDeformableQuery>> kEnumNames<RigidDeformableQuery> = kRigidDeformableQueryNames;
-inline const char* toString(RigidDeformableQuery query) { return nameOf(query); }
+template <> inline constexpr std::span<const EnumName<RigidDeformableQuery>> kEnumNames<RigidDeformableQuery> = kRigidDeformableQueryNames;
 
 struct CollisionSettings {
     ExactTest exactTest = ExactTest::TriangleTriangle;

@@ -8,7 +8,7 @@
 // caller can warn with the file and line.
 //
 // Each enum's header gives its table (kEnumNames<E>, and kDeprecatedNames<E> where old
-// spellings exist) and its toString, which returns the name.
+// spellings exist); toString(value) returns the name for every enum that has one.
 #pragma once
 
 #include <optional>
@@ -65,6 +65,13 @@ const char* nameOf(Enum value) {
 template <class Enum>
 const char* labelOf(Enum value) {
     return entryOf(value).label;
+}
+
+// The name of any value whose enum has a table.
+template <class Enum>
+    requires(!kEnumNames<Enum>.empty())
+const char* toString(Enum value) {
+    return nameOf(value);
 }
 
 // The value named `text`, or nullopt. For an old spelling, `replacement` (when given)

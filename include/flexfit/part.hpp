@@ -52,12 +52,9 @@ inline constexpr EnumName<PartMode> kPartModeNames[] = {
     {PartMode::RigidDeformable, "rigid-deformable", "rigid-deformable (zones)"},
     {PartMode::FullDeformable, "full-deformable", "full-deformable"},
 };
-template <>
-inline constexpr std::span<const EnumName<PartMode>> kEnumNames<PartMode> = kPartModeNames;
+template <> inline constexpr std::span<const EnumName<PartMode>> kEnumNames<PartMode> = kPartModeNames;
 inline constexpr DeprecatedName<PartMode> kPartModeOldNames[] = {{"zones", PartMode::RigidDeformable}, {"full", PartMode::FullDeformable}};
-template <>
-inline constexpr std::span<const DeprecatedName<PartMode>> kDeprecatedNames<PartMode> = kPartModeOldNames;
-inline const char* toString(PartMode mode) { return nameOf(mode); }
+template <> inline constexpr std::span<const DeprecatedName<PartMode>> kDeprecatedNames<PartMode> = kPartModeOldNames;
 
 struct ZoneSettings {
     int defaultLevel = 2;            // level of zones opened by forces

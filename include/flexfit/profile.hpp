@@ -28,18 +28,12 @@ enum class Stage {
 };
 // Its names (names.hpp).
 inline constexpr EnumName<Stage> kStageNames[] = {
-    {Stage::OperatorInput, "operator_input", "operator input"},
-    {Stage::RigidMotion, "rigid_motion", "rigid motion"},
-    {Stage::BroadPhase, "broad_phase", "broad phase"},
-    {Stage::NarrowPhase, "narrow_phase", "narrow phase"},
-    {Stage::ContactResponse, "contact_response", "contact response"},
-    {Stage::ZoneDynamics, "zone_dynamics", "zone dynamics"},
-    {Stage::ZoneRetirement, "zone_retirement", "zone retirement"},
-    {Stage::Assembly, "assembly", "assembly"},
+    {Stage::OperatorInput, "operator_input", "operator input"}, {Stage::RigidMotion, "rigid_motion", "rigid motion"},
+    {Stage::BroadPhase, "broad_phase", "broad phase"}, {Stage::NarrowPhase, "narrow_phase", "narrow phase"},
+    {Stage::ContactResponse, "contact_response", "contact response"}, {Stage::ZoneDynamics, "zone_dynamics", "zone dynamics"},
+    {Stage::ZoneRetirement, "zone_retirement", "zone retirement"}, {Stage::Assembly, "assembly", "assembly"},
 };
-template <>
-inline constexpr std::span<const EnumName<Stage>> kEnumNames<Stage> = kStageNames;
-inline const char* toString(Stage stage) { return nameOf(stage); }
+template <> inline constexpr std::span<const EnumName<Stage>> kEnumNames<Stage> = kStageNames;
 inline constexpr std::size_t kStageCount = std::size_t(Stage::Count);
 static_assert(std::size(kStageNames) == kStageCount, "every stage has a name");
 

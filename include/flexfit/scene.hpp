@@ -69,16 +69,11 @@ struct SceneAction {
 };
 // Its names (names.hpp).
 inline constexpr EnumName<SceneAction::Kind> kActionKindNames[] = {
-    {SceneAction::Kind::Grab, "grab", "grab"},
-    {SceneAction::Kind::Move, "move", "move"},
-    {SceneAction::Kind::Release, "release", "release"},
-    {SceneAction::Kind::Push, "push", "push"},
-    {SceneAction::Kind::Force, "force", "force"},
-    {SceneAction::Kind::Velocity, "velocity", "velocity"},
+    {SceneAction::Kind::Grab, "grab", "grab"}, {SceneAction::Kind::Move, "move", "move"},
+    {SceneAction::Kind::Release, "release", "release"}, {SceneAction::Kind::Push, "push", "push"},
+    {SceneAction::Kind::Force, "force", "force"}, {SceneAction::Kind::Velocity, "velocity", "velocity"},
 };
-template <>
-inline constexpr std::span<const EnumName<SceneAction::Kind>> kEnumNames<SceneAction::Kind> = kActionKindNames;
-inline const char* toString(SceneAction::Kind kind) { return nameOf(kind); }
+template <> inline constexpr std::span<const EnumName<SceneAction::Kind>> kEnumNames<SceneAction::Kind> = kActionKindNames;
 
 // Something the reader accepted but the user should change (an old spelling, for now).
 struct SceneWarning {

@@ -114,20 +114,15 @@ inline constexpr EnumName<Integrator> kIntegratorNames[] = {
     {Integrator::SemiImplicitEuler, "semi-implicit", "semi-implicit (symplectic) Euler"},
     {Integrator::ExplicitEuler, "explicit", "explicit Euler"},
 };
-template <>
-inline constexpr std::span<const EnumName<Integrator>> kEnumNames<Integrator> = kIntegratorNames;
-inline const char* toString(Integrator integrator) { return nameOf(integrator); }
+template <> inline constexpr std::span<const EnumName<Integrator>> kEnumNames<Integrator> = kIntegratorNames;
 // Its names (names.hpp).
 inline constexpr EnumName<RestorationMethod> kRestorationMethodNames[] = {
     {RestorationMethod::None, "none", "none"},
     {RestorationMethod::AnchorSprings, "anchors", "anchor springs"},
     {RestorationMethod::Constraint, "constraint", "restoration constraint"},
 };
-template <>
-inline constexpr std::span<const EnumName<RestorationMethod>> kEnumNames<RestorationMethod> = kRestorationMethodNames;
+template <> inline constexpr std::span<const EnumName<RestorationMethod>> kEnumNames<RestorationMethod> = kRestorationMethodNames;
 inline constexpr DeprecatedName<RestorationMethod> kRestorationMethodOldNames[] = {{"anchor", RestorationMethod::AnchorSprings}};
-template <>
-inline constexpr std::span<const DeprecatedName<RestorationMethod>> kDeprecatedNames<RestorationMethod> = kRestorationMethodOldNames;
-inline const char* toString(RestorationMethod method) { return nameOf(method); }
+template <> inline constexpr std::span<const DeprecatedName<RestorationMethod>> kDeprecatedNames<RestorationMethod> = kRestorationMethodOldNames;
 
 }  // namespace flexfit

@@ -2,6 +2,7 @@
 // for, one body's contacts against the whole narrow phase, and the hierarchies refitted only
 // when a query needs them, never by reading them.
 #include "flexfit/flexfit.hpp"
+#include "test_bodies.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,6 +11,7 @@
 #include <tuple>
 
 using namespace flexfit;
+using flexfit::testing::rigidPart;
 
 namespace {
 
@@ -19,12 +21,6 @@ std::set<ContactKey> keysOf(const std::vector<Contact>& contacts) {
     std::set<ContactKey> keys;
     for (const Contact& c : contacts) keys.insert({c.partA, c.partB, c.faceA, c.faceB});
     return keys;
-}
-
-PartSettings rigid() {
-    PartSettings s;
-    s.mode = PartMode::Rigid;
-    return s;
 }
 
 // Unit spheres scattered in a small box, registered in order; isRigid(i) picks each mode.
@@ -37,7 +33,7 @@ struct Heap {
         std::uniform_real_distribution<double> u(-1.6, 1.6);
         const auto model = buildPartModel(makeIcoSphere(1.0, 2));
         for (BodyId i = 0; i < count; ++i) {
-            parts.push_back(std::make_unique<Part>(model, isRigid(i) ? rigid() : PartSettings{}));
+            parts.push_back(std::make_unique<Part>(model, isRigid(i) ? rigidPart() : PartSettings{}));
             parts.back()->translate(Vec3(u(rng), u(rng), u(rng)));
             world.add(i, *parts.back());
         }
@@ -88,7 +84,7 @@ TEST(NarrowPhase, HierarchiesRefitWhenAQueryNeedsThemAndNotWhenRead) {
     // query refits nothing. (Reading a collider cannot refit it: collider() is const.)
     const auto torusModel = buildPartModel(makeTorus1());
     Part torus(torusModel);
-    Part probe(buildPartModel(makeIcoSphere(3.0, 3)), rigid());
+    Part probe(buildPartModel(makeIcoSphere(3.0, 3)), rigidPart());
     probe.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(12.0, 0.5, 0.0)});
     CollisionWorld world;
     world.add(0, probe);
@@ -122,7 +118,7 @@ TEST(NarrowPhase, PointShellPairsNeedNoRefit) {
     // mass by mass: its face hierarchy is never refitted.
     CollisionSettings settings;
     settings.rigidDeformable = RigidDeformableQuery::PointShell;
-    Part ball(buildPartModel(makeIcoSphere(3.0, 2)), rigid());
+    Part ball(buildPartModel(makeIcoSphere(3.0, 2)), rigidPart());
     ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(12.0, 0.5, 0.0)});
     Part torus(buildPartModel(makeTorus1()));
     CollisionWorld world(settings);

@@ -3,11 +3,13 @@
 // parts sharing a penetration by stiffness; the reaction a dynamic body feels; the rigid
 // projection against its analytic result.
 #include "flexfit/flexfit.hpp"
+#include "test_bodies.hpp"
 #include "world/contact_response.hpp"
 
 #include <gtest/gtest.h>
 
 using namespace flexfit;
+using flexfit::testing::rigidPart;
 using detail::Bodies;
 using detail::ContactResponse;
 
@@ -26,12 +28,6 @@ PartSettings deformableSettings() {
     s.simulation.restoration = {RestorationMethod::Constraint, 0.0, 0.0, 2e-3};
     s.zones.contactLevel = 3;
     s.zones.restSpeed = 1e-2;
-    return s;
-}
-
-PartSettings rigidSettings() {
-    PartSettings s;
-    s.mode = PartMode::Rigid;
     return s;
 }
 
@@ -66,7 +62,7 @@ struct Bench {
 TEST(ContactResponse, RigidTorusPressedIntoDeformableTorusAndWithdrawn) {
     const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}});
     Bench s;
-    const BodyId rigid = s.add(model, rigidSettings()), soft = s.add(model, deformableSettings());
+    const BodyId rigid = s.add(model, rigidPart()), soft = s.add(model, deformableSettings());
     // The rigid torus stands upright (axis z, its ring in the xy plane) beside the soft one and
     // moves along -x into its outer rim.
     s.part(rigid).setPose(Pose{Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX())), Vec3(25.5, 0, 0)});
@@ -143,7 +139,7 @@ TEST(ContactResponse, ADynamicBodyFeelsTheSpringsItDisplaced) {
     anchors.simulation.restoration = {RestorationMethod::AnchorSprings, 4.0, 0.5, 0.0};
     Bench s;
     const BodyId torus = s.add(torusModel, anchors);
-    const BodyId ball = s.add(buildPartModel(makeIcoSphere(2.0, 2)), rigidSettings(), MotionType::Dynamic);
+    const BodyId ball = s.add(buildPartModel(makeIcoSphere(2.0, 2)), rigidPart(), MotionType::Dynamic);
     s.part(ball).setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(10.0, 4.2, 0.0)});  // into the top of the tube
     ASSERT_FALSE(s.respond().empty());
     const Part& t = s.part(torus);
@@ -159,8 +155,8 @@ TEST(ContactResponse, RigidProjectionTakesTheBodyOutAlongTheCommonDirection) {
     // Gauss-Seidel moves the body 0.3 sqrt(2) up, not sideways, and removes the velocity into
     // the contacts.
     Bench s;
-    const BodyId floor = s.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidSettings());
-    const BodyId body = s.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidSettings(), MotionType::Dynamic);
+    const BodyId floor = s.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidPart());
+    const BodyId body = s.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidPart(), MotionType::Dynamic);
     s.bodies.rigid[body].linearVelocity = Vec3(0.5, -2.0, 0.0);
     const Vec3 n1 = Vec3(1, 1, 0).normalized(), n2 = Vec3(-1, 1, 0).normalized();
     std::vector<Contact> contacts(2);

@@ -2,7 +2,7 @@
 // torque-free rotation), its sub-steps against the no-tunnelling bound, and balls against the
 // container-mouth torus (outer diameter 25, inner 15): wider balls never pass, at any speed
 // reached in the experiments and the largest time step; narrower ones do.
-#include "ball_torus.hpp"
+#include "test_bodies.hpp"
 #include "flexfit/flexfit.hpp"
 
 #include <gtest/gtest.h>
