@@ -460,7 +460,7 @@ void App::drawPanels() {
 void App::applyLiveSettings() {
     World& w = session_->world();
     for (BodyId id = 0; id < w.bodyCount(); ++id) {
-        if (w.part(id).mode() == PartMode::Rigid) continue;
+        if (!w.part(id).deforms()) continue;
         PartSettings settings = w.part(id).settings();
         settings.simulation.restoration.method = restorationAt(restoration_);
         settings.zones.contactLevel = contactLevel_;

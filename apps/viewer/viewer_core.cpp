@@ -96,7 +96,7 @@ Camera initialCamera(const World& world, int width, int height) {
 }
 
 Vec3 partColour(const Part& part, MotionType motion) {
-    if (part.mode() != PartMode::Rigid) return {0.55, 0.66, 0.86};          // deformable: blue
+    if (part.deforms()) return {0.55, 0.66, 0.86};          // deformable: blue
     return motion == MotionType::Static ? Vec3(0.62, 0.62, 0.64) : Vec3(0.90, 0.58, 0.30);  // grey / orange
 }
 
@@ -165,21 +165,28 @@ std::vector<Vec3> SurfaceNormals::computeAll(const Part& part) {
     return n;
 }
 
+std::span<const Index> MovedMasses::update(const Part& part) {
+    const auto moving = part.movingMasses();
+    moved_.assign(moving.begin(), moving.end());
+    moved_.insert(moved_.end(), previous_.begin(), previous_.end());
+    previous_.assign(moving.begin(), moving.end());
+    return moved_;
+}
+
 SurfaceNormals::SurfaceNormals(const Part& part) : normals_(computeAll(part)), ring_(part.model().massCount()) {}
 
 bool SurfaceNormals::update(const Part& part) {
     recomputed_ = 0;
-    const auto moving = part.movingMasses();
-    if (moving.empty() && previouslyMoving_.empty()) return false;
+    const std::span<const Index> moved = moved_.update(part);
+    if (moved.empty()) return false;
     // A vertex's normal depends on its own position and its neighbours': the 1-ring of the
-    // masses that move or have just stopped, each vertex once.
+    // moved masses, each vertex once.
     const Topology& topology = part.model().topology;
     ring_.clear();
-    for (const std::span<const Index> seeds : {moving, std::span<const Index>(previouslyMoving_)})
-        for (Index seed : seeds) {
-            ring_.insert(seed);
-            for (Index n : topology.neighborsOf(seed)) ring_.insert(n);
-        }
+    for (Index seed : moved) {
+        ring_.insert(seed);
+        for (Index n : topology.neighborsOf(seed)) ring_.insert(n);
+    }
     const auto& faces = part.model().mesh.faces;
     for (Index mass : ring_) {
         Vec3 sum = Vec3::Zero();
@@ -187,22 +194,17 @@ bool SurfaceNormals::update(const Part& part) {
         normals_[mass] = sum.norm() > 0.0 ? Vec3(sum.normalized()) : Vec3(Vec3::UnitY());
     }
     recomputed_ = ring_.size();
-    previouslyMoving_.assign(moving.begin(), moving.end());
     return true;
 }
 
 // --- Hierarchies for drawing ---
 
 DisplayHierarchy::DisplayHierarchy(const Part& part, const PartCollider& like)
-    : collider_(part, like.kind(), like.exactTest()), previouslyMoving_(part.movingMasses().begin(), part.movingMasses().end()) {}
+    : collider_(part, like.kind(), like.exactTest()), moved_(part.movingMasses()) {}
 
 void DisplayHierarchy::update(const Part& part) {
-    const auto moving = part.movingMasses();
-    if (moving.empty() && previouslyMoving_.empty()) return;
-    changed_.assign(moving.begin(), moving.end());
-    changed_.insert(changed_.end(), previouslyMoving_.begin(), previouslyMoving_.end());
-    collider_.refit(part, changed_);
-    previouslyMoving_.assign(moving.begin(), moving.end());
+    const std::span<const Index> moved = moved_.update(part);
+    if (!moved.empty()) collider_.refit(part, moved);
 }
 
 // --- Session ---

@@ -78,6 +78,20 @@ std::optional<Pick> pick(const World& world, const Camera::Ray& ray);
 // Ray-triangle intersection (Moller-Trumbore): distance along the ray, nullopt when missed.
 std::optional<double> intersectRayTriangle(const Camera::Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c);
 
+// The masses of a part whose positions may have changed since the last update: those moving
+// now, and those that moved at the last update (they may have stopped and returned to rest).
+// What the viewer's incremental caches (normals, drawn hierarchies) recompute from.
+class MovedMasses {
+public:
+    explicit MovedMasses(std::span<const Index> movingAtStart = {}) : previous_(movingAtStart.begin(), movingAtStart.end()) {}
+    // The masses moving now or at the last update (each may appear twice); empty when none.
+    std::span<const Index> update(const Part& part);
+
+private:
+    std::vector<Index> previous_;
+    std::vector<Index> moved_;  // scratch
+};
+
 // Per-vertex normals of a part in its own frame (area-weighted face normals), kept up to
 // date incrementally: a rigid motion changes nothing (the renderer rotates them), and a
 // deformation recomputes only the moving masses, the masses that stopped since the last
@@ -94,8 +108,8 @@ public:
 
 private:
     std::vector<Vec3> normals_;
-    std::vector<Index> previouslyMoving_;
-    IndexSet ring_;  // (V) scratch: the moving and previously moving masses and their neighbours
+    MovedMasses moved_;
+    IndexSet ring_;  // (V) scratch: the moved masses and their neighbours
     std::size_t recomputed_ = 0;
 };
 
@@ -112,8 +126,7 @@ public:
 
 private:
     PartCollider collider_;
-    std::vector<Index> previouslyMoving_;
-    std::vector<Index> changed_;  // scratch
+    MovedMasses moved_;
 };
 
 class Session {

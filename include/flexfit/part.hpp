@@ -98,6 +98,7 @@ public:
     const PartModel& model() const { return *model_; }
     const std::shared_ptr<const PartModel>& sharedModel() const { return model_; }
     PartMode mode() const { return settings_.mode; }
+    bool deforms() const { return settings_.mode != PartMode::Rigid; }
     const PartSettings& settings() const { return settings_; }
     // Live changes (restoration method and constants, damping, zone levels and thresholds):
     // the next step uses them; open zones keep their level. The mode cannot change (throws

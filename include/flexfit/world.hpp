@@ -151,7 +151,6 @@ public:
 
 private:
     void checkBody(BodyId id, const char* what) const;
-    void checkPose(const Pose& pose, const char* what) const;
     std::unique_ptr<detail::WorldData> data_;
 };
 

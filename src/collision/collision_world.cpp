@@ -8,7 +8,6 @@
 namespace flexfit {
 namespace {
 
-bool deformable(const Part& p) { return p.mode() != PartMode::Rigid; }
 
 // nullptr for a mesh with no inside (open, inconsistently oriented, inside out): the face
 // query, which needs none, serves it.
@@ -33,8 +32,8 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     // first contact, where they would stall a haptic loop.
     PartCollider collider(part, kind, settings_.exactTest);
     const bool pointShell = settings_.rigidDeformable == RigidDeformableQuery::PointShell;
-    std::shared_ptr<const SignedDistanceField> field = pointShell && !deformable(part) ? buildDistanceField(part) : nullptr;
-    if (pointShell && deformable(part)) collider.buildRestPointTree(part);
+    std::shared_ptr<const SignedDistanceField> field = pointShell && !part.deforms() ? buildDistanceField(part) : nullptr;
+    if (pointShell && part.deforms()) collider.buildRestPointTree(part);
     std::vector<Sphere> spheres = partSpheres_;
     spheres.push_back(collider.worldSphere(part));
     Bvh<Sphere> tree;
@@ -63,7 +62,7 @@ void CollisionWorld::setExactTest(ExactTest test) {
 }
 
 bool CollisionWorld::pressesFirst(BodyId a, BodyId b) const {
-    const bool da = deformable(*parts_[a]), db = deformable(*parts_[b]);
+    const bool da = parts_[a]->deforms(), db = parts_[b]->deforms();
     return da == db ? a < b : !da;
 }
 

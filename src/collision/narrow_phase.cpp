@@ -5,12 +5,6 @@
 #include <algorithm>
 
 namespace flexfit {
-namespace {
-
-bool deformable(const Part& p) { return p.mode() != PartMode::Rigid; }
-
-}  // namespace
-
 const std::vector<Contact>& CollisionWorld::narrowPhase() {
     refitted_.clear();
     contacts_.clear();
@@ -35,7 +29,7 @@ const std::vector<Contact>& CollisionWorld::contactsOf(BodyId id, bool rigidPart
     // Other bodies in ascending id: the same pairs, in the same order, as the broad phase gives.
     for (BodyId other = 0; other < parts_.size(); ++other) {
         if (other == id || !overlap(partSpheres_[id], partSpheres_[other], identity)) continue;
-        if (rigidPartnersOnly && deformable(*parts_[other])) continue;
+        if (rigidPartnersOnly && parts_[other]->deforms()) continue;
         BodyId a = std::min(id, other), b = std::max(id, other);
         if (!pressesFirst(a, b)) std::swap(a, b);
         QueryStats ignored;
@@ -46,7 +40,7 @@ const std::vector<Contact>& CollisionWorld::contactsOf(BodyId id, bool rigidPart
 
 void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats) {
     // A field exists only for a rigid part under the point-shell setting.
-    if (const SignedDistanceField* field = fields_[a].get(); field != nullptr && deformable(*parts_[b]))
+    if (const SignedDistanceField* field = fields_[a].get(); field != nullptr && parts_[b]->deforms())
         return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(), out, stats);
     refitChanged(a);
     refitChanged(b);

@@ -7,7 +7,6 @@
 
 namespace flexfit {
 
-
 bool AssemblyArea::contains(const Vec3& pointInPart) const {
     const Vec3 p = frame.applyInverse(pointInPart);
     switch (shape) {

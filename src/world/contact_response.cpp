@@ -7,7 +7,6 @@
 namespace flexfit::detail {
 namespace {
 
-bool deformable(const Part& p) { return p.mode() != PartMode::Rigid; }
 
 // Zones at the contacted faces and each mass's deepest push, in first-contact order.
 void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& r) {
@@ -27,7 +26,7 @@ void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactRes
         }
     };
     for (const Contact& c : contacts) {
-        const bool da = deformable(*bodies.parts[c.partA]), db = deformable(*bodies.parts[c.partB]);
+        const bool da = bodies.parts[c.partA]->deforms(), db = bodies.parts[c.partB]->deforms();
         if (!da && !db) continue;
         const double ka = r.stiffness[c.partA], kb = r.stiffness[c.partB];
         const double shareA = da && db ? (ka + kb > 0 ? kb / (ka + kb) : 0.5) : (da ? 1.0 : 0.0);
@@ -50,7 +49,7 @@ void applyDeformableReactions(std::span<const Contact> contacts, Bodies& bodies,
     for (const Contact& c : contacts)
         for (const auto& [body, part, face, mass] :
              {std::tuple{c.partA, c.partB, c.faceB, c.massB}, std::tuple{c.partB, c.partA, c.faceA, kNoMass}}) {
-            if (bodies.rigid[body].motion != MotionType::Dynamic || !deformable(*bodies.parts[part])) continue;
+            if (bodies.rigid[body].motion != MotionType::Dynamic || !bodies.parts[part]->deforms()) continue;
             // Contacts come grouped by pair, so a mass pressed by two bodies counts once for each.
             for (Index m : pressedMasses(bodies.parts[part]->model().mesh.faces[face], mass)) {
                 const Index key = bodies.worldMass(part, m);
@@ -93,7 +92,7 @@ double projectRigidContacts(BodyId id, std::span<const Contact> contacts, Bodies
     r.projections.clear();
     for (const Contact& c : contacts) {
         const BodyId other = c.partA == id ? c.partB : c.partA;
-        if (deformable(*bodies.parts[other])) continue;
+        if (bodies.parts[other]->deforms()) continue;
         r.projections.emplace_back(c.partA == id ? c.normal : Vec3(-c.normal), c.depth);
     }
     if (r.projections.empty()) return -1.0;

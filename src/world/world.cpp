@@ -16,6 +16,11 @@ namespace {
 
 const std::string kSource = "world";
 
+void checkPose(const Pose& pose, const char* what) {
+    if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite() || !(pose.rotation.norm() > 0.0))
+        throw InputError(kSource, 0, std::string(what) + ": the pose must be finite, with a non-zero rotation quaternion");
+}
+
 }  // namespace
 
 World::World(WorldSettings settings) {
@@ -29,11 +34,6 @@ World& World::operator=(World&&) noexcept = default;
 
 void World::checkBody(BodyId id, const char* what) const {
     if (id >= data_->bodies.size()) throw InputError(kSource, 0, std::string(what) + ": no body " + std::to_string(id));
-}
-
-void World::checkPose(const Pose& pose, const char* what) const {
-    if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite() || !(pose.rotation.norm() > 0.0))
-        throw InputError(kSource, 0, std::string(what) + ": the pose must be finite, with a non-zero rotation quaternion");
 }
 
 // --- Bodies ---
@@ -137,7 +137,7 @@ void World::applyMassForce(BodyId id, Index mass, const Vec3& worldForce) {
     Part& part = *data_->bodies.parts[id];
     if (mass >= part.model().massCount())
         throw InputError(kSource, 0, "force: mass " + std::to_string(mass) + " out of range for body " + std::to_string(id));
-    if (part.mode() != PartMode::Rigid)
+    if (part.deforms())
         part.applyForce(mass, worldForce);
     else
         applyForceAt(id, worldForce, part.worldPosition(mass));
