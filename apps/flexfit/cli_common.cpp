@@ -107,6 +107,33 @@ void makeDirectory(const std::filesystem::path& dir) {
     if (ec || !std::filesystem::is_directory(dir)) throw InputError(dir.string(), 0, "cannot create the directory: " + ec.message());
 }
 
+PendingFiles::~PendingFiles() {
+    for (const File& f : files_) {
+        std::error_code ec;
+        std::filesystem::remove(f.temporary, ec);  // best effort: nothing to report it to
+    }
+}
+
+std::filesystem::path PendingFiles::add(const std::filesystem::path& path) {
+    std::error_code ec;
+    const std::filesystem::file_status status = std::filesystem::status(path, ec);
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) return path;  // /dev/stdout, a pipe
+    std::filesystem::path temporary = path;
+    temporary += ".partial";
+    files_.push_back({temporary, path});
+    return temporary;
+}
+
+void PendingFiles::commit() {
+    while (!files_.empty()) {
+        const File& f = files_.front();
+        std::error_code ec;
+        std::filesystem::rename(f.temporary, f.path, ec);
+        if (ec) throw InputError(f.path.string(), 0, "cannot move the finished file into place: " + ec.message());
+        files_.erase(files_.begin());
+    }
+}
+
 bool runPlotScript(const std::string& script, const std::vector<std::string>& args) {
     const char* python = "/usr/bin/python3";
     if (!std::filesystem::exists(python)) {

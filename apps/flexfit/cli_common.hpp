@@ -57,6 +57,30 @@ void writePartsObj(const std::filesystem::path& path, const std::string& header,
 // Creates the directory (and parents); throws InputError when it cannot.
 void makeDirectory(const std::filesystem::path& dir);
 
+// The files of one run, all or none: each is written under a temporary name beside it
+// (`<path>.partial`), commit() renames them all once the run has finished, and the destructor
+// removes whatever was not committed. So a run that fails (a divergence, a write error) leaves
+// no half-written output; files of an earlier run under the same names stay until commit().
+class PendingFiles {
+public:
+    PendingFiles() = default;
+    PendingFiles(const PendingFiles&) = delete;
+    PendingFiles& operator=(const PendingFiles&) = delete;
+    ~PendingFiles();
+    // The temporary path to write `path` to (`path` itself when it exists and is not a regular
+    // file: a device or a pipe, which cannot be replaced).
+    std::filesystem::path add(const std::filesystem::path& path);
+    // Renames every temporary to its path (close streams first); throws InputError when one
+    // cannot be renamed (the rest are then removed).
+    void commit();
+
+private:
+    struct File {
+        std::filesystem::path temporary, path;
+    };
+    std::vector<File> files_;
+};
+
 // Runs tools/<script> with Debian's /usr/bin/python3 (matplotlib); returns false (after a
 // warning) when Python or matplotlib is missing, so the CSV results still stand.
 bool runPlotScript(const std::string& script, const std::vector<std::string>& args);

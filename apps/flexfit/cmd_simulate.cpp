@@ -29,11 +29,12 @@ struct SimulateOptions {
     int defaultLevel = 2;
 };
 
-// Writes the deformed mesh whenever the simulation crosses one of the requested times.
+// Writes the deformed mesh whenever the simulation crosses one of the requested times (as a
+// pending file: moved into place when the run has finished).
 class ObjFrames {
 public:
-    ObjFrames(const PartModel& model, std::vector<double> times, std::string prefix)
-        : model_(model), times_(std::move(times)), prefix_(std::move(prefix)) {
+    ObjFrames(const PartModel& model, std::vector<double> times, std::string prefix, PendingFiles& files)
+        : model_(model), times_(std::move(times)), prefix_(std::move(prefix)), files_(files) {
         std::sort(times_.begin(), times_.end());
     }
     void observe(const Part& part) {
@@ -41,16 +42,22 @@ public:
             TriMesh mesh = model_.mesh;
             part.worldPositions(mesh.vertices);
             const std::string path = fmt::format("{}_{:.4f}.obj", prefix_, times_[next_]);
-            writeObj(mesh, path);
-            fmt::print("wrote {} (t = {:.4f} s)\n", path, part.time());
+            writeObj(mesh, files_.add(path));
+            written_.push_back(fmt::format("wrote {} (t = {:.4f} s)", path, part.time()));
             ++next_;
         }
+    }
+    // What was written, once it is in place.
+    void report() const {
+        for (const std::string& line : written_) fmt::print("{}\n", line);
     }
 
 private:
     const PartModel& model_;
     std::vector<double> times_;
     std::string prefix_;
+    PendingFiles& files_;
+    std::vector<std::string> written_;
     std::size_t next_ = 0;
 };
 
@@ -69,15 +76,18 @@ void run(const SimulateOptions& opt) {
     config.stopWhenRestored = opt.untilRestored;
     config.thresholds = opt.thresholds;
 
+    // The CSV and the frames are written under temporary names and moved into place at the end:
+    // a run that diverges (DivergenceError) or fails leaves none of them half-written.
+    PendingFiles files;
     std::ofstream csv;
     if (!opt.csv.empty()) {
-        csv.open(opt.csv);
+        csv.open(files.add(opt.csv));
         if (!csv) throw InputError(opt.csv, 0, "cannot open the file for writing");
         csv << "step,time";
         for (double t : opt.thresholds) csv << ",active_" << t;
         csv << ",kinetic_energy,max_displacement,moving_masses,computed_springs,zones\n";
     }
-    ObjFrames frames(*config.model, opt.objTimes, opt.objPrefix);
+    ObjFrames frames(*config.model, opt.objTimes, opt.objPrefix, files);
     const PartModel& model = *config.model;
     auto observer = [&](const Part& part, const std::vector<ActivityTracker>& trackers) {
         const PartState& state = part.state();
@@ -96,6 +106,12 @@ void run(const SimulateOptions& opt) {
     ProgressBar bar("simulate");
     const PerturbationResult result = runPerturbation(config, observer, [&](double f) { bar.update(f); });
     bar.finish();
+    if (csv.is_open()) {
+        csv.close();
+        if (!csv) throw InputError(opt.csv, 0, "write failed");
+    }
+    files.commit();
+    frames.report();
 
     const SimulationSettings& s = config.part.simulation;
     fmt::print("{}: {} masses, {} springs, mode {}, {} steps of {} s ({}, restore {}), {:.0f} steps/s\n", model.name,

@@ -1,6 +1,7 @@
 // The `flexfit` command's subcommands. Each registers its options on the CLI11 app and runs
 // through a callback; errors in user input surface as flexfit::InputError and are printed by
-// main() with the file, line and problem.
+// main() with the file, line and problem, and a simulation that diverged as
+// flexfit::DivergenceError (the body, the time, the likely cause): both exit with status 2.
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -28,6 +28,9 @@ int main(int argc, char** argv) {
     } catch (const flexfit::InputError& e) {
         fmt::print(stderr, "error: {}\n", e.what());
         return 2;
+    } catch (const flexfit::DivergenceError& e) {  // the run wrote nothing (PendingFiles)
+        fmt::print(stderr, "error: {}\n", e.what());
+        return 2;
     } catch (const std::exception& e) {
         fmt::print(stderr, "error: {}\n", e.what());
         return 1;

@@ -9,7 +9,12 @@ namespace flexfit::cli {
 ProgressBar::ProgressBar(std::string label, bool enabled)
     : label_(std::move(label)), enabled_(enabled && isatty(STDERR_FILENO) != 0) {}
 
-ProgressBar::~ProgressBar() { finish(); }
+// Left unfinished (an error stopped the run): end the line where the bar stands, not at 100%.
+ProgressBar::~ProgressBar() {
+    if (!enabled_ || finished_) return;
+    std::fprintf(stderr, "\n");
+    finished_ = true;
+}
 
 void ProgressBar::update(double fraction) {
     if (!enabled_ || finished_) return;

@@ -100,11 +100,15 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     World& w = run.world();
     const double duration = options.duration.value_or(scene.duration);
     const auto steps = std::uint64_t(std::llround(duration / scene.world.timeStep));
+    // Everything is written under temporary names and moved into place at the end: a run that
+    // fails (a divergence, World::step) leaves no half-written CSV, frames or summary.
+    PendingFiles files;
     std::ofstream csv;
+    const std::filesystem::path csvPath = options.out / "metrics.csv";
     if (!options.out.empty()) {
         makeDirectory(options.out);
-        csv.open(options.out / "metrics.csv");
-        if (!csv) throw InputError((options.out / "metrics.csv").string(), 0, "cannot write");
+        csv.open(files.add(csvPath));
+        if (!csv) throw InputError(csvPath.string(), 0, "cannot write");
         csv << csvHeader(scene);
     }
     RunSummary s;
@@ -132,7 +136,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         if (w.coupling().active) s.maxCouplingForce = std::max(s.maxCouplingForce, w.coupling().force.norm());
         if (csv.is_open() && (i + 1) % std::uint64_t(std::max(1, options.csvEvery)) == 0) csv << csvRow(scene, w);
         if (objStride && !options.out.empty() && (i + 1) % objStride == 0)
-            writeObjFrame(options.out / fmt::format("frame_{:06d}.obj", i + 1), w, scene);
+            writeObjFrame(files.add(options.out / fmt::format("frame_{:06d}.obj", i + 1)), w, scene);
         bar.update(double(i + 1) / double(steps));
     }
     bar.finish();
@@ -143,7 +147,12 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     s.events = w.assemblyEvents();
     s.stateHash = w.stateHash();
     for (BodyId id = 0; id < w.bodyCount(); ++id) s.finalCentres.push_back(w.centreOfMass(id));
-    if (!options.out.empty()) writeTextFile(options.out / "summary.json", summaryJson(scene, s));
+    if (!options.out.empty()) {
+        writeTextFile(files.add(options.out / "summary.json"), summaryJson(scene, s));
+        csv.close();
+        if (!csv) throw InputError(csvPath.string(), 0, "write failed");
+        files.commit();
+    }
     return s;
 }
 

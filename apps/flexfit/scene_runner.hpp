@@ -35,6 +35,8 @@ struct RunSummary {
     std::vector<Vec3> finalCentres;       // per body
 };
 
+// Throws DivergenceError (World::step) when the scene diverges; its files are written under
+// temporary names and moved into place only when the run ends, so a failed run leaves none.
 RunSummary runScene(const Scene& scene, const RunOptions& options);
 
 // The summary as JSON (what run writes to summary.json).

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -36,6 +37,29 @@ public:
 private:
     std::string source_;
     std::size_t line_;
+    std::string problem_;
+};
+
+// A simulation that diverged: a position, velocity or force of a body or of a part's mass is
+// no longer finite. Names the body (its id in a world, with its name when a scene gives one;
+// "part" for a part stepped alone), the simulated time at the start of the failing step, and
+// the problem: what went non-finite and its likely cause (a time step above the material's
+// stability bound, or a force beyond what the model can take). Thrown by World::step(),
+// Part::step() and stepFullModel() at the end of the failing step: the world or part then
+// holds that step's non-finite state and must not be stepped again.
+class DivergenceError : public std::runtime_error {
+public:
+    DivergenceError(std::optional<BodyId> body, double time, const std::string& problem, std::string name = {});
+
+    std::optional<BodyId> body() const { return body_; }  // none for a part stepped alone
+    const std::string& name() const { return name_; }      // the body's name, when known
+    double time() const { return time_; }                  // s, at the start of the failing step
+    const std::string& problem() const { return problem_; }
+
+private:
+    std::optional<BodyId> body_;
+    std::string name_;
+    double time_;
     std::string problem_;
 };
 

@@ -143,10 +143,13 @@ public:
 
     // --- Step ---
     // One step alone: advance() with the settings' time step and gravity, then
-    // retireRestingZones().
+    // retireRestingZones(). Throws DivergenceError (core.hpp: "part", the time at the start of
+    // the step) when a moving mass's position, velocity or force is no longer finite; the check
+    // costs O(moving masses).
     void step(StepCounters* counters = nullptr);
     // The moving masses by one step of context.timeStep, under context.gravity (world frame);
-    // O(1) when nothing moves.
+    // O(1) when nothing moves. Checks nothing but what stepFullModel checks (a world checks its
+    // parts after its whole step, world.hpp).
     void advance(const StepContext& context, StepCounters* counters = nullptr);
     // Every retireCheckInterval steps: retires the zones at rest (see Lifecycle above).
     void retireRestingZones();

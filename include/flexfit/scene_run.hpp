@@ -17,7 +17,8 @@ public:
     World& world() { return *world_; }
     const World& world() const { return *world_; }
     const Scene& scene() const { return scene_; }
-    // Applies the actions due in this step, then steps the world.
+    // Applies the actions due in this step, then steps the world. A DivergenceError from the
+    // world (world.hpp) comes out with the diverging part's name.
     void step();
     bool finished() const;
     // Operator actions that the scene did not script (the viewer's mouse) go to world() directly.

@@ -134,6 +134,12 @@ public:
     const std::vector<AssemblyEvent>& assemblyEvents() const;
     bool assembled(std::size_t rule) const;
 
+    // One step of the stages above. Divergence is an error, never silent garbage: when a body's
+    // pose, velocity, force or torque, or a moving mass of a part, is no longer finite at the
+    // end of the step, throws DivergenceError (core.hpp) naming the body, the time at the start
+    // of the step and the likely cause (the part's time step above its stability bound, or a
+    // force beyond what the model can take). The check costs O(bodies + moving masses); the
+    // world then holds the non-finite state and must not be stepped again.
     void step();
     double time() const;
     std::uint64_t stepCount() const;

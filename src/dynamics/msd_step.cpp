@@ -1,6 +1,7 @@
 // One step of the full mass-spring-damper model: by spring blocks when the model has them
 // (block_step.cpp), else a single sweep over the masses.
 #include "flexfit/simulation.hpp"
+#include "divergence.hpp"
 #include "flush_denormals.hpp"
 #include "full_step.hpp"
 
@@ -63,6 +64,7 @@ void validateSettings(const SimulationSettings& s) {
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
                    PartState& state, StepCounters* counters) {
     const detail::FlushDenormals flush;
+    const double start = state.time;
     for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
     const detail::MassUpdate update = detail::MassUpdate::from(settings);
     if (!model.hasSpringBlocks())
@@ -75,6 +77,7 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings, s
         counters->springsEvaluated += model.springCount();
         counters->massesIntegrated += model.massCount();
     }
+    detail::checkAllMassesFinite(model, settings, state, std::nullopt, start);  // every mass was touched anyway
 }
 
 double totalEnergy(const PartModel& model, const SimulationSettings& settings, const PartState& state) {

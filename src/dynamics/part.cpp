@@ -1,5 +1,6 @@
 #include "flexfit/part.hpp"
 
+#include "divergence.hpp"
 #include "model/kring.hpp"
 
 #include <algorithm>
@@ -221,7 +222,11 @@ void Part::applyForce(Index mass, const Vec3& worldForce) {
 // --- Step ---
 
 void Part::step(StepCounters* counters) {
+    const double start = state_.time;
+    // The full step checks every mass itself (stepFullModel); the region step's are checked here.
+    const bool fullStep = region_.coversEveryMass() && settings_.zones.fullSweepWhenComplete;
     advance({settings_.simulation.timeStep, settings_.simulation.gravity}, counters);
+    if (!fullStep) detail::checkMassesFinite(*model_, settings_.simulation, state_, movingMasses(), std::nullopt, start);
     retireRestingZones();
 }
 

@@ -22,7 +22,12 @@ void SceneRun::step() {
         const double end = it->first.time + it->first.duration;
         it = t + 1.5 * h > end ? running_.erase(it) : it + 1;
     }
-    world_->step();
+    try {
+        world_->step();
+    } catch (const DivergenceError& e) {  // the world knows ids; the scene knows names
+        if (!e.body() || *e.body() >= scene_.parts.size()) throw;
+        throw DivergenceError(e.body(), e.time(), e.problem(), scene_.parts[*e.body()].name);
+    }
 }
 
 void SceneRun::start(const SceneAction& a) {

@@ -3,6 +3,7 @@
 #include "flexfit/world.hpp"
 
 #include "core/fnv1a.hpp"
+#include "divergence_check.hpp"
 #include "rigid_motion.hpp"
 #include "step_profiler.hpp"
 #include "world_data.hpp"
@@ -182,6 +183,7 @@ void World::step() {
     detail::retireZones(d.bodies);                                 // zones at rest back to rest
     profiler.enter(Stage::Assembly);
     detail::assemble(step, contacts, d.assembly, d.bodies, d.op);  // snapping rules
+    detail::checkFinite(step, d.bodies);                           // divergence (charged to assembly)
     profiler.finish();
     d.time += d.settings.timeStep;
     ++d.stepIndex;

@@ -6,7 +6,13 @@ namespace flexfit::detail {
 void advanceZones(const StepContext& step, Bodies& bodies) {
     StepContext zones = step;
     zones.gravity = Vec3::Zero();
-    for (auto& part : bodies.parts) part->advance(zones);
+    for (BodyId id = 0; id < bodies.size(); ++id) {
+        try {
+            bodies.parts[id]->advance(zones);
+        } catch (const DivergenceError& e) {  // from the full step, which knows no body: name it
+            throw DivergenceError(id, step.time, e.problem());
+        }
+    }
 }
 
 }  // namespace flexfit::detail

@@ -11,7 +11,7 @@ import pathlib
 import subprocess
 import sys
 
-STAGES = ["operator_input", "rigid_motion", "broad_phase", "narrow_phase", "contact_response",
+STAGES = ["operator_input", "rigid_motion", "contact_solver", "broad_phase", "narrow_phase", "contact_response",
           "zone_dynamics", "zone_retirement", "assembly"]
 
 

@@ -1,4 +1,10 @@
 # Runs EXE with ARGS (a ;-list) and checks: exit status 2, stderr matching REGEX, nothing on stdout.
+# With EMPTY_DIR: that directory is emptied first and must hold no file afterwards (a run that
+# fails writes nothing half-done).
+if(DEFINED EMPTY_DIR)
+  file(REMOVE_RECURSE ${EMPTY_DIR})
+  file(MAKE_DIRECTORY ${EMPTY_DIR})
+endif()
 execute_process(COMMAND ${EXE} ${ARGS} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT status EQUAL 2)
   message(FATAL_ERROR "expected exit status 2, got '${status}'\nstdout: ${out}\nstderr: ${err}")
@@ -8,4 +14,10 @@ if(NOT err MATCHES "${REGEX}")
 endif()
 if(NOT out STREQUAL "")
   message(FATAL_ERROR "expected no output on stdout, got:\n${out}")
+endif()
+if(DEFINED EMPTY_DIR)
+  file(GLOB_RECURSE left ${EMPTY_DIR}/*)
+  if(left)
+    message(FATAL_ERROR "expected no file in ${EMPTY_DIR}, found: ${left}")
+  endif()
 endif()

@@ -8,7 +8,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <random>
+#include <sstream>
 
 using namespace flexfit;
 
@@ -243,6 +245,72 @@ TEST(MsdStep, SettingsValidation) {
     s = {};
     s.gravity = Vec3(0, INFINITY, 0);
     EXPECT_THROW(validateSettings(s), InputError);
+}
+
+// --- Divergence is an error (DivergenceError) ---
+
+namespace {
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Steps under `load` until the step throws (at most `steps`); returns the error and the time
+// at the start of the step that threw.
+std::pair<std::optional<DivergenceError>, double> stepUntilDivergence(const PartModel& model, const SimulationSettings& settings,
+                                                                      const PointLoad& load, int steps) {
+    PartState state = PartState::atRest(model);
+    for (int step = 0; step < steps; ++step) {
+        const double start = state.time;
+        try {
+            stepFullModel(model, settings, std::span(&load, 1), state);
+        } catch (const DivergenceError& e) {
+            return {e, start};
+        }
+    }
+    return {std::nullopt, state.time};
+}
+
+}  // namespace
+
+TEST(MsdStep, AHugeForceDivergesAndThrowsNamingThePartTheTimeAndTheCause) {
+    // Both paths of the full step: spring blocks (torus1) and the per-mass sweep (shuffled).
+    const auto blocks = buildPartModel(makeTorus1());
+    const auto sweep = buildPartModel(flexfit::testing::shuffledVertices(makeTorus1(), 3));
+    ASSERT_TRUE(blocks->hasSpringBlocks());
+    ASSERT_FALSE(sweep->hasSpringBlocks());
+    for (const auto& model : {blocks, sweep}) {
+        const auto [error, start] = stepUntilDivergence(*model, plain(1e-3), {0, Vec3(1e300, 0, 0)}, 10);
+        ASSERT_TRUE(error) << "a force of 1e300 did not diverge";
+        EXPECT_FALSE(error->body());
+        EXPECT_EQ(error->time(), start);
+        EXPECT_GT(start, 0.0);  // the first step is still finite (|x| ~ 1e294); its springs overflow next
+        const std::string what = error->what();
+        EXPECT_TRUE(contains(what, "part diverged at t = ")) << what;
+        EXPECT_TRUE(contains(what, " of mass ")) << what;
+        EXPECT_TRUE(contains(what, "is not finite")) << what;
+        EXPECT_TRUE(contains(what, "likely cause: a force beyond what the model can take")) << what;
+    }
+}
+
+TEST(MsdStep, ATimeStepAboveTheStabilityBoundDivergesAndSaysSo) {
+    const auto model = buildPartModel(makeTorus1(), {Material{1e4, 0.0}, 1.0, {}, {}});
+    SimulationSettings settings = plain(0.05);
+    const StabilityReport report = analyzeStability(*model, settings);
+    ASSERT_TRUE(report.certainlyUnstable);
+    const auto [error, start] = stepUntilDivergence(*model, settings, {0, Vec3(1e-3, 0, 0)}, 2000);
+    ASSERT_TRUE(error) << "an unstable time step did not diverge";
+    EXPECT_EQ(error->time(), start);
+    std::ostringstream cause;
+    cause << "likely cause: the time step 0.05 s is above the stability bound " << report.unstableTimeStep << " s of this material";
+    EXPECT_TRUE(contains(error->what(), cause.str())) << error->what();
+}
+
+TEST(MsdStep, AStableLoadedRunNeverThrows) {
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}});
+    SimulationSettings settings = plain(1e-3);
+    settings.restoration.method = RestorationMethod::AnchorSprings;
+    PartState state = PartState::atRest(*model);
+    const PointLoad load{5, Vec3(50, -20, 10)};
+    for (int step = 0; step < 3000; ++step) ASSERT_NO_THROW(stepFullModel(*model, settings, std::span(&load, step < 1000 ? 1 : 0), state));
 }
 
 // --- Pinned hashes (golden.hpp) ---

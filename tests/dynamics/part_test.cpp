@@ -370,3 +370,25 @@ TEST(Part, ACopyStepsOnItsOwnLikeTheOriginal) {
     copy.openZone(ZoneSeed::mass(200), 2);  // the copy's zones are its own
     EXPECT_EQ(copy.zoneCount(), original.zoneCount() + 1);
 }
+
+TEST(Part, AHugeForceOnAZoneDivergesAndThrowsNamingThePart) {
+    // The region step does not check itself; Part::step checks the moving masses.
+    const auto model = buildPartModel(makeTorus1());
+    Part part(model, zoneSettings());
+    double start = 0.0;
+    try {
+        for (int i = 0; i < 10; ++i) {
+            start = part.time();
+            part.applyForce(100, Vec3(0, 1e300, 0));
+            part.step();
+        }
+        FAIL() << "a force of 1e300 did not diverge";
+    } catch (const DivergenceError& e) {
+        EXPECT_FALSE(e.body());
+        EXPECT_EQ(e.time(), start);
+        const std::string what = e.what();
+        EXPECT_NE(what.find("part diverged at t = "), std::string::npos) << what;
+        EXPECT_NE(what.find("likely cause: a force beyond what the model can take"), std::string::npos) << what;
+    }
+    EXPECT_LT(part.movingMasses().size(), model->massCount());  // it was a zone, not the whole part
+}

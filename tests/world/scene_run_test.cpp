@@ -190,3 +190,40 @@ INSTANTIATE_TEST_SUITE_P(Examples, GoldenSceneRun, ::testing::ValuesIn(kGoldenSc
     name = name.substr(0, name.find('.'));
     return name;
 });
+
+TEST(SceneRun, ADivergenceNamesThePartOfTheScene) {
+    const Scene scene = parseScene(R"(
+[world]
+time_step = 0.001
+gravity = [0, 0, 0]
+duration = 1.0
+
+[[part]]
+name = "bystander"
+generator = { type = "sphere", radius = 1.0, level = 1 }
+mode = "rigid"
+position = [40, 0, 0]
+
+[[part]]
+name = "rim"
+generator = "torus1"
+
+[[action]]
+time = 0.0
+type = "force"
+part = "rim"
+masses = [3]
+force = [0, 1e300, 0]
+duration = 0.1
+)",
+                                   "diverging.toml", ".");
+    SceneRun run(scene);
+    try {
+        runFor(run, 0.1);
+        FAIL() << "a force of 1e300 did not diverge";
+    } catch (const DivergenceError& e) {
+        EXPECT_EQ(e.body(), BodyId(1));
+        EXPECT_EQ(e.name(), "rim");
+        EXPECT_EQ(std::string(e.what()).rfind("body 1 'rim' diverged at t = ", 0), 0u) << e.what();
+    }
+}

@@ -1,0 +1,35 @@
+// Internal to src/dynamics (used by src/world): finding a part's non-finite masses and naming
+// the likely cause, for DivergenceError (core.hpp).
+#pragma once
+
+#include "flexfit/simulation.hpp"
+
+#include <optional>
+#include <span>
+#include <string>
+
+namespace flexfit::detail {
+
+// True when every coordinate is finite. No early exit: one vectorised pass over the array.
+bool allFinite(std::span<const Vec3> values);
+
+// "velocity of mass 17 is not finite (nan, nan, nan)" when the mass's position, velocity or
+// pending force (tested in that order) is not finite; nothing when all are.
+std::optional<std::string> nonFiniteMass(const PartState& state, Index mass);
+
+// The likely cause of a part's divergence, in words, from the stability bounds of its model
+// under `settings` (with the time step it was stepped with, analyzeStability): the time step
+// above the bound, else a force beyond what the model can take. Costs O(masses + springs):
+// call it only to describe a divergence.
+std::string likelyCause(const PartModel& model, const SimulationSettings& settings);
+
+// Throw DivergenceError (`body`, `time`) naming the first mass whose position, velocity or
+// pending force is not finite, and the likely cause. The first checks `masses`, in O(|masses|);
+// the second every mass, in one vectorised pass over the positions when all are finite (and
+// over the velocities with explicit Euler): for stepFullModel, right after its step.
+void checkMassesFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
+                       std::span<const Index> masses, std::optional<BodyId> body, double time);
+void checkAllMassesFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
+                          std::optional<BodyId> body, double time);
+
+}  // namespace flexfit::detail

@@ -1,0 +1,96 @@
+// Finding non-finite masses and naming the likely cause (src/dynamics/divergence.cpp): the
+// vectorised test against every position of a bad value, the first bad mass and what of it,
+// and the cause from the stability bounds.
+#include "dynamics/divergence.hpp"
+#include "flexfit/flexfit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+using namespace flexfit;
+
+namespace {
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+}  // namespace
+
+TEST(Divergence, AllFiniteFindsABadValueAnywhere) {
+    EXPECT_TRUE(detail::allFinite({}));
+    for (std::size_t n : {1u, 2u, 3u, 5u, 8u, 13u}) {  // remainders of any vector width
+        std::vector<Vec3> values(n, Vec3(1.0, -std::numeric_limits<double>::max(), std::numeric_limits<double>::denorm_min()));
+        EXPECT_TRUE(detail::allFinite(values));
+        for (std::size_t i = 0; i < n; ++i)
+            for (int c = 0; c < 3; ++c)
+                for (double bad : {kInf, -kInf, kNaN, -kNaN}) {
+                    std::vector<Vec3> copy = values;
+                    copy[i][c] = bad;
+                    EXPECT_FALSE(detail::allFinite(copy)) << n << " " << i << " " << c << " " << bad;
+                }
+    }
+}
+
+TEST(Divergence, NamesTheMassAndWhatOfItIsNotFinite) {
+    const auto model = buildPartModel(makeTorus1());
+    PartState state = PartState::atRest(*model);
+    for (Index m = 0; m < model->massCount(); ++m) EXPECT_FALSE(detail::nonFiniteMass(state, m));
+    state.velocities[17] = Vec3(kNaN, 0, 0);
+    state.forces[17] = Vec3(kInf, 0, 0);
+    ASSERT_TRUE(detail::nonFiniteMass(state, 17));
+    EXPECT_EQ(*detail::nonFiniteMass(state, 17), "velocity of mass 17 is not finite (nan, 0, 0)");
+    state.positions[17].z() = -kInf;  // the position comes first
+    std::ostringstream expected;
+    expected << "position of mass 17 is not finite (" << state.positions[17].x() << ", " << state.positions[17].y() << ", -inf)";
+    EXPECT_EQ(*detail::nonFiniteMass(state, 17), expected.str());
+    state.positions[17] = model->restPositions[17];
+    state.velocities[17].setZero();
+    EXPECT_EQ(*detail::nonFiniteMass(state, 17), "force of mass 17 is not finite (inf, 0, 0)");
+}
+
+TEST(Divergence, CheckingSomeMassesLooksOnlyAtThem) {
+    const auto model = buildPartModel(makeTorus1());
+    const SimulationSettings settings;
+    PartState state = PartState::atRest(*model);
+    state.positions[300].x() = kNaN;
+    const std::vector<Index> others{0, 1, 299, 301};
+    EXPECT_NO_THROW(detail::checkMassesFinite(*model, settings, state, others, std::nullopt, 0.0));
+    const std::vector<Index> with{0, 300};
+    try {
+        detail::checkMassesFinite(*model, settings, state, with, BodyId(4), 1.25);
+        FAIL() << "no DivergenceError";
+    } catch (const DivergenceError& e) {
+        EXPECT_EQ(e.body(), BodyId(4));
+        EXPECT_EQ(e.time(), 1.25);
+        EXPECT_TRUE(contains(e.what(), "body 4 diverged at t = 1.25 s: position of mass 300 is not finite (nan")) << e.what();
+    }
+    try {
+        detail::checkAllMassesFinite(*model, settings, state, std::nullopt, 0.5);
+        FAIL() << "no DivergenceError";
+    } catch (const DivergenceError& e) {
+        EXPECT_FALSE(e.body());
+        EXPECT_TRUE(contains(e.what(), "part diverged at t = 0.5 s: position of mass 300")) << e.what();
+    }
+}
+
+TEST(Divergence, TheLikelyCauseComesFromTheStabilityBound) {
+    const auto model = buildPartModel(makeTorus1());  // elastic: k 0.1, 1 kg masses
+    SimulationSettings settings;
+    const StabilityReport stable = analyzeStability(*model, settings);
+    ASSERT_FALSE(stable.possiblyUnstable);
+    const std::string force = detail::likelyCause(*model, settings);
+    EXPECT_TRUE(contains(force, "likely cause: a force beyond what the model can take (the time step 0.001 s is within")) << force;
+
+    settings.timeStep = 10.0;  // far above 2 / omega
+    const StabilityReport unstable = analyzeStability(*model, settings);
+    ASSERT_TRUE(unstable.certainlyUnstable);
+    const std::string step = detail::likelyCause(*model, settings);
+    std::ostringstream bound;
+    bound << "likely cause: the time step 10 s is above the stability bound " << unstable.unstableTimeStep << " s of this material";
+    EXPECT_TRUE(contains(step, bound.str())) << step;
+}

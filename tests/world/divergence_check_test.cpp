@@ -1,0 +1,147 @@
+// The divergence check at the end of a world step (src/world/divergence_check.cpp): every
+// non-finite piece of a body's rigid state and of a part's moving masses stops World::step()
+// with a DivergenceError naming the body, the time at the start of the step and the likely
+// cause; a normal run never throws.
+#include "flexfit/flexfit.hpp"
+#include "test_bodies.hpp"
+#include "world/divergence_check.hpp"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <limits>
+#include <sstream>
+
+using namespace flexfit;
+using flexfit::testing::at;
+using flexfit::testing::dynamicBody;
+using flexfit::testing::rigidPart;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Steps the world, calling `load` before each step, until a step throws (at most `steps`).
+// Returns the error and the world's time before the step that threw.
+std::pair<std::optional<DivergenceError>, double> stepUntilDivergence(World& world, const std::function<void()>& load, int steps) {
+    for (int i = 0; i < steps; ++i) {
+        const double start = world.time();
+        load();
+        try {
+            world.step();
+        } catch (const DivergenceError& e) {
+            return {e, start};
+        }
+    }
+    return {std::nullopt, world.time()};
+}
+
+}  // namespace
+
+TEST(DivergenceCheck, ANonFiniteRigidStateNamesTheBodyTheTimeAndWhatWentWrong) {
+    const auto model = buildPartModel(makeIcoSphere(1.0, 1));
+    struct Case {
+        const char* what;
+        std::function<void(Part&, RigidBody&)> spoil;
+    };
+    const Case cases[] = {
+        {"the accumulated force of the rigid body is not finite (inf, 0, 0)", [](Part&, RigidBody& b) { b.force.x() = kInf; }},
+        {"the accumulated torque of the rigid body is not finite (0, nan, 0)", [](Part&, RigidBody& b) { b.torque.y() = kNaN; }},
+        {"the linear velocity of the rigid body is not finite (0, 0, -inf)", [](Part&, RigidBody& b) { b.linearVelocity.z() = -kInf; }},
+        {"the angular velocity of the rigid body is not finite (nan, 0, 0)", [](Part&, RigidBody& b) { b.angularVelocity.x() = kNaN; }},
+        {"the position of the rigid body is not finite (1, inf, 3)", [](Part& p, RigidBody&) { p.setPose(at(Vec3(1, kInf, 3))); }},
+        {"the orientation (quaternion x, y, z, w) of the rigid body is not finite",
+         [](Part& p, RigidBody&) { p.setPose(Pose{Eigen::Quaterniond(kNaN, 0, 0, 0), Vec3::Zero()}); }},
+    };
+    for (const Case& c : cases) {
+        detail::Bodies bodies;
+        for (int i = 0; i < 3; ++i) bodies.add(std::make_unique<Part>(model, rigidPart()), makeRigidBody(*model, dynamicBody()));
+        const StepContext step{1e-3, Vec3::Zero(), 1234, 1.234};
+        ASSERT_NO_THROW(detail::checkFinite(step, bodies));
+        c.spoil(*bodies.parts[2], bodies.rigid[2]);
+        try {
+            detail::checkFinite(step, bodies);
+            ADD_FAILURE() << "no DivergenceError for: " << c.what;
+        } catch (const DivergenceError& e) {
+            EXPECT_EQ(e.body(), BodyId(2));
+            EXPECT_EQ(e.time(), 1.234);
+            const std::string what = e.what();
+            EXPECT_TRUE(contains(what, std::string("body 2 diverged at t = 1.234 s: ") + c.what)) << what;
+            EXPECT_TRUE(contains(what, "likely cause: a force or torque beyond what the model can take")) << what;
+        }
+    }
+}
+
+TEST(DivergenceCheck, AHugeForceOnAZoneStopsTheWorldNamingTheBodyAndTheTime) {
+    World world;
+    world.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidPart(), BodySettings{}, at(Vec3(40, 0, 0)));  // body 0: bystander
+    const BodyId torus = world.add(buildPartModel(makeTorus1()), PartSettings{}, BodySettings{}, Pose{});
+    ASSERT_EQ(torus, BodyId(1));
+    const auto [error, start] = stepUntilDivergence(world, [&] { world.applyMassForce(torus, 100, Vec3(0, 1e300, 0)); }, 10);
+    ASSERT_TRUE(error) << "a force of 1e300 did not diverge";
+    EXPECT_EQ(error->body(), torus);
+    EXPECT_EQ(error->time(), start);
+    EXPECT_EQ(world.time(), start);  // the failing step did not complete
+    std::ostringstream head;
+    head << "body 1 diverged at t = " << start << " s: ";
+    const std::string what = error->what();
+    EXPECT_EQ(what.rfind(head.str(), 0), 0u) << what;
+    EXPECT_TRUE(contains(what, " of mass ")) << what;
+    EXPECT_TRUE(contains(what, "likely cause: a force beyond what the model can take")) << what;
+    EXPECT_LT(world.part(torus).movingMasses().size(), world.part(torus).model().massCount());  // a zone: the check read only it
+}
+
+TEST(DivergenceCheck, AFullDeformablePartThatDivergesIsNamedByItsBody) {
+    // The full step throws first (stepFullModel knows no body); the zone dynamics stage names it.
+    World world;
+    world.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidPart(), BodySettings{}, at(Vec3(40, 0, 0)));
+    PartSettings full;
+    full.mode = PartMode::FullDeformable;
+    const BodyId torus = world.add(buildPartModel(makeTorus1()), full, BodySettings{}, Pose{});
+    const auto [error, start] = stepUntilDivergence(world, [&] { world.applyMassForce(torus, 7, Vec3(-1e300, 0, 0)); }, 10);
+    ASSERT_TRUE(error) << "a force of 1e300 did not diverge";
+    EXPECT_EQ(error->body(), torus);
+    EXPECT_EQ(error->time(), start);
+    EXPECT_TRUE(contains(error->what(), "body 1 diverged at t = ")) << error->what();
+}
+
+TEST(DivergenceCheck, TheCauseWeighsTheWorldsTimeStepNotThePartsOwn) {
+    // The part's own settings (1 ms) are stable; the world steps it at 50 ms, far above its bound.
+    const auto model = buildPartModel(makeTorus1(), {Material{1e4, 0.0}, 1.0, {}, {}});
+    PartSettings zones;
+    zones.simulation.restoration.method = RestorationMethod::None;
+    zones.zones.defaultLevel = 4;
+    ASSERT_FALSE(analyzeStability(*model, zones.simulation).possiblyUnstable);
+    SimulationSettings atWorldStep = zones.simulation;
+    atWorldStep.timeStep = 0.05;
+    const StabilityReport report = analyzeStability(*model, atWorldStep);
+    ASSERT_TRUE(report.certainlyUnstable);
+    WorldSettings settings;
+    settings.timeStep = 0.05;
+    settings.gravity = Vec3::Zero();
+    World world(settings);
+    const BodyId torus = world.add(model, zones, BodySettings{}, Pose{});
+    int steps = 0;
+    const auto [error, start] = stepUntilDivergence(world, [&] { if (steps++ < 5) world.applyMassForce(torus, 0, Vec3(1e-3, 0, 0)); }, 2000);
+    ASSERT_TRUE(error) << "an unstable time step did not diverge";
+    EXPECT_EQ(error->body(), torus);
+    std::ostringstream cause;
+    cause << "likely cause: the time step 0.05 s is above the stability bound " << report.unstableTimeStep << " s of this material";
+    EXPECT_TRUE(contains(error->what(), cause.str())) << error->what();
+}
+
+TEST(DivergenceCheck, NormalRunsNeverThrow) {
+    // A rigid ball dropped on the rigid mouth, resting on its rim.
+    flexfit::testing::BallTorus rigid(17.0, 1e-3, Vec3::Zero());
+    for (int i = 0; i < 1500; ++i) ASSERT_NO_THROW(rigid.world.step()) << "step " << i;
+    // A deformable torus under a real load, released, restoring.
+    World world;
+    const BodyId torus = world.add(buildPartModel(makeTorus1()), PartSettings{}, BodySettings{}, Pose{});
+    for (int i = 0; i < 1500; ++i) {
+        if (i < 500) world.applyMassForce(torus, 100, Vec3(0, 5, 0));
+        ASSERT_NO_THROW(world.step()) << "step " << i;
+    }
+}
