@@ -5,6 +5,11 @@
 // the body's density). Every body is a Part, so any motion type combines with any deformation
 // mode (rigid, rigid-deformable, full-deformable). A body's id is its index in the world, 0, 1,
 // 2, ... in the order added: the world and its collision side use the same id.
+//
+// Contact materials (world.hpp, "Contacts"): Coulomb friction with a static and a kinetic
+// coefficient, and restitution, per body. A pair combines them as Box2D and Jolt do: friction
+// by the geometric mean sqrt(mu_a mu_b) (a frictionless body makes every contact with it
+// frictionless), restitution by the larger of the two (a bouncy ball bounces off a dull floor).
 #pragma once
 
 #include "flexfit/names.hpp"
@@ -31,6 +36,9 @@ struct BodySettings {
     Vec3 angularVelocity = Vec3::Zero();   // initial, world (rad/s)
     double thickness = 0.0;                // for the no-tunnelling bound; 0: smallest box half-extent
     BoundingVolumeKind boundingVolume = BoundingVolumeKind::Aabb;
+    double staticFriction = 0.0;           // Coulomb, while the contact sticks (>= kinetic)
+    double kineticFriction = 0.0;          // Coulomb, while it slides
+    double restitution = 0.0;              // 0: inelastic, 1: elastic (normal speed kept)
 };
 
 // The rigid-body state of one body. Mass properties are fixed when the body is added; the
@@ -46,6 +54,10 @@ struct RigidBody {
     Vec3 torque = Vec3::Zero();           // world, about the centre of mass
     double thickness = 0.0;
     double boundingRadius = 0.0;          // from the centre of mass to the farthest mass
+    double staticFriction = 0.0, kineticFriction = 0.0, restitution = 0.0;
+    // The force (world) deformable parts pressed on the body in the last step: their springs'
+    // reaction, its damping and friction (contact_response). Zero without such contact.
+    Vec3 deformableContactForce = Vec3::Zero();
 };
 
 // A body's rigid description from its model and settings: mass and inertia from the closed

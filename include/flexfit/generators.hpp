@@ -26,6 +26,16 @@ TriMesh makeIcoSphere(double radius, int subdivisions);
 // (the thesis's heart: 7,349 masses, 22,087 springs).
 TriMesh makeHeart(double size = 20.0, int segments = 93, int rings = 80);
 
+// Box centred at the origin with the given half extents, each face a divisions x divisions
+// grid of quads (so that contacts find points across a face, not only at its corners):
+// 6 d^2 + 2 vertices. Requires positive half extents and 1 <= divisions <= 256.
+TriMesh makeBox(const Vec3& halfExtents, int divisions = 1);
+
+// Plate centred at the origin (half extents along x, y, z) with a rectangular hole through it
+// along y (half widths holeX, holeZ, smaller than the plate's): a peg's hole. 16 vertices, 32
+// faces, genus 1.
+TriMesh makePlateWithHole(const Vec3& halfExtents, double holeX, double holeZ);
+
 // The thesis's models as Flexfit ships them in examples/.
 TriMesh makeTorus1();          // 24 x 24: 576 masses, 1,728 springs (R = 10, r = 2.5)
 TriMesh makeTorus2();          // 54 x 29: 1,566 masses, 4,698 springs (R = 10, r = 2.5)

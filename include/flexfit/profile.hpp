@@ -2,7 +2,7 @@
 //
 // The stages partition the step: from the first instruction of World::step to its last, every
 // instant is charged to exactly one stage, the one running then. A stage running inside
-// another (the narrow-phase queries and contact projections inside the rigid motion's
+// another (the narrow-phase queries and the contact solver inside the rigid motion's
 // sub-steps) is charged to itself and paused in the outer one. So the stages add up to
 // stepSeconds, and a stage that reads near zero did next to nothing.
 #pragma once
@@ -18,9 +18,10 @@ namespace flexfit {
 enum class Stage {
     OperatorInput,    // the operator's coupling force, kinematic targets
     RigidMotion,      // rigid bodies integrated, in sub-steps (no tunnelling)
+    ContactSolver,    // rigid contacts' impulses: normal, friction, restitution (in the sub-steps)
     BroadPhase,       // parts' bounding spheres, candidate pairs
     NarrowPhase,      // contacts of the candidate pairs (and of each sub-step's body)
-    ContactResponse,  // deformable pushes and reactions, rigid projections
+    ContactResponse,  // deformable pushes and reactions
     ZoneDynamics,     // the deformable parts' masses (restoration included)
     ZoneRetirement,   // zones at rest retired, their masses back at rest
     Assembly,         // the snapping rules
@@ -29,6 +30,7 @@ enum class Stage {
 // Its names (names.hpp).
 inline constexpr EnumName<Stage> kStageNames[] = {
     {Stage::OperatorInput, "operator_input", "operator input"}, {Stage::RigidMotion, "rigid_motion", "rigid motion"},
+    {Stage::ContactSolver, "contact_solver", "contact solver"},
     {Stage::BroadPhase, "broad_phase", "broad phase"}, {Stage::NarrowPhase, "narrow_phase", "narrow phase"},
     {Stage::ContactResponse, "contact_response", "contact response"}, {Stage::ZoneDynamics, "zone_dynamics", "zone dynamics"},
     {Stage::ZoneRetirement, "zone_retirement", "zone retirement"}, {Stage::Assembly, "assembly", "assembly"},

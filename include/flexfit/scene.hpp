@@ -9,12 +9,15 @@
 // Schema (every key is checked: an unknown key is an error, as is a value of the wrong type
 // or out of range; see examples/*.toml and the README for a complete table):
 //   [world]      time_step, gravity, duration, max_travel_fraction, max_substeps,
-//                contact_iterations, exact_test = "triangle" | "sphere"
+//                contact_iterations, contact_slop, contact_damping,
+//                exact_test = "triangle" | "sphere", rigid_deformable_query
 //   [[part]]     name, mesh (path relative to the scene) or generator ("torus1", "torus2",
-//                "heart", "container-mouth", or a table {type = "torus" | "sphere", ...}),
+//                "heart", "container-mouth", or a table {type = "torus" | "sphere" | "box" |
+//                "plate", ...}),
 //                mode, motion, material (preset or {stiffness, damping}), vertex_mass, position,
 //                rotation (degrees about x, then y, then z, world axes), density, velocity,
-//                angular_velocity (rad/s), thickness, bounding_volume, restoration,
+//                angular_velocity (rad/s), thickness, bounding_volume, static_friction,
+//                kinetic_friction (default: static_friction), restitution, restoration,
 //                constraint_fraction, anchor_stiffness, anchor_damping, global_damping,
 //                integrator, default_level, contact_level, activity_threshold, rest_speed
 //   [[assembly]] name, primary, secondary (part names), technique, final_position,

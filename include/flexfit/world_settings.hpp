@@ -16,11 +16,18 @@ struct WorldSettings {
     CollisionSettings collision;
     double maxTravelFraction = 0.25;  // of the thinnest body, per sub-step
     int maxSubsteps = 4096;
-    int contactIterations = 4;        // projection passes per sub-step
+    int contactIterations = 8;        // contact solver iterations per sub-step (velocity passes)
+    // The deepest a sub-step may take a body into a part that does not deform, as a fraction of
+    // the thinnest body: a move that would go deeper is cut short (conservative advancement).
+    double contactSlop = 0.01;
+    // Damping of the reaction a deformable part opposes to a dynamic body, as a ratio of the
+    // critical damping of the body's mass on the contact's stiffness (contact_response).
+    double contactDamping = 1.0;
 };
 
 // Throws InputError (source "world") for a time step that is not finite and positive,
-// non-finite gravity, a travel fraction outside (0, 1], or sub-steps or iterations below 1.
+// non-finite gravity, a travel fraction or contact slop outside (0, 1], sub-steps or
+// iterations below 1, or a negative or non-finite contact damping.
 inline void validateSettings(const WorldSettings& settings) {
     const std::string source = "world";
     if (!std::isfinite(settings.timeStep) || settings.timeStep <= 0.0) throw InputError(source, 0, "time step must be finite and > 0");
@@ -29,6 +36,9 @@ inline void validateSettings(const WorldSettings& settings) {
         throw InputError(source, 0, "max travel fraction must be in (0, 1]");
     if (settings.maxSubsteps < 1 || settings.contactIterations < 1)
         throw InputError(source, 0, "max substeps and contact iterations must be >= 1");
+    if (!(settings.contactSlop > 0.0 && settings.contactSlop <= 1.0)) throw InputError(source, 0, "contact slop must be in (0, 1]");
+    if (!(settings.contactDamping >= 0.0) || !std::isfinite(settings.contactDamping))
+        throw InputError(source, 0, "contact damping must be finite and >= 0");
 }
 
 // The operator's spring-damper coupling. Zero stiffness: the body's mass (and smallest

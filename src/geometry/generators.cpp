@@ -1,5 +1,6 @@
 #include "flexfit/generators.hpp"
 
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -124,6 +125,65 @@ TriMesh makeIcoSphere(double radius, int subdivisions) {
         mesh.faces = std::move(faces);
     }
     for (Vec3& v : mesh.vertices) v *= radius;
+    return mesh;
+}
+
+TriMesh makeBox(const Vec3& halfExtents, int divisions) {
+    require(halfExtents.allFinite() && halfExtents.minCoeff() > 0.0, "box needs finite half extents > 0");
+    require(divisions >= 1 && divisions <= 256, "box needs 1 <= divisions <= 256");
+    const int d = divisions;
+    TriMesh mesh;
+    mesh.name = "box";
+    // Vertices on the surface lattice (i, j, k) in [0, d]^3, each once.
+    std::map<std::array<int, 3>, Index> index;
+    auto vertex = [&](std::array<int, 3> g) {
+        auto [it, inserted] = index.try_emplace(g, Index(mesh.vertices.size()));
+        if (inserted)
+            mesh.vertices.push_back(Vec3(halfExtents.x() * (2.0 * g[0] / d - 1.0), halfExtents.y() * (2.0 * g[1] / d - 1.0),
+                                         halfExtents.z() * (2.0 * g[2] / d - 1.0)));
+        return it->second;
+    };
+    // Each face: the lattice point at (a, b) of the face's grid; quads counter-clockwise seen
+    // from outside (u x v along the outward normal).
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side : {0, d}) {
+            const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+            auto at = [&](int a, int b) {
+                std::array<int, 3> g{};
+                g[std::size_t(axis)] = side;
+                g[std::size_t(u)] = a;
+                g[std::size_t(v)] = b;
+                return vertex(g);
+            };
+            for (int a = 0; a < d; ++a)
+                for (int b = 0; b < d; ++b) {
+                    if (side == d) addQuad(mesh.faces, at(a, b), at(a + 1, b), at(a + 1, b + 1), at(a, b + 1));
+                    else addQuad(mesh.faces, at(a, b), at(a, b + 1), at(a + 1, b + 1), at(a + 1, b));
+                }
+        }
+    return mesh;
+}
+
+TriMesh makePlateWithHole(const Vec3& halfExtents, double holeX, double holeZ) {
+    require(halfExtents.allFinite() && halfExtents.minCoeff() > 0.0, "plate needs finite half extents > 0");
+    require(std::isfinite(holeX) && std::isfinite(holeZ) && holeX > 0.0 && holeZ > 0.0 && holeX < halfExtents.x() &&
+                holeZ < halfExtents.z(),
+            "plate's hole needs half widths > 0 and smaller than the plate's");
+    TriMesh mesh;
+    mesh.name = "plate";
+    // Corners counter-clockwise seen from +y: outer top 0-3, inner top 4-7, outer bottom 8-11,
+    // inner bottom 12-15.
+    const double corner[4][2] = {{1, 1}, {1, -1}, {-1, -1}, {-1, 1}};
+    for (double y : {halfExtents.y(), -halfExtents.y()})
+        for (const auto& [x, z] : {std::pair{halfExtents.x(), halfExtents.z()}, std::pair{holeX, holeZ}})
+            for (const auto& c : corner) mesh.vertices.push_back(Vec3(c[0] * x, y, c[1] * z));
+    for (Index i = 0; i < 4; ++i) {
+        const Index j = (i + 1) % 4;
+        addQuad(mesh.faces, i, j, 4 + j, 4 + i);          // top ring, facing +y
+        addQuad(mesh.faces, 8 + i, 12 + i, 12 + j, 8 + j);  // bottom ring, facing -y
+        addQuad(mesh.faces, i, 8 + i, 8 + j, j);          // outer wall, facing out
+        addQuad(mesh.faces, 4 + i, 4 + j, 12 + j, 12 + i);  // hole wall, facing the hole
+    }
     return mesh;
 }
 

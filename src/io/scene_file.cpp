@@ -190,15 +190,25 @@ TriMesh generatePartMesh(Table& t) {
     if (!n->is_table()) t.fail(*n, "generator", "expected a name or a table");
     Table g = t.sub("generator");
     const std::string type = g.text("type", "torus");
-    if (type != "torus" && type != "sphere")
-        g.fail(*g.node("type"), "type", "unknown value '" + type + "' (expected one of 'torus', 'sphere')");
+    if (type != "torus" && type != "sphere" && type != "box" && type != "plate")
+        g.fail(*g.node("type"), "type", "unknown value '" + type + "' (expected one of 'torus', 'sphere', 'box', 'plate')");
     TriMesh mesh;
     if (type == "torus") {
         const double major = g.positive("major", 10.0), minor = g.positive("minor", 2.5);
         if (!(minor < major)) g.fail("minor radius must be smaller than the major radius");
         mesh = makeTorus(major, minor, g.integer("u", 24, 3, 4096), g.integer("v", 24, 3, 4096));
-    } else {
+    } else if (type == "sphere") {
         mesh = makeIcoSphere(g.positive("radius", 1.0), g.integer("level", 3, 0, 7));
+    } else if (type == "box") {
+        const Vec3 half = g.vec3("half_extents", Vec3::Ones());
+        if (!(half.minCoeff() > 0.0)) g.fail(*g.node("half_extents"), "half_extents", "must be > 0");
+        mesh = makeBox(half, g.integer("divisions", 1, 1, 256));
+    } else {
+        const Vec3 half = g.vec3("half_extents", Vec3(2.0, 0.5, 2.0));
+        const double hx = g.positive("hole_x", 0.5 * half.x()), hz = g.positive("hole_z", 0.5 * half.z());
+        if (!(half.minCoeff() > 0.0) || !(hx < half.x()) || !(hz < half.z()))
+            g.fail("plate needs half_extents > 0 and a hole (hole_x, hole_z) smaller than them");
+        mesh = makePlateWithHole(half, hx, hz);
     }
     g.finish();
     return mesh;
@@ -250,6 +260,13 @@ ScenePart readPart(Table& t, const std::filesystem::path& base) {
     p.body.angularVelocity = t.vec3("angular_velocity", Vec3::Zero());
     p.body.thickness = t.nonNegative("thickness", 0.0);
     p.body.boundingVolume = t.choice("bounding_volume", BoundingVolumeKind::Aabb);
+    p.body.staticFriction = t.nonNegative("static_friction", 0.0);
+    // Kinetic friction defaults to the static one (a single coefficient, as most users give).
+    p.body.kineticFriction = t.nonNegative("kinetic_friction", p.body.staticFriction);
+    if (p.body.kineticFriction > p.body.staticFriction)
+        t.fail(*t.node("kinetic_friction"), "kinetic_friction", "must not exceed static_friction");
+    p.body.restitution = t.nonNegative("restitution", 0.0);
+    if (p.body.restitution > 1.0) t.fail(*t.node("restitution"), "restitution", "must be in [0, 1]");
     p.pose = t.pose("position", "rotation");
     t.finish();
     try {
@@ -387,6 +404,9 @@ void readWorld(Table& root, Scene& scene) {
     if (s.maxTravelFraction > 1.0) w.fail(*w.node("max_travel_fraction"), "max_travel_fraction", "must be in (0, 1]");
     s.maxSubsteps = w.integer("max_substeps", s.maxSubsteps, 1, 1 << 20);
     s.contactIterations = w.integer("contact_iterations", s.contactIterations, 1, 1000);
+    s.contactSlop = w.positive("contact_slop", s.contactSlop);
+    if (s.contactSlop > 1.0) w.fail(*w.node("contact_slop"), "contact_slop", "must be in (0, 1]");
+    s.contactDamping = w.nonNegative("contact_damping", s.contactDamping);
     s.collision.exactTest = w.choice("exact_test", ExactTest::TriangleTriangle);
     s.collision.rigidDeformable = w.choice("rigid_deformable_query", RigidDeformableQuery::Faces);
     w.finish();

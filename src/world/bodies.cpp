@@ -15,6 +15,9 @@ RigidBody makeRigidBody(const PartModel& model, const BodySettings& settings) {
     if (!(settings.thickness >= 0.0) || !std::isfinite(settings.thickness) || !settings.linearVelocity.allFinite() ||
         !settings.angularVelocity.allFinite())
         throw InputError(source, 0, "body thickness and velocities must be finite");
+    if (!(settings.kineticFriction >= 0.0) || !(settings.staticFriction >= settings.kineticFriction) || !std::isfinite(settings.staticFriction))
+        throw InputError(source, 0, "friction must be finite and >= 0, with kinetic friction <= static friction");
+    if (!(settings.restitution >= 0.0 && settings.restitution <= 1.0)) throw InputError(source, 0, "restitution must be in [0, 1]");
     RigidBody body;
     body.motion = settings.motion;
     const Eigen::AlignedBox3d box = boundingBox(model.mesh);
@@ -30,6 +33,9 @@ RigidBody makeRigidBody(const PartModel& model, const BodySettings& settings) {
     for (const Vec3& p : model.restPositions) body.boundingRadius = std::max(body.boundingRadius, (p - body.centreOfMass).norm());
     body.linearVelocity = settings.linearVelocity;
     body.angularVelocity = settings.angularVelocity;
+    body.staticFriction = settings.staticFriction;
+    body.kineticFriction = settings.kineticFriction;
+    body.restitution = settings.restitution;
     return body;
 }
 

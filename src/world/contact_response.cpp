@@ -1,7 +1,10 @@
 // The contact response stage (contact_response.hpp).
 #include "contact_response.hpp"
 
+#include "contact_solver.hpp"
+
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace flexfit::detail {
@@ -39,9 +42,57 @@ void displacePushedMasses(Bodies& bodies, const ContactResponse& r) {
     for (const ContactResponse::Push& p : r.pushes) bodies.parts[p.body]->displaceMass(p.mass, p.displacement);
 }
 
+// Velocity of the material point at world position x of a body: its rigid motion, plus the
+// mass's own velocity when the point is a moving mass of a deforming part.
+Vec3 pointVelocity(const Bodies& bodies, BodyId id, const Vec3& x) {
+    const RigidBody& b = bodies.rigid[id];
+    return b.linearVelocity + b.angularVelocity.cross(x - bodies.centreOfMass(id));
+}
+
+// Each reaction: the spring force k_eff (rest - x) of the mass, damped along it by the body's
+// approach, never pulling; Coulomb friction against the body's sliding over the mass, which
+// feels the opposite; the body gets the force and its torque.
+void applyReactionForces(const StepContext& step, double dampingRatio, Bodies& bodies, ContactResponse& r) {
+    for (RigidBody& b : bodies.rigid) b.deformableContactForce.setZero();
+    r.reactionCount.assign(bodies.size(), 0u);
+    for (const ContactResponse::Reaction& reaction : r.reactions) ++r.reactionCount[reaction.body];
+    for (const ContactResponse::Reaction& reaction : r.reactions) {
+        Part& p = *bodies.parts[reaction.part];
+        const Vec3 displacement = p.pose().rotate(p.state().positions[reaction.mass] - p.model().restPositions[reaction.mass]);
+        const double length = displacement.norm();
+        if (!(length > 0.0)) continue;
+        RigidBody& body = bodies.rigid[reaction.body];
+        const double k = r.stiffness[reaction.part];
+        const double share = body.mass / double(r.reactionCount[reaction.body]);  // of the body's mass, per mass pressed
+        const double damping = std::min(2.0 * dampingRatio * std::sqrt(k * share), share / step.timeStep);
+        const Vec3 normal = -displacement / length;  // the way the mass pushes the body
+        const Vec3 x = p.worldPosition(reaction.mass);
+        const Vec3 relative = pointVelocity(bodies, reaction.body, x) - pointVelocity(bodies, reaction.part, x) -
+                              p.pose().rotate(p.state().velocities[reaction.mass]);
+        const double normalSpeed = relative.dot(normal);
+        const double pressing = std::max(k * length - damping * normalSpeed, 0.0);
+        const Vec3 sliding = relative - normalSpeed * normal;
+        const double slidingSpeed = sliding.norm();
+        Vec3 friction = Vec3::Zero();
+        if (slidingSpeed > 0.0) {
+            const RigidBody& other = bodies.rigid[reaction.part];
+            const double stopping = share * slidingSpeed / step.timeStep;  // stops the sliding in one step
+            const double limit = combinedFriction(body.staticFriction, other.staticFriction) * pressing;
+            const double magnitude = stopping <= limit ? stopping : combinedFriction(body.kineticFriction, other.kineticFriction) * pressing;
+            friction = -(magnitude / slidingSpeed) * sliding;
+            if (magnitude > 0.0) p.applyForce(reaction.mass, -friction);
+        }
+        const Vec3 force = pressing * normal + friction;
+        body.force += force;
+        body.torque += (x - bodies.centreOfMass(reaction.body)).cross(force);
+        body.deformableContactForce += force;
+    }
+}
+
 // Each (body, contacted mass) once, in first-contact order (deterministic); then each body
-// feels k_eff (rest - x) of its masses, for the next step.
-void applyDeformableReactions(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& r) {
+// feels its masses' reactions, for the next step.
+void applyDeformableReactions(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
+                              ContactResponse& r) {
     r.reacting.growTo(bodies.massCount());
     r.reactionOwner.resize(bodies.massCount(), 0u);
     r.reacting.clear();
@@ -59,11 +110,7 @@ void applyDeformableReactions(std::span<const Contact> contacts, Bodies& bodies,
                 }
             }
         }
-    for (const ContactResponse::Reaction& reaction : r.reactions) {
-        const Part& p = *bodies.parts[reaction.part];
-        const Vec3 displacement = p.pose().rotate(p.state().positions[reaction.mass] - p.model().restPositions[reaction.mass]);
-        bodies.rigid[reaction.body].force -= r.stiffness[reaction.part] * displacement;
-    }
+    applyReactionForces(step, dampingRatio, bodies, r);
 }
 
 }  // namespace
@@ -81,37 +128,15 @@ double effectiveContactStiffness(const Part& part, double timeStep) {
     return springs;
 }
 
-void respondToContacts(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response) {
+void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response) {
     collectPushes(contacts, bodies, response);
     displacePushedMasses(bodies, response);
-    applyDeformableReactions(contacts, bodies, response);
 }
 
-double projectRigidContacts(BodyId id, std::span<const Contact> contacts, Bodies& bodies, ContactResponse& r) {
-    // This body's contacts with parts that do not deform: direction out of them, depth.
-    r.projections.clear();
-    for (const Contact& c : contacts) {
-        const BodyId other = c.partA == id ? c.partB : c.partA;
-        if (bodies.parts[other]->deforms()) continue;
-        r.projections.emplace_back(c.partA == id ? c.normal : Vec3(-c.normal), c.depth);
-    }
-    if (r.projections.empty()) return -1.0;
-    // Gauss-Seidel over the contacts: each takes what the correction so far leaves of its depth
-    // along its normal. Symmetric contacts (a ball on a ring) cancel sideways and add up along
-    // the common direction, instead of pushing the body from side to side.
-    Vec3 correction = Vec3::Zero();
-    for (int pass = 0; pass < 4; ++pass)
-        for (const auto& [out, depth] : r.projections) {
-            const double remaining = depth - correction.dot(out);
-            if (remaining > 0.0) correction += remaining * out;
-        }
-    bodies.parts[id]->translate(correction);
-    RigidBody& body = bodies.rigid[id];
-    for (const auto& [out, depth] : r.projections) {
-        const double into = body.linearVelocity.dot(out);
-        if (into < 0.0) body.linearVelocity -= into * out;  // inelastic
-    }
-    return correction.norm();
+void respondToContacts(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
+                       ContactResponse& response) {
+    pushDeformableMasses(contacts, bodies, response);
+    applyDeformableReactions(step, dampingRatio, contacts, bodies, response);
 }
 
 }  // namespace flexfit::detail

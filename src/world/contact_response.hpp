@@ -10,11 +10,17 @@
 // Reactions: a dynamic body pressing a deformable part feels the springs it displaced. The
 // contacted masses sit at x, pushed from their rest positions; the part pulls them back with
 // k_eff (rest - x), and through the contact the body receives that force, for the next step. A
-// weak push is stopped by a stiff rim; a strong one deforms it and passes.
+// weak push is stopped by a stiff rim; a strong one deforms it and passes. The reaction is
+// damped along it (a dashpot c = 2 zeta sqrt(k m_share), zeta the world's contactDamping, m_share
+// the body's mass over the masses it presses, capped at m_share / h so the explicit force
+// cannot reverse the approach in one step), so a fast ball does not bounce off a stiff rim with
+// the energy it brought; it never pulls. Coulomb friction acts against the body's sliding over
+// each mass: the force that stops the sliding in one step while within mu_s times the normal
+// force, mu_k times it otherwise; the mass feels the opposite. The body gets each force at the
+// mass's position, so also its torque, and RigidBody::deformableContactForce reports the sum.
 //
-// Rigid contacts: a dynamic body's contacts with rigid parts are resolved by projection, inside
-// the rigid motion's sub-steps: the body moves out along the contact normals (Gauss-Seidel over
-// their depths) and loses the velocity into them (inelastic, no friction yet).
+// Rigid contacts (neither part deforms) belong to the contact solver (contact_solver.hpp),
+// inside the rigid motion's sub-steps.
 #pragma once
 
 #include "bodies.hpp"
@@ -49,15 +55,15 @@ struct ContactResponse {
         Index mass;
     };
     std::vector<Reaction> reactions;
-    std::vector<std::pair<Vec3, double>> projections;  // a body's rigid contacts: direction out, depth
+    std::vector<std::uint32_t> reactionCount;  // (nbody) masses each body presses
 };
 
 // Deformable pushes, then the reactions dynamic bodies feel, for the contacts of this step.
-void respondToContacts(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response);
+void respondToContacts(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
+                       ContactResponse& response);
 
-// Projects body `id` out of its contacts with rigid parts (Gauss-Seidel) and removes its
-// velocity into them. Returns the length of the correction, or a negative number when there
-// was no such contact.
-double projectRigidContacts(BodyId id, std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response);
+// The deformable pushes alone (zones at the contacted faces, masses moved out): for a body
+// pressing parts in the middle of its sub-steps.
+void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response);
 
 }  // namespace flexfit::detail

@@ -59,18 +59,21 @@ void applyCoupling(double h, OperatorState& op, Bodies& bodies) {
     op.previousTarget = op.target;
 }
 
-// Kinematic bodies jump to their targets; the move over the step gives their velocity.
-void reachKinematicTargets(double h, Bodies& bodies) {
+// Kinematic bodies take the velocity that reaches their target in this step; the rigid motion
+// stage moves them there in sub-steps (rigid_motion.hpp). One without a target stands still.
+void aimKinematicBodies(double h, Bodies& bodies) {
     for (BodyId id = 0; id < bodies.size(); ++id) {
-        if (!bodies.kinematicTargets[id]) continue;
-        const Pose target = *bodies.kinematicTargets[id];
         RigidBody& body = bodies.rigid[id];
-        const Vec3 before = bodies.centreOfMass(id);
-        const Eigen::AngleAxisd turn(target.rotation * bodies.parts[id]->pose().rotation.conjugate());
-        bodies.parts[id]->setPose(target);
-        body.linearVelocity = (bodies.centreOfMass(id) - before) / h;
+        if (body.motion != MotionType::Kinematic) continue;
+        if (!bodies.kinematicTargets[id]) {
+            body.linearVelocity.setZero();
+            body.angularVelocity.setZero();
+            continue;
+        }
+        const Pose& target = *bodies.kinematicTargets[id];
+        const Eigen::AngleAxisd turn = shortestTurn(target.rotation * bodies.parts[id]->pose().rotation.conjugate());
+        body.linearVelocity = (target.apply(body.centreOfMass) - bodies.centreOfMass(id)) / h;
         body.angularVelocity = turn.axis() * (turn.angle() / h);
-        bodies.kinematicTargets[id].reset();
     }
 }
 
@@ -96,7 +99,7 @@ void release(OperatorState& op) {
 
 void operatorInput(const StepContext& step, OperatorState& op, Bodies& bodies) {
     applyCoupling(step.timeStep, op, bodies);
-    reachKinematicTargets(step.timeStep, bodies);
+    aimKinematicBodies(step.timeStep, bodies);
 }
 
 }  // namespace flexfit::detail

@@ -1,6 +1,6 @@
 // Internal to src/world: the operator stage (world.hpp). The operator holds at most one body;
-// each step the coupling between its target and the body is applied, and kinematic bodies jump
-// to the targets set for them.
+// each step the coupling between its target and the body is applied, and kinematic bodies are
+// aimed at the targets set for them (the rigid motion stage moves them there).
 #pragma once
 
 #include "bodies.hpp"
@@ -27,8 +27,8 @@ void grab(BodyId id, const GrabSettings& settings, double timeStep, const Bodies
 void release(OperatorState& op);
 
 // The stage: the coupling force and torque on the grabbed dynamic body (or the target as a
-// grabbed kinematic body's target), then every kinematic body at its target, its velocity
-// derived from the move.
+// grabbed kinematic body's target), then every kinematic body's velocity: the one that reaches
+// its target in this step, or zero without a target.
 void operatorInput(const StepContext& step, OperatorState& op, Bodies& bodies);
 
 }  // namespace flexfit::detail

@@ -1,21 +1,45 @@
-// Internal to src/world: the rigid motion stage (world.hpp). Dynamic bodies take their forces,
-// torques and gravity (semi-implicit Euler) and move in sub-steps short enough that no point
-// of a body travels more than maxTravelFraction of the thinnest body per sub-step; after each
-// sub-step the body's contacts with rigid parts are found and projected out, so it can never
-// jump over a part, whatever its speed or the time step.
+// Internal to src/world: the rigid motion stage (world.hpp, "Contacts"). Dynamic bodies take
+// their forces, torques and gravity (semi-implicit Euler, once per step); kinematic bodies
+// with a target this step take the velocity that reaches it. Then every moving body advances
+// in the same sub-steps, short enough that no point of any travels more than
+// maxTravelFraction of the thinnest body per sub-step. Each sub-step:
+//   1. the dynamic bodies' contacts with parts that do not deform (NarrowPhase);
+//   2. the contact solver's first pass, which also separates penetrating points (ContactSolver);
+//   3. every moving body advances, kinematic ones first, by conservative advancement: a move
+//      that would take a body deeper than the contact slop (or than it already was) into a
+//      part that does not deform is cut to the last fraction that does not (bisection), so
+//      contact normals and depths always come from a shallow configuration and no load, speed
+//      or time step gets a body through a rigid part;
+//   4. the solver's relax pass and restitution;
+//   5. a kinematic body that has sub-steps left presses the deformable parts it meets, so it
+//      deforms them along its way instead of jumping through.
+// A kinematic body is not stopped by dynamic bodies (it pushes them) but is by static and
+// kinematic rigid parts; it reaches its target exactly unless one stopped it.
 #pragma once
 
 #include "bodies.hpp"
 #include "contact_response.hpp"
+#include "contact_solver.hpp"
 #include "flexfit/collision_world.hpp"
 #include "flexfit/world_settings.hpp"
 #include "step_profiler.hpp"
 
 namespace flexfit::detail {
 
-// Charges its own work to Stage::RigidMotion, each sub-step's contact query to NarrowPhase and
-// each projection to ContactResponse. Adds the sub-steps taken to profile.substeps.
-void moveDynamicBodies(const StepContext& step, const WorldSettings& settings, Bodies& bodies, CollisionWorld& collision,
-                       ContactResponse& response, StepProfiler& profiler, Profile& profile);
+// Scratch of the stage, kept between steps.
+struct RigidMotionScratch {
+    ContactSolver solver;
+    std::vector<BodyId> moving;         // kinematic bodies with a target, then dynamic ones
+    std::vector<double> startDepth;     // (nbody) deepest rigid contact at the sub-step's start
+    std::vector<Pose> stepStart;        // (nbody) pose at the step's start (kinematic bodies)
+    std::vector<char> stopped;          // (nbody) a sub-step of this step was cut short
+    std::vector<Contact> cached;        // contacts of `cachedBody` at its current pose
+    std::optional<BodyId> cachedBody;
+};
+
+// Charges its own work to Stage::RigidMotion, queries to NarrowPhase, the solver to
+// ContactSolver and kinematic pushes to ContactResponse. Adds the sub-steps to profile.substeps.
+void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bodies& bodies, CollisionWorld& collision,
+                     ContactResponse& response, RigidMotionScratch& scratch, StepProfiler& profiler, Profile& profile);
 
 }  // namespace flexfit::detail

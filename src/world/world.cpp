@@ -169,14 +169,14 @@ void World::step() {
     detail::StepProfiler profiler(d.profile, Stage::OperatorInput);
     detail::operatorInput(step, d.op, d.bodies);                   // coupling force, kinematic targets
     profiler.enter(Stage::RigidMotion);
-    detail::moveDynamicBodies(step, d.settings, d.bodies, d.collision, d.response, profiler, d.profile);  // sub-stepped
+    detail::moveRigidBodies(step, d.settings, d.bodies, d.collision, d.response, d.rigidMotion, profiler, d.profile);  // sub-stepped, solved
     profiler.enter(Stage::BroadPhase);
     d.collision.update();                                          // spheres, candidate pairs
     profiler.enter(Stage::NarrowPhase);
     const std::vector<Contact>& contacts = d.collision.narrowPhase();  // refits deformed hierarchies it needs
     detail::clearRefittedChanges(d.collision, d.bodies);
     profiler.enter(Stage::ContactResponse);
-    detail::respondToContacts(contacts, d.bodies, d.response);     // deformable pushes, reactions
+    detail::respondToContacts(step, d.settings.contactDamping, contacts, d.bodies, d.response);  // deformable pushes, reactions
     profiler.enter(Stage::ZoneDynamics);
     detail::advanceZones(step, d.bodies);                          // moving masses, restoration
     profiler.enter(Stage::ZoneRetirement);

@@ -8,6 +8,7 @@
 #include "flexfit/collision_world.hpp"
 #include "flexfit/world_settings.hpp"
 #include "operator_input.hpp"
+#include "rigid_motion.hpp"
 
 namespace flexfit::detail {
 
@@ -19,6 +20,7 @@ struct WorldData {
     CollisionWorld collision;   // read-only views of the parts, by the same ids
     OperatorState op;           // the grab and its coupling
     ContactResponse response;   // contact stiffness per body, response scratch
+    RigidMotionScratch rigidMotion;  // the sub-steps' solver and contacts
     AssemblyState assembly;     // the rules and their events
     Profile profile;
     std::uint64_t stepIndex = 0;

@@ -304,4 +304,28 @@ TEST(Generators, InfiniteSizesThrowInputError) {
 }
 
 }  // namespace
+
+TEST(Generators, BoxAndPlateAreClosedWithTheirExactVolumes) {
+    // Flat faces: the volumes are exact (a box 8abc; a plate less its hole), the counts those
+    // documented, and every face points out of the solid.
+    for (int d : {1, 2, 5}) {
+        SCOPED_TRACE(d);
+        const TriMesh box = makeBox(Vec3(1.0, 2.0, 0.5), d);
+        const MeshDiagnostics diagnostics = expectCleanClosed(box);
+        EXPECT_EQ(eulerCharacteristic(box, diagnostics.edgeCount), 2);
+        expectConsistentlyOrientedClosed(box);
+        EXPECT_EQ(box.vertices.size(), std::size_t(6 * d * d + 2));
+        EXPECT_NEAR(signedVolume(box), 8.0, 1e-12);
+    }
+    const TriMesh plate = makePlateWithHole(Vec3(3.0, 0.5, 2.0), 1.0, 0.75);
+    const MeshDiagnostics diagnostics = expectCleanClosed(plate);
+    EXPECT_EQ(eulerCharacteristic(plate, diagnostics.edgeCount), 0);  // genus 1
+    expectConsistentlyOrientedClosed(plate);
+    EXPECT_EQ(plate.vertices.size(), 16u);
+    EXPECT_EQ(plate.faces.size(), 32u);
+    EXPECT_NEAR(signedVolume(plate), 8.0 * 3.0 * 0.5 * 2.0 - 8.0 * 1.0 * 0.5 * 0.75, 1e-12);
+    EXPECT_THROW(makeBox(Vec3(1, 0, 1)), InputError);
+    EXPECT_THROW(makePlateWithHole(Vec3(1, 1, 1), 1.0, 0.5), InputError);
+}
+
 }  // namespace flexfit

@@ -155,8 +155,8 @@ struct GoldenScene {
 };
 
 const GoldenScene kGoldenScenes[] = {
-    {"ball_torus.toml", "8ed71ef566397074"},   {"ball_torus_haptic.toml", "d33c4367fe205d20"},
-    {"ball_torus_rigid.toml", "d4b63ce728b38f4d"}, {"contact.toml", "391238feb38a73f9"},
+    {"ball_torus.toml", "4372e99d59cae164"},   {"ball_torus_haptic.toml", "8aef0c49fa3bf18c"},
+    {"ball_torus_rigid.toml", "b4498b85a813732e"}, {"contact.toml", "6f71c49d7327c00a"},
     {"restoration.toml", "2bc6f95d3b2e0cfe"},  {"snap_vector.toml", "9ae6d4634631f9cc"},
     {"zones.toml", "8256e010fa0e79ca"},
 };

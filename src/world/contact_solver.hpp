@@ -1,0 +1,83 @@
+// Internal to src/world: the contact solver stage (world.hpp, "Contacts"). It runs inside the
+// rigid motion's sub-steps, on the contacts between bodies whose parts do not deform (rigid
+// mode), at least one of them dynamic.
+//
+// Sequential impulses (Catto's, as Box2D and Jolt use): each contact point is a normal
+// constraint (relative normal speed >= 0, impulse >= 0) and two friction constraints along the
+// tangent plane, solved one point at a time over a few iterations. Every impulse goes to both
+// bodies at the same point, weighted by inverse mass and world inverse inertia, so two dynamic
+// bodies conserve linear and angular momentum to rounding.
+//
+//   Friction (Coulomb, static and kinetic): a point's tangential impulse is the one that stops
+//   the sliding, while it stays within mu_s times the normal impulse (the point sticks); beyond
+//   that the point slides and gets mu_k times the normal impulse, against the sliding (a disc,
+//   not a pyramid: no preferred direction).
+//   Depth: a penetrating point asks for a separating speed beta (depth - linear slop) / dt
+//   (Baumgarte) in a first pass; the sub-step's positions move with those velocities, and a
+//   second pass without it (relax, as Box2D v3's soft step) takes back the speed that only
+//   served to separate. Both passes are impulses, so correcting a depth conserves momentum too.
+//   Restitution: after the relax, a point that approached faster than the threshold gets the
+//   normal impulse that makes it separate at e times its approach speed.
+//
+// Known limits: no warm starting (a point's impulses start at zero every sub-step, so tall
+// stacks need more iterations); contact points come from triangle pairs, several per face
+// pair, so a box on a face is held at several points of its face, not exactly at its corners.
+#pragma once
+
+#include "bodies.hpp"
+#include "flexfit/collision.hpp"
+#include "flexfit/world_settings.hpp"
+
+#include <span>
+#include <vector>
+
+namespace flexfit::detail {
+
+struct SolverContact {
+    BodyId a = 0, b = 0;       // pushing a along +normal separates them
+    Vec3 ra, rb;               // from each body's centre of mass to the point (world)
+    Vec3 normal, tangent1, tangent2;
+    double depth = 0.0;
+    double normalMass = 0.0, tangentMass1 = 0.0, tangentMass2 = 0.0;  // 1 / effective inverse mass
+    double normalImpulse = 0.0, tangentImpulse1 = 0.0, tangentImpulse2 = 0.0;  // accumulated
+    double approachSpeed = 0.0;  // relative normal speed before the solve (< 0: approaching)
+    double staticFriction = 0.0, kineticFriction = 0.0, restitution = 0.0;
+};
+
+struct ContactSolver {
+    std::vector<SolverContact> contacts;
+    std::vector<Eigen::Matrix3d> inverseInertia;  // (nbody) world frame, at the sub-step's start
+};
+
+// Combining rules (body.hpp): geometric mean of the frictions, larger restitution.
+double combinedFriction(double a, double b);
+double combinedRestitution(double a, double b);
+
+// World inverse inertia of every dynamic body at its current pose (zero for the others).
+void updateInverseInertia(const Bodies& bodies, ContactSolver& solver);
+
+// Appends one solver point per contact, with its effective masses and approach speed. Skips
+// contacts where a part deforms or neither body is dynamic.
+void addContacts(std::span<const Contact> contacts, const Bodies& bodies, ContactSolver& solver);
+
+// After the sub-step's move: each point's lever arms from the bodies' new centres of mass to
+// one common point (the middle of where the two bodies carried it), so that the passes after
+// the move still give both bodies the impulse at the same point (angular momentum conserved).
+void refreshLeverArms(const Bodies& bodies, ContactSolver& solver);
+
+// How fast a penetrating point asks to separate: rate (beta / dt) times its depth beyond
+// `slop`, at most maxSpeed. The cap matters in wedges (a ball in a ring, a peg in a hole): normals
+// nearly opposite turn a small separating speed along them into a large one along the wedge,
+// which the relax pass converges too slowly to take back. Rate 0: the relax pass.
+struct Separation {
+    double rate = 0.0, slop = 0.0, maxSpeed = 0.0;
+};
+
+// `iterations` passes over the points, friction then normal at each.
+void solveVelocities(int iterations, const Separation& separation, Bodies& bodies, ContactSolver& solver);
+
+// Normal impulses that turn each point's approach into a separation at restitution times its
+// approach speed, for points that approached faster than `threshold`.
+void applyRestitution(int iterations, double threshold, Bodies& bodies, ContactSolver& solver);
+
+}  // namespace flexfit::detail
