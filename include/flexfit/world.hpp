@@ -4,9 +4,11 @@
 //
 // A step, in order (each stage charged to profile(), profile.hpp):
 //   1. operator input    the operator's coupling force on the grabbed body; kinematic bodies
-//                        jump to their targets (operator_input.cpp)
-//   2. rigid motion      dynamic bodies integrated in sub-steps, their contacts with rigid
-//                        parts projected out after each sub-step (rigid_motion.cpp)
+//                        aimed at their targets (operator_input.cpp)
+//   2. rigid motion      dynamic and kinematic bodies moved in sub-steps, each move
+//                        conservative (rigid_motion.cpp), with in each sub-step
+//      contact solver    the impulses of the rigid contacts: normal, friction, restitution
+//                        (contact_solver.cpp)
 //   3. broad phase       bounding spheres, candidate pairs (broad_phase.cpp)
 //   4. narrow phase      the contacts of the candidate pairs, refitting the deformed
 //                        hierarchies it traverses (narrow_phase.cpp)
@@ -25,21 +27,28 @@
 // the same ids, and only the world's stages change them. part() and collision() are read-only
 // views; settings change through setPartSettings().
 //
-// No tunnelling (conservative advancement): a dynamic body's motion in a step is cut into
-// sub-steps so that no point of it travels more than `maxTravelFraction` of the thinnest body
-// it can meet (each body's thickness: its smallest bounding-box half-extent unless given), and
-// contacts are detected and resolved after every sub-step. A body can therefore not jump over
-// a part, whatever its speed or the time step; the cost grows with speed x dt / thickness.
-// Known limit: the thickness estimate assumes parts are at least as thick as the smallest
-// half-extent of their box (a thin diagonal feature needs BodySettings::thickness).
+// No tunnelling (conservative advancement): the moving bodies' motion in a step is cut into
+// sub-steps so that no point travels more than `maxTravelFraction` of the thinnest body it can
+// meet (each body's thickness: its smallest bounding-box half-extent unless given), and a
+// sub-step's move that would take a body deeper than `contactSlop` of that thickness into a
+// part that does not deform is bisected back to the last fraction that does not. Contact
+// normals and depths therefore come from shallow configurations, and no force, speed or time
+// step gets a body through a rigid part; the cost grows with speed x dt / thickness. Known
+// limits: the thickness estimate assumes parts are at least as thick as the smallest
+// half-extent of their box (a thin diagonal feature needs BodySettings::thickness); a move cut
+// short loses its remainder (energy, and momentum between two dynamic bodies).
 //
 // Gravity acts on bodies (dynamic ones fall), not on the masses of deformation zones: a part's
 // rest shape is its shape under its own weight, and in a falling body's frame its masses feel
 // none, so zones deform from contacts and operator forces only.
 //
-// Contacts (contact_response.cpp): the response deforms rigid-deformable parts, and a dynamic
-// body pressing one receives the force of the displaced springs for the next step. Rigid
-// contacts are resolved by projection (inelastic, no friction yet).
+// Contacts: rigid ones (neither part deforms) are solved by impulses in the sub-steps, by
+// inverse mass and inertia, with Coulomb friction and restitution per body (contact_solver.hpp
+// and body.hpp give the model and the combining rules). The response deforms rigid-deformable
+// parts, and a dynamic body pressing one receives the damped force of the displaced springs,
+// friction and their torque for the next step (contact_response.hpp). Kinematic bodies are
+// swept: they push dynamic bodies, press the deformable parts they cross, and stop at static
+// and kinematic rigid parts.
 //
 // The operator (thesis 4.1.4; SHARP, VEDAP-II): grab() holds a body; setGrabTarget() moves the
 // pose the operator wants it at. A dynamic body is pulled by a spring-damper coupling between

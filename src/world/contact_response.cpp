@@ -67,8 +67,9 @@ void applyReactionForces(const StepContext& step, double dampingRatio, Bodies& b
         const double damping = std::min(2.0 * dampingRatio * std::sqrt(k * share), share / step.timeStep);
         const Vec3 normal = -displacement / length;  // the way the mass pushes the body
         const Vec3 x = p.worldPosition(reaction.mass);
-        const Vec3 relative = pointVelocity(bodies, reaction.body, x) - pointVelocity(bodies, reaction.part, x) -
-                              p.pose().rotate(p.state().velocities[reaction.mass]);
+        // The body's motion over the part's surface, taken as it moves rigidly: a pushed mass's
+        // own velocity is what the restoration gives it, not the surface's resistance.
+        const Vec3 relative = pointVelocity(bodies, reaction.body, x) - pointVelocity(bodies, reaction.part, x);
         const double normalSpeed = relative.dot(normal);
         const double pressing = std::max(k * length - damping * normalSpeed, 0.0);
         const Vec3 sliding = relative - normalSpeed * normal;

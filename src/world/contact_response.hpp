@@ -15,8 +15,10 @@
 // the body's mass over the masses it presses, capped at m_share / h so the explicit force
 // cannot reverse the approach in one step), so a fast ball does not bounce off a stiff rim with
 // the energy it brought; it never pulls. Coulomb friction acts against the body's sliding over
-// each mass: the force that stops the sliding in one step while within mu_s times the normal
-// force, mu_k times it otherwise; the mass feels the opposite. The body gets each force at the
+// the surface at each mass: the force that stops the sliding in one step while within mu_s
+// times the normal force, mu_k times it otherwise; the mass feels the opposite. Both speeds are
+// the body's relative to the part moving rigidly: a pushed mass's own velocity comes from the
+// restoration, and counting it made a fast ball bounce higher with damping than without. The body gets each force at the
 // mass's position, so also its torque, and RigidBody::deformableContactForce reports the sum.
 //
 // Rigid contacts (neither part deforms) belong to the contact solver (contact_solver.hpp),

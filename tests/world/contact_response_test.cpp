@@ -8,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 using namespace flexfit;
 using flexfit::testing::rigidPart;
 using detail::Bodies;
@@ -148,4 +151,88 @@ TEST(ContactResponse, ADynamicBodyFeelsTheSpringsItDisplaced) {
     ASSERT_GT(expected.norm(), 0.0);
     EXPECT_GT(expected.y(), 0.0);  // pushed down, the rim pushes the ball up
     EXPECT_LT((s.bodies.rigid[ball].force - expected).norm(), 1e-9 * expected.norm());
+}
+
+namespace {
+
+// A ball (density 0.01, about 25 kg) over the container mouth made rigid-deformable, with the
+// given restoration constraint and friction on both.
+struct BallOnRim {
+    World world;
+    BodyId mouth = 0, ball = 0;
+    BallOnRim(double diameter, double constraint, double friction, WorldSettings settings = {}, Vec3 velocity = Vec3::Zero())
+        : world(settings) {
+        PartSettings rim;
+        rim.simulation.restoration = {RestorationMethod::Constraint, 0.0, 0.0, constraint};
+        rim.simulation.globalDamping = 1.0;
+        rim.zones.contactLevel = 3;
+        BodySettings mouthBody;
+        mouthBody.staticFriction = mouthBody.kineticFriction = friction;
+        BodySettings ballBody = flexfit::testing::dynamicBody(velocity);
+        ballBody.density = 0.01;
+        ballBody.staticFriction = ballBody.kineticFriction = friction;
+        mouth = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}}), rim, mouthBody, Pose{});
+        ball = world.add(buildPartModel(makeIcoSphere(diameter / 2, 2)), rigidPart(), ballBody,
+                         flexfit::testing::at(Vec3(0, diameter / 2 + 2.6, 0)));
+    }
+};
+
+// Did a 16 ball pushed with `push` N for 2.5 s get through a soft rim with this friction?
+bool passes(double friction, double push) {
+    BallOnRim s(16.0, 1e-4, friction);
+    for (int i = 0; i < 2500; ++i) {
+        s.world.applyForce(s.ball, Vec3(0, -push, 0));
+        s.world.step();
+    }
+    return s.world.centreOfMass(s.ball).y() < -20.0;
+}
+
+}  // namespace
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kRimFrictions[] = {0.0, 1.0};
+constexpr double kRimPushes[] = {1000.0};
+#else
+constexpr double kRimFrictions[] = {0.0, 0.3, 1.0};
+constexpr double kRimPushes[] = {300.0, 1000.0, 3000.0, 10000.0};
+#endif
+
+TEST(ContactResponse, FrictionOnADeformableRimRaisesThePushNeededToPass) {
+    // The smallest push (of a doubling ladder) that gets a 16 ball through the soft rim grows
+    // with the friction: the rim's masses hold the ball's surface as it slides past them.
+    std::vector<double> needed;
+    for (double friction : kRimFrictions) {
+        double smallest = std::numeric_limits<double>::infinity();
+        for (double push : kRimPushes)
+            if (passes(friction, push)) {
+                smallest = push;
+                break;
+            }
+        needed.push_back(smallest);
+    }
+    EXPECT_TRUE(std::isfinite(needed.front())) << "frictionless, some push passes";
+    for (std::size_t i = 1; i < needed.size(); ++i) EXPECT_GE(needed[i], needed[i - 1]) << "friction " << kRimFrictions[i];
+    EXPECT_GT(needed.back(), needed.front());
+}
+
+TEST(ContactResponse, TheReactionIsDampedAndReported) {
+    // A 17 ball thrown at 100 units/s onto a stiff rim (no gravity): it bounces back slower than
+    // it came (no energy gained), and slower with the contact damping than without. While it
+    // presses, the force it feels is reported and points out of the rim (+y).
+    double rebound[2] = {0.0, 0.0};
+    for (int damped = 0; damped < 2; ++damped) {
+        WorldSettings settings;
+        settings.gravity = Vec3::Zero();
+        settings.contactDamping = damped;
+        BallOnRim s(17.0, 5e-3, 0.0, settings, Vec3(0, -100, 0));
+        double reported = 0.0;
+        for (int i = 0; i < 1500; ++i) {
+            s.world.step();
+            rebound[damped] = std::max(rebound[damped], s.world.body(s.ball).linearVelocity.y());
+            reported = std::max(reported, s.world.body(s.ball).deformableContactForce.y());
+        }
+        EXPECT_GT(reported, 0.0);
+        EXPECT_LT(rebound[damped], 100.0);
+    }
+    EXPECT_LT(rebound[1], 0.8 * rebound[0]);
 }

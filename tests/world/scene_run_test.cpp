@@ -155,7 +155,7 @@ struct GoldenScene {
 };
 
 const GoldenScene kGoldenScenes[] = {
-    {"ball_torus.toml", "4372e99d59cae164"},   {"ball_torus_haptic.toml", "8aef0c49fa3bf18c"},
+    {"ball_torus.toml", "4372e99d59cae164"},   {"ball_torus_haptic.toml", "0725a3112c0fb200"},
     {"ball_torus_rigid.toml", "b4498b85a813732e"}, {"contact.toml", "6f71c49d7327c00a"},
     {"restoration.toml", "2bc6f95d3b2e0cfe"},  {"snap_vector.toml", "9ae6d4634631f9cc"},
     {"zones.toml", "8256e010fa0e79ca"},
