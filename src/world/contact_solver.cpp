@@ -41,6 +41,16 @@ void applyImpulse(const Vec3& p, const ContactSolver& s, const SolverContact& c,
     }
 }
 
+// Rigid contacts; and a dynamic deforming body's contacts with static or kinematic rigid parts
+// (its rigid motion meets them as a rigid body's would; the response deforms it there).
+bool solvedByImpulses(const Bodies& bodies, BodyId a, BodyId b) {
+    const bool da = bodies.parts[a]->deforms(), db = bodies.parts[b]->deforms();
+    if (!da && !db) return isDynamic(bodies, a) || isDynamic(bodies, b);
+    if (da && db) return false;
+    const BodyId deforming = da ? a : b, other = da ? b : a;
+    return isDynamic(bodies, deforming) && !isDynamic(bodies, other);
+}
+
 // Two unit tangents completing the normal to an orthonormal frame.
 void tangentsOf(const Vec3& n, Vec3& t1, Vec3& t2) {
     const Vec3 helper = std::abs(n.x()) < 0.57 ? Vec3::UnitX() : Vec3::UnitY();
@@ -94,8 +104,7 @@ void updateInverseInertia(const Bodies& bodies, ContactSolver& solver) {
 void addContacts(std::span<const Contact> contacts, const Bodies& bodies, ContactSolver& solver) {
     for (const Contact& contact : contacts) {
         const BodyId a = contact.partA, b = contact.partB;
-        if (bodies.parts[a]->deforms() || bodies.parts[b]->deforms()) continue;
-        if (!isDynamic(bodies, a) && !isDynamic(bodies, b)) continue;
+        if (!solvedByImpulses(bodies, a, b)) continue;
         const RigidBody& ba = bodies.rigid[a];
         const RigidBody& bb = bodies.rigid[b];
         SolverContact c;

@@ -1,6 +1,8 @@
 // Internal to src/world: the contact solver stage (world.hpp, "Contacts"). It runs inside the
 // rigid motion's sub-steps, on the contacts between bodies whose parts do not deform (rigid
-// mode), at least one of them dynamic.
+// mode), at least one of them dynamic; and on a dynamic deforming body's contacts with static
+// or kinematic rigid parts (its rigid motion meets them as a rigid body's would, while the
+// contact response deforms it there).
 //
 // Sequential impulses (Catto's, as Box2D and Jolt use): each contact point is a normal
 // constraint (relative normal speed >= 0, impulse >= 0) and two friction constraints along the
@@ -57,7 +59,7 @@ double combinedRestitution(double a, double b);
 void updateInverseInertia(const Bodies& bodies, ContactSolver& solver);
 
 // Appends one solver point per contact, with its effective masses and approach speed. Skips
-// contacts where a part deforms or neither body is dynamic.
+// the contacts the solver does not own (see above).
 void addContacts(std::span<const Contact> contacts, const Bodies& bodies, ContactSolver& solver);
 
 // After the sub-step's move: each point's lever arms from the bodies' new centres of mass to

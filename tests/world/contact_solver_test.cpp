@@ -207,3 +207,20 @@ TEST(ContactSolver, AStackStaysAtRest) {
     EXPECT_LT(drift, 1e-3);
     EXPECT_LT(turn, 1e-3);
 }
+
+TEST(ContactSolver, ADeformingDynamicBodyLandsOnARigidFloor) {
+    // A rigid-deformable ball falls on a rigid floor: its rigid motion stops there like a rigid
+    // body's (no fall through, no speed piling up while held), and the floor deforms it.
+    World world(WorldSettings{1e-3, Vec3(0, -kG, 0), {}, 0.25, 4096, 8});
+    world.add(buildPartModel(makeBox(Vec3(5, 1, 5), 1)), rigidPart(), withFriction({}, 0.5, 0.5), at(Vec3(0, -1, 0)));
+    const BodyId ball = world.add(buildPartModel(makeIcoSphere(1.0, 3)), PartSettings{}, withFriction(dynamicBody(), 0.5, 0.5), at(Vec3(0, 1.5, 0)));
+    double lowest = 10.0;
+    for (int i = 0; i < 2000; ++i) {
+        world.step();
+        lowest = std::min(lowest, world.centreOfMass(ball).y());
+    }
+    EXPECT_GT(lowest, 0.9);
+    EXPECT_LT(std::abs(world.body(ball).linearVelocity.y()), 0.05);  // 2 s of fall would be 19.6
+    EXPECT_NEAR(world.centreOfMass(ball).y(), 1.0, 0.05);
+    EXPECT_GT(world.part(ball).movingMasses().size(), 0u);
+}
