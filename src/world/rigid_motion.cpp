@@ -93,13 +93,12 @@ void gatherContacts(Bodies& bodies, CollisionWorld& collision, RigidMotionScratc
         s.startDepth[id] = deepestStop(id, contacts, bodies);
         if (bodies.rigid[id].motion != MotionType::Dynamic) continue;
         // A pair of dynamic bodies is added by the lower id's query.
-        const auto firstIndex = s.solver.contacts.size();
-        addContacts(contacts, bodies, s.solver);
-        std::erase_if(s.solver.contacts, [&, i = std::size_t(0)](const SolverContact& c) mutable {
-            const bool fresh = i++ >= firstIndex;
-            const BodyId other = c.a == id ? c.b : c.a;
-            return fresh && other < id && bodies.rigid[other].motion == MotionType::Dynamic;
-        });
+        s.unseen.clear();
+        for (const Contact& c : contacts) {
+            const BodyId other = c.partA == id ? c.partB : c.partA;
+            if (other > id || bodies.rigid[other].motion != MotionType::Dynamic) s.unseen.push_back(c);
+        }
+        addContacts(s.unseen, bodies, s.solver);
     }
     s.cachedBody.reset();
 }
@@ -217,7 +216,9 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
         RigidBody& body = bodies.rigid[id];
         const Pose& start = s.stepStart[id];
         const Pose& end = bodies.parts[id]->pose();
-        const Eigen::AngleAxisd turn(end.rotation * start.rotation.conjugate());
+        Eigen::Quaterniond rotation = end.rotation * start.rotation.conjugate();
+        if (rotation.w() < 0.0) rotation.coeffs() *= -1.0;  // the short way round
+        const Eigen::AngleAxisd turn(rotation);
         body.linearVelocity = (end.apply(body.centreOfMass) - start.apply(body.centreOfMass)) / h;
         body.angularVelocity = turn.axis() * (turn.angle() / h);
     }
