@@ -38,12 +38,18 @@ double deformation(const Part& part) {
     return d;
 }
 
+// metrics.csv: one row per step (time at its end); counts over the world, the operator's
+// coupling, per-stage microseconds; then per part, in scene order: its centre of mass
+// (<part>_x, _y, _z; moving parts), the force deformable parts pressed on it in the step
+// (<part>_contact_fx, _fy, _fz, world frame, RigidBody::deformableContactForce; dynamic parts)
+// and its largest deformation (<part>_deformation; parts that deform).
 std::string csvHeader(const Scene& scene) {
     std::string h = "time,contacts,zones,moving_masses,computed_springs,coupling_fx,coupling_fy,coupling_fz,coupling_tx,coupling_ty,coupling_tz";
     for (std::size_t s = 0; s < kStageCount; ++s) h += std::string(",us_") + toString(Stage(s));
     h += ",us_world_step";
     for (const ScenePart& p : scene.parts) {
         if (p.body.motion != MotionType::Static) h += "," + p.name + "_x," + p.name + "_y," + p.name + "_z";
+        if (p.body.motion == MotionType::Dynamic) h += "," + p.name + "_contact_fx," + p.name + "_contact_fy," + p.name + "_contact_fz";
         if (p.part.mode != PartMode::Rigid) h += "," + p.name + "_deformation";
     }
     return h + "\n";
@@ -60,6 +66,10 @@ std::string csvRow(const Scene& scene, const World& w) {
         if (scene.parts[id].body.motion != MotionType::Static) {
             const Vec3 p = w.centreOfMass(id);
             row += fmt::format(",{:.9g},{:.9g},{:.9g}", p.x(), p.y(), p.z());
+        }
+        if (scene.parts[id].body.motion == MotionType::Dynamic) {
+            const Vec3& f = w.body(id).deformableContactForce;
+            row += fmt::format(",{:.9g},{:.9g},{:.9g}", f.x(), f.y(), f.z());
         }
         if (scene.parts[id].part.mode != PartMode::Rigid) row += fmt::format(",{:.9g}", deformation(w.part(id)));
     }

@@ -205,9 +205,11 @@ TriMesh generatePartMesh(Table& t) {
         mesh = makeBox(half, g.integer("divisions", 1, 1, 256));
     } else {
         const Vec3 half = g.vec3("half_extents", Vec3(2.0, 0.5, 2.0));
+        if (!(half.minCoeff() > 0.0)) g.fail(*g.node("half_extents"), "half_extents", "must be > 0");
+        // A hole key left out is half the plate's, so only a given one can be too wide.
         const double hx = g.positive("hole_x", 0.5 * half.x()), hz = g.positive("hole_z", 0.5 * half.z());
-        if (!(half.minCoeff() > 0.0) || !(hx < half.x()) || !(hz < half.z()))
-            g.fail("plate needs half_extents > 0 and a hole (hole_x, hole_z) smaller than them");
+        if (!(hx < half.x())) g.fail(*g.node("hole_x"), "hole_x", "must be smaller than the plate's half extent along x (half_extents[0])");
+        if (!(hz < half.z())) g.fail(*g.node("hole_z"), "hole_z", "must be smaller than the plate's half extent along z (half_extents[2])");
         mesh = makePlateWithHole(half, hx, hz);
     }
     g.finish();

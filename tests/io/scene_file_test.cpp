@@ -1,9 +1,11 @@
 // Scene files: every error class names the file, the line and the key, and nothing is built;
-// a valid scene gives exactly the values it states (checked key by key against the text).
+// a valid scene gives exactly the values it states (checked key by key against the text),
+// contact materials, the contact solver's settings and the box and plate generators included.
 #include "flexfit/scene_file.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 using namespace flexfit;
@@ -216,4 +218,150 @@ TEST(SceneFile, OldSpellingsAreReadWithAWarningNamingTheNewOne) {
     EXPECT_EQ(s.warnings[1].line, 12u);
     EXPECT_EQ(s.warnings[1].message, "part 1, key 'restoration': 'anchor' is deprecated: write 'anchors'");
     EXPECT_TRUE(parseScene(kBall, "scene.toml", ".").warnings.empty());
+}
+
+// --- Contact materials, the contact solver's settings and the box and plate generators. ---
+
+namespace {
+
+// `text` with `line` inserted after the line holding `after`.
+std::string insertedAfter(std::string text, const std::string& after, const std::string& line) {
+    text.insert(text.find('\n', text.find(after)) + 1, line + "\n");
+    return text;
+}
+
+// `text` with `from` (which it holds) replaced by `to`.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+    text.replace(text.find(from), from.size(), to);
+    return text;
+}
+
+const std::string kSphere = "generator = { type = \"sphere\", radius = 8.5, level = 2 }";  // the ball's, line 18
+const std::string kMouth = "generator = \"container-mouth\"";                              // the mouth's, line 9
+
+std::string withBallGenerator(const std::string& generator) { return replaced(kBall, kSphere, generator); }
+std::string withMouthGenerator(const std::string& generator) { return replaced(kBall, kMouth, generator); }
+
+Eigen::AlignedBox3d boundsOf(const TriMesh& mesh) {
+    Eigen::AlignedBox3d b;
+    for (const Vec3& v : mesh.vertices) b.extend(v);
+    return b;
+}
+
+}  // namespace
+
+TEST(SceneFile, ParsesContactMaterialsAndSolverSettings) {
+    const std::string text = insertedAfter(withLine("duration = 2.5", "contact_slop = 0.02\ncontact_damping = 0.5"), "name = \"ball\"",
+                                           "static_friction = 0.6\nkinetic_friction = 0.4\nrestitution = 0.3");
+    const Scene s = parseScene(text, "scene.toml", ".");
+    EXPECT_EQ(s.world.contactSlop, 0.02);
+    EXPECT_EQ(s.world.contactDamping, 0.5);
+    EXPECT_EQ(s.parts[1].body.staticFriction, 0.6);
+    EXPECT_EQ(s.parts[1].body.kineticFriction, 0.4);
+    EXPECT_EQ(s.parts[1].body.restitution, 0.3);
+    // Left out: frictionless, inelastic, the world's defaults.
+    EXPECT_EQ(s.parts[0].body.staticFriction, 0.0);
+    EXPECT_EQ(s.parts[0].body.kineticFriction, 0.0);
+    EXPECT_EQ(s.parts[0].body.restitution, 0.0);
+    const Scene plain = parseScene(kBall, "scene.toml", ".");
+    EXPECT_EQ(plain.world.contactSlop, WorldSettings{}.contactSlop);
+    EXPECT_EQ(plain.world.contactDamping, WorldSettings{}.contactDamping);
+    // The limits themselves are valid: mu_k = mu_s, restitution 1, slop 1, no damping.
+    const std::string limits = withLine("duration = 2.5", "contact_slop = 1\ncontact_damping = 0");
+    EXPECT_EQ(errorOf(limits), "");
+    EXPECT_EQ(errorOf(withLine("name = \"ball\"", "static_friction = 0.5\nkinetic_friction = 0.5\nrestitution = 1")), "");
+}
+
+TEST(SceneFile, KineticFrictionDefaultsToTheStaticOne) {
+    const Scene s = parseScene(withLine("name = \"ball\"", "static_friction = 0.7"), "scene.toml", ".");
+    EXPECT_EQ(s.parts[1].body.staticFriction, 0.7);
+    EXPECT_EQ(s.parts[1].body.kineticFriction, 0.7);
+}
+
+TEST(SceneFile, KineticFrictionAboveTheStaticOneIsReported) {
+    const std::string e = errorOf(withLine("name = \"ball\"", "static_friction = 0.3\nkinetic_friction = 0.5"));
+    EXPECT_NE(e.find("scene.toml:19: part 2, key 'kinetic_friction': must not exceed static_friction"), std::string::npos) << e;
+    // A kinetic coefficient alone exceeds the static one's default, 0.
+    const std::string alone = errorOf(withLine("name = \"ball\"", "kinetic_friction = 0.2"));
+    EXPECT_NE(alone.find(":18: part 2, key 'kinetic_friction': must not exceed static_friction"), std::string::npos) << alone;
+}
+
+TEST(SceneFile, NegativeFrictionIsReported) {
+    const std::string e = errorOf(withLine("name = \"ball\"", "static_friction = -0.1"));
+    EXPECT_NE(e.find("scene.toml:18: part 2, key 'static_friction': must be >= 0"), std::string::npos) << e;
+    const std::string kinetic = errorOf(withLine("name = \"ball\"", "static_friction = 0.5\nkinetic_friction = -0.1"));
+    EXPECT_NE(kinetic.find("scene.toml:19: part 2, key 'kinetic_friction': must be >= 0"), std::string::npos) << kinetic;
+}
+
+TEST(SceneFile, RestitutionAboveOneIsReported) {
+    const std::string e = errorOf(withLine("name = \"ball\"", "restitution = 1.5"));
+    EXPECT_NE(e.find("scene.toml:18: part 2, key 'restitution': must be in [0, 1]"), std::string::npos) << e;
+    const std::string negative = errorOf(withLine("name = \"ball\"", "restitution = -0.5"));
+    EXPECT_NE(negative.find(":18: part 2, key 'restitution': must be >= 0"), std::string::npos) << negative;
+}
+
+TEST(SceneFile, ContactSlopAndDampingOutOfRangeAreReported) {
+    const std::string e = errorOf(withLine("duration = 2.5", "contact_slop = 1.5"));
+    EXPECT_NE(e.find("scene.toml:6: scene.world, key 'contact_slop': must be in (0, 1]"), std::string::npos) << e;
+    const std::string zero = errorOf(withLine("duration = 2.5", "contact_slop = 0"));
+    EXPECT_NE(zero.find(":6: scene.world, key 'contact_slop': must be > 0"), std::string::npos) << zero;
+    const std::string damping = errorOf(withLine("duration = 2.5", "contact_damping = -1"));
+    EXPECT_NE(damping.find(":6: scene.world, key 'contact_damping': must be >= 0"), std::string::npos) << damping;
+}
+
+TEST(SceneFile, BoxAndPlateGeneratorsGiveTheShapesTheyState) {
+    const std::string text = replaced(withMouthGenerator("generator = { type = \"plate\", half_extents = [3, 0.5, 4], hole_x = 1, hole_z = 2 }"),
+                                      kSphere, "generator = { type = \"box\", half_extents = [0.5, 1, 2], divisions = 3 }");
+    const Scene s = parseScene(text, "scene.toml", ".");
+    const TriMesh& plate = s.parts[0].model->mesh;
+    EXPECT_EQ(plate.vertices.size(), 16u);
+    EXPECT_EQ(plate.faces.size(), 32u);
+    EXPECT_EQ(boundsOf(plate).max(), Vec3(3, 0.5, 4));
+    EXPECT_EQ(boundsOf(plate).min(), Vec3(-3, -0.5, -4));
+    // The hole's corners: (+-1, +-0.5, +-2).
+    std::size_t holeCorners = 0;
+    for (const Vec3& v : plate.vertices) holeCorners += std::abs(v.x()) == 1.0 && std::abs(v.z()) == 2.0;
+    EXPECT_EQ(holeCorners, 8u);
+    const TriMesh& ball = s.parts[1].model->mesh;
+    EXPECT_EQ(ball.vertices.size(), 6u * 3u * 3u + 2u);  // 6 d^2 + 2
+    EXPECT_EQ(boundsOf(ball).max(), Vec3(0.5, 1, 2));
+    EXPECT_EQ(boundsOf(ball).min(), Vec3(-0.5, -1, -2));
+    // Defaults: a unit box of one quad per face; a 4 x 1 x 4 plate with a hole half its size.
+    const Scene d = parseScene(withBallGenerator("generator = { type = \"box\" }"), "scene.toml", ".");
+    EXPECT_EQ(d.parts[1].model->mesh.vertices.size(), 8u);
+    EXPECT_EQ(boundsOf(d.parts[1].model->mesh).max(), Vec3(1, 1, 1));
+    const Scene p = parseScene(withMouthGenerator("generator = { type = \"plate\" }"), "scene.toml", ".");
+    EXPECT_EQ(boundsOf(p.parts[0].model->mesh).max(), Vec3(2, 0.5, 2));
+    holeCorners = 0;
+    for (const Vec3& v : p.parts[0].model->mesh.vertices) holeCorners += std::abs(v.x()) == 1.0 && std::abs(v.z()) == 1.0;
+    EXPECT_EQ(holeCorners, 8u);
+}
+
+TEST(SceneFile, BadBoxHalfExtentsAreReported) {
+    const std::string zero = errorOf(withBallGenerator("generator = { type = \"box\", half_extents = [1, 0, 1] }"));
+    EXPECT_NE(zero.find("scene.toml:18: part 2.generator, key 'half_extents': must be > 0"), std::string::npos) << zero;
+    const std::string negative = errorOf(withBallGenerator("generator = { type = \"box\", half_extents = [1, 1, -2] }"));
+    EXPECT_NE(negative.find(":18: part 2.generator, key 'half_extents': must be > 0"), std::string::npos) << negative;
+    const std::string two = errorOf(withBallGenerator("generator = { type = \"box\", half_extents = [1, 1] }"));
+    EXPECT_NE(two.find(":18: part 2.generator, key 'half_extents': expected an array of 3 numbers"), std::string::npos) << two;
+    const std::string divisions = errorOf(withBallGenerator("generator = { type = \"box\", divisions = 0 }"));
+    EXPECT_NE(divisions.find(":18: part 2.generator, key 'divisions': must be in [1, 256]"), std::string::npos) << divisions;
+    const std::string unknown = errorOf(withBallGenerator("generator = { type = \"box\", half_extent = [1, 1, 1] }"));
+    EXPECT_NE(unknown.find(":18: part 2.generator, key 'half_extent': unknown key"), std::string::npos) << unknown;
+}
+
+TEST(SceneFile, PlateHoleLargerThanThePlateIsReported) {
+    const std::string x = errorOf(withMouthGenerator("generator = { type = \"plate\", half_extents = [2, 0.5, 2], hole_x = 2.5 }"));
+    EXPECT_NE(x.find("scene.toml:9: part 1.generator, key 'hole_x': must be smaller than the plate's half extent along x"),
+              std::string::npos)
+        << x;
+    // As wide as the plate leaves no wall: refused too.
+    const std::string z = errorOf(withMouthGenerator("generator = { type = \"plate\", half_extents = [2, 0.5, 2], hole_z = 2 }"));
+    EXPECT_NE(z.find("scene.toml:9: part 1.generator, key 'hole_z': must be smaller than the plate's half extent along z"),
+              std::string::npos)
+        << z;
+    const std::string half = errorOf(withMouthGenerator("generator = { type = \"plate\", half_extents = [2, 0, 2] }"));
+    EXPECT_NE(half.find("scene.toml:9: part 1.generator, key 'half_extents': must be > 0"), std::string::npos) << half;
+    const std::string hole = errorOf(withMouthGenerator("generator = { type = \"plate\", hole_x = -1 }"));
+    EXPECT_NE(hole.find("scene.toml:9: part 1.generator, key 'hole_x': must be > 0"), std::string::npos) << hole;
 }

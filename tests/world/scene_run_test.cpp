@@ -1,13 +1,19 @@
 // Scripted scene runs against analytic mechanics (impulse of a push, the interpolated grab
-// target), the thesis's ball-through-torus cases with the shipped example scene, and
-// determinism of a whole scene run.
+// target), the thesis's ball-through-torus cases with the shipped example scene, the contact
+// solver's example scenes (incline, peg in hole, stack, ball-torus with friction) against
+// Coulomb's law, and determinism of a whole scene run.
 #include "flexfit/scene_file.hpp"
 #include "flexfit/scene_run.hpp"
 #include "golden.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <stdexcept>
+#include <string_view>
+#include <vector>
 
 using namespace flexfit;
 
@@ -57,6 +63,39 @@ Scene exampleScene(const std::string& file) { return loadScene(std::string(FLEXF
 void runFor(SceneRun& run, double seconds) {
     const int steps = int(std::lround(seconds / run.scene().world.timeStep));
     for (int i = 0; i < steps; ++i) run.step();
+}
+
+BodyId partNamed(const Scene& scene, std::string_view name) {
+    const std::optional<BodyId> id = scene.find(name);
+    if (!id) throw std::runtime_error("no part named " + std::string(name));
+    return *id;
+}
+
+// The pair's coefficients by the combining rule (body.hpp): geometric mean.
+double pairStaticFriction(const Scene& scene, BodyId a, BodyId b) {
+    return std::sqrt(scene.parts[a].body.staticFriction * scene.parts[b].body.staticFriction);
+}
+double pairKineticFriction(const Scene& scene, BodyId a, BodyId b) {
+    return std::sqrt(scene.parts[a].body.kineticFriction * scene.parts[b].body.kineticFriction);
+}
+
+// The push the scene gives `body` (its only one).
+Vec3 pushOn(const Scene& scene, BodyId body) {
+    for (const SceneAction& a : scene.actions)
+        if (a.kind == SceneAction::Kind::Push && a.body == body) return a.force;
+    throw std::runtime_error("no push on body " + std::to_string(body));
+}
+
+// Lowest and highest y of the part's vertices in the world.
+std::pair<double, double> heightRange(const World& world, BodyId id) {
+    std::vector<Vec3> positions;
+    world.part(id).worldPositions(positions);
+    double lo = positions[0].y(), hi = lo;
+    for (const Vec3& x : positions) {
+        lo = std::min(lo, x.y());
+        hi = std::max(hi, x.y());
+    }
+    return {lo, hi};
 }
 
 }  // namespace
@@ -124,6 +163,119 @@ INSTANTIATE_TEST_SUITE_P(BothQueries, SceneRunWithQuery,
                          ::testing::Values(RigidDeformableQuery::Faces, RigidDeformableQuery::PointShell),
                          [](const auto& param) { return param.param == RigidDeformableQuery::Faces ? "Faces" : "PointShell"; });
 
+// --- The contact solver's example scenes, against Coulomb's law. ---
+
+TEST(SceneRun, InclineHoldsOneBoxAndSlidesTheOtherWithTheKineticAcceleration) {
+    const Scene scene = exampleScene("incline.toml");
+    const BodyId slope = partNamed(scene, "slope"), holding = partNamed(scene, "holding"), sliding = partNamed(scene, "sliding");
+    const Eigen::Quaterniond tilt = scene.parts[slope].pose.rotation;
+    const Vec3 up = tilt * Vec3::UnitY(), down = -(tilt * Vec3::UnitX());
+    const double g = scene.world.gravity.norm();
+    const double theta = std::acos(up.dot(-scene.world.gravity / g));
+    // The premises the scene states: tan theta between the two boxes' static coefficients.
+    ASSERT_LT(std::tan(theta), pairStaticFriction(scene, slope, holding));
+    ASSERT_GT(std::tan(theta), pairStaticFriction(scene, slope, sliding));
+    ASSERT_LT(down.y(), 0.0);
+    const double muK = pairKineticFriction(scene, slope, sliding);
+    const double expected = g * (std::sin(theta) - muK * std::cos(theta));
+
+    SceneRun run(scene);
+    const World& w = run.world();
+    const Vec3 holdingStart = w.centreOfMass(holding);
+    double holdingMoved = 0.0, v1 = 0.0, t1 = 0.0;
+    while (!run.finished()) {
+        run.step();
+        holdingMoved = std::max(holdingMoved, (w.centreOfMass(holding) - holdingStart).norm());
+        if (std::abs(w.time() - 0.2) < 1e-9) {  // past the first contact's settling
+            v1 = w.body(sliding).linearVelocity.dot(down);
+            t1 = w.time();
+        }
+    }
+    EXPECT_LT(holdingMoved, 1e-3);
+    const double a = (w.body(sliding).linearVelocity.dot(down) - v1) / (w.time() - t1);
+    EXPECT_NEAR(a / expected, 1.0, 0.02) << "a = " << a << ", g (sin theta - mu_k cos theta) = " << expected;
+    // It slid the distance that acceleration gives (4.7 in the 2 s), not a little.
+    EXPECT_GT((w.centreOfMass(sliding) - scene.parts[sliding].pose.translation).dot(down), 0.4 * expected * w.time() * w.time());
+}
+
+TEST(SceneRun, PegSticksInItsHoleWhenPushedTooWeaklyAndPassesWhenPushedHarder) {
+    // A peg pushed with a side force Fs on the hole's wall and a down force Fd slides down iff
+    // Fd + m g > mu_s Fs (mu: the pair's, by the combining rule).
+    const Scene scene = exampleScene("peg_in_hole.toml");
+    const BodyId weakPlate = partNamed(scene, "plate_weak"), strongPlate = partNamed(scene, "plate_strong");
+    const BodyId weak = partNamed(scene, "weak"), strong = partNamed(scene, "strong");
+    SceneRun run(scene);
+    const World& w = run.world();
+    const double g = scene.world.gravity.norm();
+    auto downLoad = [&](BodyId peg) { return -pushOn(scene, peg).y() + w.body(peg).mass * g; };
+    auto friction = [&](BodyId peg, BodyId plate) { return pairStaticFriction(scene, peg, plate) * pushOn(scene, peg).x(); };
+    ASSERT_LT(downLoad(weak), 0.9 * friction(weak, weakPlate));      // 15.0 against 20
+    ASSERT_GT(downLoad(strong), 1.1 * friction(strong, strongPlate));  // 35.0 against 20
+
+    const Vec3 weakStart = w.centreOfMass(weak);
+    const auto [weakPlateBottom, weakPlateTop] = heightRange(w, weakPlate);
+    const double strongPlateBottom = heightRange(w, strongPlate).first;
+    // The strong peg slides down the wall with a = (Fd + m g - mu_k Fs) / m while it is wholly in
+    // the hole (the first 0.1 s: 0.19 of its 0.9 to go).
+    runFor(run, 0.1);
+    const double a = (downLoad(strong) - pairKineticFriction(scene, strong, strongPlate) * pushOn(scene, strong).x()) / w.body(strong).mass;
+    EXPECT_NEAR(-w.body(strong).linearVelocity.y() / (a * w.time()), 1.0, 0.02) << "a = " << a;
+    double weakMoved = 0.0;
+    while (!run.finished()) {
+        run.step();
+        weakMoved = std::max(weakMoved, (w.centreOfMass(weak) - weakStart).norm());
+    }
+    EXPECT_LT(weakMoved, 1e-3);                                // stuck where it was put
+    EXPECT_GT(heightRange(w, weak).first, weakPlateBottom);    // still in its hole
+    EXPECT_LT(heightRange(w, weak).second, weakPlateTop);
+    EXPECT_LT(heightRange(w, strong).second, strongPlateBottom);  // wholly below its plate: through
+}
+
+TEST(SceneRun, StackStaysInItsSettledPose) {
+    const Scene scene = exampleScene("stack.toml");
+    std::vector<BodyId> boxes;
+    for (const char* name : {"bottom", "middle", "top"}) boxes.push_back(partNamed(scene, name));
+    SceneRun run(scene);
+    const World& w = run.world();
+    runFor(run, 0.2);  // settle into the contacts (each box starts 1e-4 above the one below)
+    std::vector<Pose> settled;
+    for (BodyId id : boxes) settled.push_back(w.part(id).pose());
+    EXPECT_LT((settled[0].translation - scene.parts[boxes[0]].pose.translation).norm(), 1e-3);  // settled where it was put
+    double drift = 0.0, turn = 0.0;
+    while (!run.finished()) {
+        run.step();
+        for (std::size_t k = 0; k < boxes.size(); ++k) {
+            drift = std::max(drift, (w.part(boxes[k]).pose().translation - settled[k].translation).norm());
+            turn = std::max(turn, w.part(boxes[k]).pose().rotation.angularDistance(settled[k].rotation));
+        }
+    }
+    EXPECT_LT(drift, 1e-3);
+    EXPECT_LT(turn, 1e-3);
+}
+
+TEST(SceneRun, FrictionSlowsTheBallThroughTheMouthButItStillPasses) {
+    auto assembled = [](const char* file) {
+        const Scene scene = exampleScene(file);
+        SceneRun run(scene);
+        runFor(run, scene.duration);
+        const World& w = run.world();
+        EXPECT_EQ(w.part(0).movingMasses().size(), 0u) << file;  // the rim restored
+        EXPECT_LT((w.centreOfMass(1) - Vec3(0, -12, 0)).norm(), 1e-9) << file;
+        return w.assemblyEvents();
+    };
+    const Scene scene = exampleScene("ball_torus_friction.toml");
+    ASSERT_GT(pairStaticFriction(scene, 0, 1), 0.0);
+    ASSERT_GT(pairKineticFriction(scene, 0, 1), 0.0);
+    const std::vector<AssemblyEvent> withFriction = assembled("ball_torus_friction.toml");
+    const std::vector<AssemblyEvent> without = assembled("ball_torus.toml");
+    ASSERT_EQ(withFriction.size(), 1u);
+    ASSERT_EQ(without.size(), 1u);
+    EXPECT_EQ(withFriction[0].technique, SnapTechnique::ZoneSnap);
+    EXPECT_LT(withFriction[0].primaryPoseBefore.translation.y(), -8.5 + 1e-9);  // its top below the rim plane
+    EXPECT_GT(withFriction[0].time, without[0].time + 0.1);  // friction held it back (0.99 s against 0.62 s)
+    EXPECT_LT(withFriction[0].time, 1.5);                     // through while the push lasts
+}
+
 TEST(SceneRun, WholeRunIsDeterministic) {
     auto hashOf = [](double startOffset, RigidDeformableQuery query = RigidDeformableQuery::Faces) {
         Scene scene = exampleScene("ball_torus.toml");
@@ -158,7 +310,9 @@ const GoldenScene kGoldenScenes[] = {
     {"ball_torus.toml", "4372e99d59cae164"},   {"ball_torus_haptic.toml", "0725a3112c0fb200"},
     {"ball_torus_rigid.toml", "b4498b85a813732e"}, {"contact.toml", "6f71c49d7327c00a"},
     {"restoration.toml", "2bc6f95d3b2e0cfe"},  {"snap_vector.toml", "9ae6d4634631f9cc"},
-    {"zones.toml", "8256e010fa0e79ca"},
+    {"zones.toml", "8256e010fa0e79ca"},        {"incline.toml", "dba0c26014f5eef3"},
+    {"peg_in_hole.toml", "bbaee4c8797dcd12"},  {"stack.toml", "e7b5b8e0ed26a439"},
+    {"ball_torus_friction.toml", "b0c65fe9c1762920"},
 };
 
 void PrintTo(const GoldenScene& scene, std::ostream* out) { *out << scene.file; }
