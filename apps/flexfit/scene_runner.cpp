@@ -177,8 +177,9 @@ std::string summaryJson(const Scene& scene, const RunSummary& s) {
                      s.maxContacts, s.maxZones, s.maxMovingMasses, s.maxComputedSprings);
     j += fmt::format("  \"max_deformation\": {:.9g},\n  \"last_contact\": {},\n  \"restored_at\": {},\n  \"max_coupling_force\": {:.9g},\n",
                      s.maxDeformation, optionalJson(s.lastContact), optionalJson(s.restored), s.maxCouplingForce);
-    j += fmt::format("  \"substeps\": {},\n  \"world_step_seconds\": {:.9f},\n  \"stage_seconds\": {{", s.profile.substeps,
-                     s.profile.totalStepSeconds);
+    j += fmt::format("  \"substeps\": {},\n  \"cut_moves\": {},\n  \"rigid_queries\": {},\n", s.profile.substeps, s.profile.cutMoves,
+                     s.profile.rigidQueries);
+    j += fmt::format("  \"world_step_seconds\": {:.9f},\n  \"stage_seconds\": {{", s.profile.totalStepSeconds);
     for (std::size_t i = 0; i < kStageCount; ++i)
         j += fmt::format("{}{}: {:.9f}", i ? ", " : "", jsonString(toString(Stage(i))), s.profile.totalSeconds[i]);
     j += "},\n  \"assembly_events\": [";

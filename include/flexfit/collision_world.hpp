@@ -85,9 +85,16 @@ public:
     const Bvh<Sphere>& broadPhaseTree() const { return broadPhase_; }
 
     // --- Narrow phase (narrow_phase.cpp) ---
+    // Contacts already found at the current poses: contactsOf(body, true)'s answer. The narrow
+    // phase copies them for those pairs instead of querying them again.
+    struct KnownContacts {
+        BodyId body = 0;
+        std::span<const Contact> contacts;
+    };
     // The contacts of the candidate pairs of the last update(). Part A of a pair is the
     // pressing one: the rigid part when exactly one is deformable, otherwise the lower id.
-    const std::vector<Contact>& narrowPhase();
+    // Pairs covered by `known` are not queried (stats() does not count them).
+    const std::vector<Contact>& narrowPhase(const KnownContacts* known = nullptr);
     // update(), then narrowPhase(): for a caller without a world.
     const std::vector<Contact>& findContacts();
     // The contacts of one body with every body whose sphere touches its own, without updating

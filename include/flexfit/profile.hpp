@@ -45,7 +45,9 @@ struct Profile {
     double lastStepSeconds = 0.0;                    // the last World::step, whole
     double totalStepSeconds = 0.0;                   // every World::step so far
     std::uint64_t steps = 0;
-    std::uint64_t substeps = 0;  // dynamic sub-steps taken in all (no-tunnelling bound)
+    std::uint64_t substeps = 0;  // sub-steps taken in all (no-tunnelling bound)
+    std::uint64_t cutMoves = 0;  // sub-step moves cut short by the contact slop (bisected)
+    std::uint64_t rigidQueries = 0;  // one body's contact queries inside the sub-steps
 };
 
 }  // namespace flexfit

@@ -5,13 +5,21 @@
 #include <algorithm>
 
 namespace flexfit {
-const std::vector<Contact>& CollisionWorld::narrowPhase() {
+const std::vector<Contact>& CollisionWorld::narrowPhase(const KnownContacts* known) {
     refitted_.clear();
     contacts_.clear();
     stats_ = {};
+    const bool knownRigid = known != nullptr && !parts_[known->body]->deforms();
     for (auto [i, j] : pairs_) {
         if (!pressesFirst(i, j)) std::swap(i, j);
-        queryPair(i, j, contacts_, stats_);
+        const bool covered = knownRigid && (i == known->body || j == known->body) && !parts_[i == known->body ? j : i]->deforms();
+        if (!covered) {
+            queryPair(i, j, contacts_, stats_);
+            continue;
+        }
+        // contactsOf answers the same pair in the same orientation and order.
+        for (const Contact& c : known->contacts)
+            if (c.partA == i && c.partB == j) contacts_.push_back(c);
     }
     return contacts_;
 }

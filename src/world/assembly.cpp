@@ -106,6 +106,7 @@ void assemble(const StepContext& step, std::span<const Contact> contacts, Assemb
         }
         const double s = rule.snapDuration > 0.0 ? (step.time + step.timeStep - state.start) / rule.snapDuration : 1.0;
         primary.setPose(interpolate(state.from, target, s));
+        ++bodies.poseEpoch;
         if (s >= 1.0) state.phase = RuleState::Phase::Assembled;  // and stays attached
     }
 }

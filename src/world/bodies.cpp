@@ -46,6 +46,7 @@ BodyId Bodies::add(std::unique_ptr<Part> part, const RigidBody& body) {
     parts.push_back(std::move(part));
     rigid.push_back(body);
     kinematicTargets.emplace_back();
+    ++poseEpoch;
     return BodyId(parts.size() - 1);
 }
 

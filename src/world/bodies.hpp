@@ -19,6 +19,9 @@ struct Bodies {
     // (nbody + 1) the world's mass numbering: body b's masses are massAdr[b] .. massAdr[b+1]-1,
     // so per-mass scratch of the contact response spans every body.
     std::vector<Index> massAdr{0};
+    // Bumped whenever a body is added or a stage other than rigid motion moves one (a snap):
+    // contacts the rigid motion kept from an earlier step are stale then.
+    std::uint64_t poseEpoch = 0;
 
     std::size_t size() const { return parts.size(); }
     Index massCount() const { return massAdr.back(); }

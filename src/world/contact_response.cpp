@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <numeric>
 
 namespace flexfit::detail {
@@ -42,51 +43,73 @@ void displacePushedMasses(Bodies& bodies, const ContactResponse& r) {
     for (const ContactResponse::Push& p : r.pushes) bodies.parts[p.body]->displaceMass(p.mass, p.displacement);
 }
 
-// Velocity of the material point at world position x of a body: its rigid motion, plus the
-// mass's own velocity when the point is a moving mass of a deforming part.
-Vec3 pointVelocity(const Bodies& bodies, BodyId id, const Vec3& x) {
-    const RigidBody& b = bodies.rigid[id];
-    return b.linearVelocity + b.angularVelocity.cross(x - bodies.centreOfMass(id));
+// What every reaction between one pressing body and one deformable part shares.
+struct PairTerms {
+    Vec3 bodyCentre, bodyVelocity, bodySpin, partCentre, partVelocity, partSpin;
+    double stiffness = 0.0, share = 0.0, damping = 0.0, staticFriction = 0.0, kineticFriction = 0.0;
+
+    PairTerms(const Bodies& bodies, BodyId body, BodyId part, double stiffness_, std::uint32_t pressed, double dampingRatio, double h)
+        : bodyCentre(bodies.centreOfMass(body)), bodyVelocity(bodies.rigid[body].linearVelocity),
+          bodySpin(bodies.rigid[body].angularVelocity), partCentre(bodies.centreOfMass(part)),
+          partVelocity(bodies.rigid[part].linearVelocity), partSpin(bodies.rigid[part].angularVelocity), stiffness(stiffness_) {
+        share = bodies.rigid[body].mass / double(pressed);  // of the body's mass, per mass pressed
+        damping = std::min(2.0 * dampingRatio * std::sqrt(stiffness * share), share / h);
+        staticFriction = combinedFriction(bodies.rigid[body].staticFriction, bodies.rigid[part].staticFriction);
+        kineticFriction = combinedFriction(bodies.rigid[body].kineticFriction, bodies.rigid[part].kineticFriction);
+    }
+    // The body's motion over the part's surface at x, the part taken as moving rigidly: a
+    // pushed mass's own velocity is what the restoration gives it, not the surface's resistance.
+    Vec3 relativeVelocity(const Vec3& x) const {
+        return bodyVelocity + bodySpin.cross(x - bodyCentre) - partVelocity - partSpin.cross(x - partCentre);
+    }
+};
+
+// Coulomb friction on the body against its sliding: the force that stops it in one step while
+// within mu_s times the normal force, mu_k times it otherwise.
+Vec3 frictionForce(const PairTerms& t, const Vec3& sliding, double pressing, double h) {
+    const double speed = sliding.norm();
+    if (!(speed > 0.0)) return Vec3::Zero();
+    const double stopping = t.share * speed / h;
+    const double magnitude = stopping <= t.staticFriction * pressing ? stopping : t.kineticFriction * pressing;
+    return -(magnitude / speed) * sliding;
 }
 
 // Each reaction: the spring force k_eff (rest - x) of the mass, damped along it by the body's
-// approach, never pulling; Coulomb friction against the body's sliding over the mass, which
-// feels the opposite; the body gets the force and its torque.
+// approach, never pulling; Coulomb friction against the body's sliding over the surface, which
+// the mass feels the opposite of; the body gets the force and its torque.
 void applyReactionForces(const StepContext& step, double dampingRatio, Bodies& bodies, ContactResponse& r) {
     for (RigidBody& b : bodies.rigid) b.deformableContactForce.setZero();
     r.reactionCount.assign(bodies.size(), 0u);
     for (const ContactResponse::Reaction& reaction : r.reactions) ++r.reactionCount[reaction.body];
+    const double h = step.timeStep;
+    std::optional<PairTerms> terms;
+    BodyId body = 0, partId = 0;
     for (const ContactResponse::Reaction& reaction : r.reactions) {
-        Part& p = *bodies.parts[reaction.part];
-        const Vec3 displacement = p.pose().rotate(p.state().positions[reaction.mass] - p.model().restPositions[reaction.mass]);
+        if (!terms || reaction.body != body || reaction.part != partId) {  // reactions come grouped by pair
+            body = reaction.body;
+            partId = reaction.part;
+            terms.emplace(bodies, body, partId, r.stiffness[partId], r.reactionCount[body], dampingRatio, h);
+        }
+        Part& p = *bodies.parts[partId];
+        const Vec3& local = p.state().positions[reaction.mass];
+        const Vec3 displacement = p.pose().rotate(local - p.model().restPositions[reaction.mass]);
         const double length = displacement.norm();
         if (!(length > 0.0)) continue;
-        RigidBody& body = bodies.rigid[reaction.body];
-        const double k = r.stiffness[reaction.part];
-        const double share = body.mass / double(r.reactionCount[reaction.body]);  // of the body's mass, per mass pressed
-        const double damping = std::min(2.0 * dampingRatio * std::sqrt(k * share), share / step.timeStep);
         const Vec3 normal = -displacement / length;  // the way the mass pushes the body
-        const Vec3 x = p.worldPosition(reaction.mass);
-        // The body's motion over the part's surface, taken as it moves rigidly: a pushed mass's
-        // own velocity is what the restoration gives it, not the surface's resistance.
-        const Vec3 relative = pointVelocity(bodies, reaction.body, x) - pointVelocity(bodies, reaction.part, x);
+        const Vec3 x = p.pose().apply(local);
+        const Vec3 relative = terms->relativeVelocity(x);
         const double normalSpeed = relative.dot(normal);
-        const double pressing = std::max(k * length - damping * normalSpeed, 0.0);
-        const Vec3 sliding = relative - normalSpeed * normal;
-        const double slidingSpeed = sliding.norm();
-        Vec3 friction = Vec3::Zero();
-        if (slidingSpeed > 0.0) {
-            const RigidBody& other = bodies.rigid[reaction.part];
-            const double stopping = share * slidingSpeed / step.timeStep;  // stops the sliding in one step
-            const double limit = combinedFriction(body.staticFriction, other.staticFriction) * pressing;
-            const double magnitude = stopping <= limit ? stopping : combinedFriction(body.kineticFriction, other.kineticFriction) * pressing;
-            friction = -(magnitude / slidingSpeed) * sliding;
-            if (magnitude > 0.0) p.applyForce(reaction.mass, -friction);
+        const double pressing = std::max(terms->stiffness * length - terms->damping * normalSpeed, 0.0);
+        Vec3 force = pressing * normal;
+        if (terms->staticFriction > 0.0) {
+            const Vec3 friction = frictionForce(*terms, relative - normalSpeed * normal, pressing, h);
+            if (friction != Vec3::Zero()) p.applyForce(reaction.mass, -friction);
+            force += friction;
         }
-        const Vec3 force = pressing * normal + friction;
-        body.force += force;
-        body.torque += (x - bodies.centreOfMass(reaction.body)).cross(force);
-        body.deformableContactForce += force;
+        RigidBody& b = bodies.rigid[body];
+        b.force += force;
+        b.torque += (x - terms->bodyCentre).cross(force);
+        b.deformableContactForce += force;
     }
 }
 

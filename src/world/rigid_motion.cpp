@@ -79,6 +79,7 @@ std::span<const Contact> rigidContactsOf(BodyId id, Bodies& bodies, CollisionWor
     const std::vector<Contact>& contacts = collision.contactsOf(id, true);
     clearRefittedChanges(collision, bodies);
     profiler.enter(outer);
+    ++s.queries;
     return contacts;
 }
 
@@ -100,7 +101,14 @@ void gatherContacts(Bodies& bodies, CollisionWorld& collision, RigidMotionScratc
         }
         addContacts(s.unseen, bodies, s.solver);
     }
-    s.cachedBody.reset();
+}
+
+// The body's last query stays usable while nothing moves; not for a deforming body, whose
+// shape changes between steps.
+void keepCache(BodyId id, const Bodies& bodies, RigidMotionScratch& s) {
+    if (bodies.parts[id]->deforms()) return;
+    s.cachedBody = id;
+    s.cacheEpoch = bodies.poseEpoch;
 }
 
 // 3. Moves the body along its velocities for dt, or as far as it goes without getting deeper
@@ -137,7 +145,7 @@ bool advanceConservatively(BodyId id, double dt, double allowed, double bound, c
         reached = fraction;
     }
     if (reached == 1.0) {
-        s.cachedBody = id;
+        keepCache(id, bodies, s);
         return true;
     }
     for (int i = 0; i < kBisections; ++i) {
@@ -145,13 +153,12 @@ bool advanceConservatively(BodyId id, double dt, double allowed, double bound, c
         (fits(middle) ? reached : blocked) = middle;
     }
     part.setPose(reached > 0.0 ? advancedPose(start, reached * dt, body) : start);
-    if (reached > 0.0) s.cachedBody = id;
+    if (reached > 0.0) keepCache(id, bodies, s);
     return false;
 }
 
 // 5. A kinematic body's pushes on the deformable parts it meets mid-step.
-void pressDeformableParts(BodyId id, Bodies& bodies, CollisionWorld& collision, ContactResponse& response,
-                          RigidMotionScratch& s, StepProfiler& profiler) {
+void pressDeformableParts(BodyId id, Bodies& bodies, CollisionWorld& collision, ContactResponse& response, StepProfiler& profiler) {
     const Stage outer = profiler.running();
     profiler.enter(Stage::NarrowPhase);
     const std::vector<Contact>& contacts = collision.contactsOf(id, false);
@@ -159,7 +166,6 @@ void pressDeformableParts(BodyId id, Bodies& bodies, CollisionWorld& collision, 
     profiler.enter(Stage::ContactResponse);
     pushDeformableMasses(contacts, bodies, response);
     profiler.enter(outer);
-    s.cachedBody.reset();
 }
 
 int substepCount(double h, const WorldSettings& settings, const Bodies& bodies, const RigidMotionScratch& s) {
@@ -170,6 +176,12 @@ int substepCount(double h, const WorldSettings& settings, const Bodies& bodies, 
 }
 
 }  // namespace
+
+const CollisionWorld::KnownContacts* knownContacts(RigidMotionScratch& s, const Bodies& bodies) {
+    if (!s.cachedBody || s.cacheEpoch != bodies.poseEpoch) return nullptr;
+    s.known = {*s.cachedBody, s.cached};
+    return &s.known;
+}
 
 void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bodies& bodies, CollisionWorld& collision,
                      ContactResponse& response, RigidMotionScratch& s, StepProfiler& profiler, Profile& profile) {
@@ -188,7 +200,9 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
     // the slop, so the separation only corrects drift.
     const Separation separation{kSeparationShare / dt, kLinearSlopShare * slop, slop / h};
     s.stopped.assign(bodies.size(), 0);
-    s.cachedBody.reset();
+    // The last mover's contacts stay valid into this step unless something moved it or a part
+    // it may touch since: a body at rest costs one query per step.
+    if (s.cacheEpoch != bodies.poseEpoch) s.cachedBody.reset();
     for (int sub = 0; sub < substeps; ++sub) {
         gatherContacts(bodies, collision, s, profiler);
         profiler.enter(Stage::ContactSolver);
@@ -196,7 +210,10 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
         profiler.enter(Stage::RigidMotion);
         for (BodyId id : s.moving) {
             const bool reached = advanceConservatively(id, dt, std::max(slop, s.startDepth[id]), bound, step, bodies, collision, s, profiler);
-            if (!reached) s.stopped[id] = 1;
+            if (!reached) {
+                s.stopped[id] = 1;
+                ++profile.cutMoves;
+            }
         }
         profiler.enter(Stage::ContactSolver);
         refreshLeverArms(bodies, s.solver);
@@ -205,13 +222,18 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
         profiler.enter(Stage::RigidMotion);
         if (sub + 1 < substeps)
             for (BodyId id : s.moving)
-                if (bodies.rigid[id].motion == MotionType::Kinematic) pressDeformableParts(id, bodies, collision, response, s, profiler);
+                if (bodies.rigid[id].motion == MotionType::Kinematic) pressDeformableParts(id, bodies, collision, response, profiler);
     }
     // Kinematic bodies end exactly at their targets unless a part stopped them; their velocity
     // is the move they made.
     for (BodyId id : s.moving) {
         if (bodies.rigid[id].motion != MotionType::Kinematic) continue;
-        if (!s.stopped[id]) bodies.parts[id]->setPose(*bodies.kinematicTargets[id]);
+        if (!s.stopped[id]) {
+            const Pose& target = *bodies.kinematicTargets[id];
+            const Pose& now = bodies.parts[id]->pose();
+            if (target.translation != now.translation || target.rotation.coeffs() != now.rotation.coeffs()) s.cachedBody.reset();
+            bodies.parts[id]->setPose(target);
+        }
         bodies.kinematicTargets[id].reset();
         RigidBody& body = bodies.rigid[id];
         const Pose& start = s.stepStart[id];
@@ -223,6 +245,8 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
         body.angularVelocity = turn.axis() * (turn.angle() / h);
     }
     profile.substeps += std::uint64_t(substeps);
+    profile.rigidQueries += s.queries;
+    s.queries = 0;
 }
 
 }  // namespace flexfit::detail

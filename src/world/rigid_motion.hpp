@@ -36,7 +36,14 @@ struct RigidMotionScratch {
     std::vector<Contact> cached;        // contacts of `cachedBody` at its current pose
     std::vector<Contact> unseen;        // a body's contacts not added by a lower id's query
     std::optional<BodyId> cachedBody;
+    std::uint64_t cacheEpoch = 0;       // Bodies::poseEpoch when the cache was kept
+    std::uint64_t queries = 0;          // this step's, for the profile
+    CollisionWorld::KnownContacts known;  // knownContacts()'s answer
 };
+
+// The last mover's contacts with rigid parts, when they still hold at the current poses (for the
+// world's narrow phase, which then does not query those pairs again); null otherwise.
+const CollisionWorld::KnownContacts* knownContacts(RigidMotionScratch& scratch, const Bodies& bodies);
 
 // Charges its own work to Stage::RigidMotion, queries to NarrowPhase, the solver to
 // ContactSolver and kinematic pushes to ContactResponse. Adds the sub-steps to profile.substeps.

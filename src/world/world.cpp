@@ -173,7 +173,7 @@ void World::step() {
     profiler.enter(Stage::BroadPhase);
     d.collision.update();                                          // spheres, candidate pairs
     profiler.enter(Stage::NarrowPhase);
-    const std::vector<Contact>& contacts = d.collision.narrowPhase();  // refits deformed hierarchies it needs
+    const std::vector<Contact>& contacts = d.collision.narrowPhase(detail::knownContacts(d.rigidMotion, d.bodies));  // refits deformed hierarchies it needs
     detail::clearRefittedChanges(d.collision, d.bodies);
     profiler.enter(Stage::ContactResponse);
     detail::respondToContacts(step, d.settings.contactDamping, contacts, d.bodies, d.response);  // deformable pushes, reactions
