@@ -59,7 +59,8 @@ void Bodies::reserve(std::size_t count) {
 
 double Bodies::minimumThickness() const {
     double thinnest = std::numeric_limits<double>::infinity();
-    for (const RigidBody& b : rigid) thinnest = std::min(thinnest, b.thickness);
+    for (const RigidBody& b : rigid)
+        if (b.thickness > 0.0) thinnest = std::min(thinnest, b.thickness);
     return thinnest;
 }
 

@@ -32,7 +32,9 @@ struct Bodies {
     void reserve(std::size_t count);
     // World position of a body's centre of mass.
     Vec3 centreOfMass(BodyId id) const { return parts[id]->pose().apply(rigid[id].centreOfMass); }
-    // The thinnest body's thickness (the no-tunnelling bound's scale).
+    // The thinnest body's thickness (the no-tunnelling bound's scale). Flat parts (thickness 0:
+    // a quad floor) do not count: a body moving less than its own thickness per sub-step
+    // cannot cross them unseen. Infinity when every part is flat.
     double minimumThickness() const;
 };
 

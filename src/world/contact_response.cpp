@@ -125,6 +125,7 @@ void applyDeformableReactions(const StepContext& step, double dampingRatio, std:
         for (const auto& [body, part, face, mass] :
              {std::tuple{c.partA, c.partB, c.faceB, c.massB}, std::tuple{c.partB, c.partA, c.faceA, kNoMass}}) {
             if (bodies.rigid[body].motion != MotionType::Dynamic || !bodies.parts[part]->deforms()) continue;
+            if (solvedByImpulses(bodies, body, part)) continue;  // the contact solver answered it
             // Contacts come grouped by pair, so a mass pressed by two bodies counts once for each.
             for (Index m : pressedMasses(bodies.parts[part]->model().mesh.faces[face], mass)) {
                 const Index key = bodies.worldMass(part, m);

@@ -41,16 +41,6 @@ void applyImpulse(const Vec3& p, const ContactSolver& s, const SolverContact& c,
     }
 }
 
-// Rigid contacts; and a dynamic deforming body's contacts with static or kinematic rigid parts
-// (its rigid motion meets them as a rigid body's would; the response deforms it there).
-bool solvedByImpulses(const Bodies& bodies, BodyId a, BodyId b) {
-    const bool da = bodies.parts[a]->deforms(), db = bodies.parts[b]->deforms();
-    if (!da && !db) return isDynamic(bodies, a) || isDynamic(bodies, b);
-    if (da && db) return false;
-    const BodyId deforming = da ? a : b, other = da ? b : a;
-    return isDynamic(bodies, deforming) && !isDynamic(bodies, other);
-}
-
 // Two unit tangents completing the normal to an orthonormal frame.
 void tangentsOf(const Vec3& n, Vec3& t1, Vec3& t2) {
     const Vec3 helper = std::abs(n.x()) < 0.57 ? Vec3::UnitX() : Vec3::UnitY();
@@ -85,6 +75,15 @@ void solveNormal(SolverContact& c, double targetSpeed, const ContactSolver& s, B
 }
 
 }  // namespace
+
+// Rigid contacts; and a dynamic deforming body's contacts with rigid parts (its rigid motion
+// meets them as a rigid body's would; the response deforms it there).
+bool solvedByImpulses(const Bodies& bodies, BodyId a, BodyId b) {
+    const bool da = bodies.parts[a]->deforms(), db = bodies.parts[b]->deforms();
+    if (!da && !db) return isDynamic(bodies, a) || isDynamic(bodies, b);
+    if (da && db) return false;
+    return isDynamic(bodies, da ? a : b);
+}
 
 double combinedFriction(double a, double b) { return std::sqrt(a * b); }
 double combinedRestitution(double a, double b) { return std::max(a, b); }
@@ -144,13 +143,13 @@ void solveVelocities(int iterations, const Separation& separation, Bodies& bodie
         }
 }
 
-void applyRestitution(int iterations, double threshold, Bodies& bodies, ContactSolver& solver) {
-    const bool any = std::any_of(solver.contacts.begin(), solver.contacts.end(),
-                                 [&](const SolverContact& c) { return c.restitution > 0.0 && c.approachSpeed < -threshold; });
+void applyRestitution(int iterations, Bodies& bodies, ContactSolver& solver) {
+    auto bounces = [](const SolverContact& c) { return c.restitution > 0.0 && c.approachSpeed < -c.bounceThreshold; };
+    const bool any = std::any_of(solver.contacts.begin(), solver.contacts.end(), bounces);
     if (!any) return;
     for (int iteration = 0; iteration < iterations; ++iteration)
         for (SolverContact& c : solver.contacts)
-            if (c.restitution > 0.0 && c.approachSpeed < -threshold) solveNormal(c, -c.restitution * c.approachSpeed, solver, bodies);
+            if (bounces(c)) solveNormal(c, -c.restitution * c.approachSpeed, solver, bodies);
 }
 
 }  // namespace flexfit::detail

@@ -1,8 +1,8 @@
 // Internal to src/world: the contact solver stage (world.hpp, "Contacts"). It runs inside the
 // rigid motion's sub-steps, on the contacts between bodies whose parts do not deform (rigid
-// mode), at least one of them dynamic; and on a dynamic deforming body's contacts with static
-// or kinematic rigid parts (its rigid motion meets them as a rigid body's would, while the
-// contact response deforms it there).
+// mode), at least one of them dynamic; and on a dynamic deforming body's contacts with rigid
+// parts (its rigid motion meets them as a rigid body's would, while the contact response
+// deforms it there and gives no spring reaction for that pair).
 //
 // Sequential impulses (Catto's, as Box2D and Jolt use): each contact point is a normal
 // constraint (relative normal speed >= 0, impulse >= 0) and two friction constraints along the
@@ -18,7 +18,8 @@
 //   (Baumgarte) in a first pass; the sub-step's positions move with those velocities, and a
 //   second pass without it (relax, as Box2D v3's soft step) takes back the speed that only
 //   served to separate. Both passes are impulses, so correcting a depth conserves momentum too.
-//   Restitution: after the relax, a point that approached faster than the threshold gets the
+//   Restitution: after the relax, a point that approached faster than its threshold (twice
+//   the speed the loads give in a step: resting contacts never bounce) gets the
 //   normal impulse that makes it separate at e times its approach speed.
 //
 // Known limits: no warm starting (a point's impulses start at zero every sub-step, so tall
@@ -43,6 +44,7 @@ struct SolverContact {
     double normalMass = 0.0, tangentMass1 = 0.0, tangentMass2 = 0.0;  // 1 / effective inverse mass
     double normalImpulse = 0.0, tangentImpulse1 = 0.0, tangentImpulse2 = 0.0;  // accumulated
     double approachSpeed = 0.0;  // relative normal speed before the solve (< 0: approaching)
+    double bounceThreshold = 1e-9;  // approach speed below which it does not bounce
     double staticFriction = 0.0, kineticFriction = 0.0, restitution = 0.0;
 };
 
@@ -79,7 +81,10 @@ struct Separation {
 void solveVelocities(int iterations, const Separation& separation, Bodies& bodies, ContactSolver& solver);
 
 // Normal impulses that turn each point's approach into a separation at restitution times its
-// approach speed, for points that approached faster than `threshold`.
-void applyRestitution(int iterations, double threshold, Bodies& bodies, ContactSolver& solver);
+// approach speed, for points that approached faster than their bounce threshold.
+void applyRestitution(int iterations, Bodies& bodies, ContactSolver& solver);
+
+// Whether the solver owns the contacts of the pair (see above).
+bool solvedByImpulses(const Bodies& bodies, BodyId a, BodyId b);
 
 }  // namespace flexfit::detail

@@ -18,9 +18,10 @@ constexpr int kBisections = 6;
 constexpr double kMaxPieces = 64.0;
 
 // Velocity first (semi-implicit Euler): the loads of the last step and gravity, then the
-// loads are consumed.
-void integrateVelocity(const StepContext& step, const Part& part, RigidBody& body) {
+// loads are consumed. Returns the speed the loads gave in the step.
+double integrateVelocity(const StepContext& step, const Part& part, RigidBody& body) {
     const double h = step.timeStep;
+    const double loadSpeed = h * (step.gravity + body.inverseMass * body.force).norm();
     const Eigen::Matrix3d r = part.pose().rotation.toRotationMatrix();
     const Eigen::Matrix3d inverseInertia = r * body.inverseInertia * r.transpose();
     const Eigen::Matrix3d inertia = inverseInertia.inverse();
@@ -28,6 +29,7 @@ void integrateVelocity(const StepContext& step, const Part& part, RigidBody& bod
     body.angularVelocity += h * (inverseInertia * (body.torque - body.angularVelocity.cross(inertia * body.angularVelocity)));
     body.force.setZero();
     body.torque.setZero();
+    return loadSpeed;
 }
 
 // The pose reached from `start` moving along the body's velocities for dt: its centre of mass
@@ -55,18 +57,46 @@ void collectMovingBodies(const Bodies& bodies, RigidMotionScratch& s) {
         if (bodies.rigid[id].motion == MotionType::Dynamic) s.moving.push_back(id);
 }
 
-// A kinematic body is stopped by static and kinematic rigid parts; a dynamic one by every
-// rigid part. Parts that deform never stop a body: they yield (contact_response).
+// A kinematic body is stopped by static and kinematic rigid parts; a dynamic one by the parts
+// whose contacts with it the solver owns (contact_solver.hpp), so that a body held back is
+// also one whose velocity the contact removes. Parts that deform never stop a body: they
+// yield (contact_response).
 bool stops(const Bodies& bodies, BodyId mover, BodyId other) {
     if (bodies.parts[other]->deforms()) return false;
-    return bodies.rigid[mover].motion == MotionType::Dynamic || bodies.rigid[other].motion != MotionType::Dynamic;
+    if (bodies.rigid[mover].motion == MotionType::Dynamic) return solvedByImpulses(bodies, mover, other);
+    return bodies.rigid[other].motion != MotionType::Dynamic;
 }
 
-double deepestStop(BodyId id, std::span<const Contact> contacts, const Bodies& bodies) {
-    double deepest = 0.0;
-    for (const Contact& c : contacts)
-        if (stops(bodies, id, c.partA == id ? c.partB : c.partA)) deepest = std::max(deepest, c.depth);
-    return deepest;
+BodyId partnerOf(BodyId id, const Contact& c) { return c.partA == id ? c.partB : c.partA; }
+
+// The deepest each pair may get in this sub-step: the contact slop, or the pair's depth at the
+// sub-step's start when it was deeper (a pair pushed in by a third body only gets shallower).
+double allowedDepth(BodyId id, BodyId other, double slop, const RigidMotionScratch& s) {
+    for (std::size_t k = s.startOffset[id]; k < s.startOffset[id] + s.startCount[id]; ++k)
+        if (s.startDepths[k].first == other) return std::max(slop, s.startDepths[k].second);
+    return slop;
+}
+
+bool tooDeep(BodyId id, std::span<const Contact> contacts, double slop, const Bodies& bodies, const RigidMotionScratch& s) {
+    for (const Contact& c : contacts) {
+        const BodyId other = partnerOf(id, c);
+        if (stops(bodies, id, other) && c.depth > allowedDepth(id, other, slop, s)) return true;
+    }
+    return false;
+}
+
+// Records each stopping pair's deepest contact at the sub-step's start.
+void recordStartDepths(BodyId id, std::span<const Contact> contacts, const Bodies& bodies, RigidMotionScratch& s) {
+    s.startOffset[id] = s.startDepths.size();
+    for (const Contact& c : contacts) {
+        const BodyId other = partnerOf(id, c);
+        if (!stops(bodies, id, other)) continue;
+        if (s.startDepths.size() > s.startOffset[id] && s.startDepths.back().first == other)  // contacts come by pair
+            s.startDepths.back().second = std::max(s.startDepths.back().second, c.depth);
+        else
+            s.startDepths.emplace_back(other, c.depth);
+    }
+    s.startCount[id] = s.startDepths.size() - s.startOffset[id];
 }
 
 // The body's contacts with rigid parts at its current pose (its cached ones when nothing moved
@@ -83,23 +113,34 @@ std::span<const Contact> rigidContactsOf(BodyId id, Bodies& bodies, CollisionWor
     return contacts;
 }
 
-// 1. The dynamic bodies' rigid contacts into the solver, each pair once; every moving body's
-// deepest stopping contact.
+// 1. The dynamic bodies' rigid contacts into the solver, each pair once, with their
+// restitution threshold; every moving body's stopping pairs' depths.
 void gatherContacts(Bodies& bodies, CollisionWorld& collision, RigidMotionScratch& s, StepProfiler& profiler) {
     s.solver.contacts.clear();
     updateInverseInertia(bodies, s.solver);
-    s.startDepth.assign(bodies.size(), 0.0);
+    s.startDepths.clear();
+    s.startOffset.assign(bodies.size(), 0);
+    s.startCount.assign(bodies.size(), 0);
     for (BodyId id : s.moving) {
         const std::span<const Contact> contacts = rigidContactsOf(id, bodies, collision, s, profiler);
-        s.startDepth[id] = deepestStop(id, contacts, bodies);
+        recordStartDepths(id, contacts, bodies, s);
         if (bodies.rigid[id].motion != MotionType::Dynamic) continue;
-        // A pair of dynamic bodies is added by the lower id's query.
+        // A pair of dynamic bodies is added by the lower id's query, when that query saw it
+        // (queries skip deforming partners).
         s.unseen.clear();
+        const bool seenByLower = !bodies.parts[id]->deforms();
         for (const Contact& c : contacts) {
-            const BodyId other = c.partA == id ? c.partB : c.partA;
-            if (other > id || bodies.rigid[other].motion != MotionType::Dynamic) s.unseen.push_back(c);
+            const BodyId other = partnerOf(id, c);
+            if (other > id || bodies.rigid[other].motion != MotionType::Dynamic || !seenByLower) s.unseen.push_back(c);
         }
+        const std::size_t first = s.solver.contacts.size();
         addContacts(s.unseen, bodies, s.solver);
+        // A point bounces only when it approaches faster than twice what the loads give in a
+        // step: a resting contact under any load does not.
+        for (std::size_t k = first; k < s.solver.contacts.size(); ++k) {
+            SolverContact& c = s.solver.contacts[k];
+            c.bounceThreshold = 2.0 * std::max(s.loadSpeed[c.a], s.loadSpeed[c.b]) + 1e-9;
+        }
     }
 }
 
@@ -111,26 +152,28 @@ void keepCache(BodyId id, const Bodies& bodies, RigidMotionScratch& s) {
     s.cacheEpoch = bodies.poseEpoch;
 }
 
-// 3. Moves the body along its velocities for dt, or as far as it goes without getting deeper
-// than `allowed` into a part that stops it. The move is tried in pieces no longer than the
-// travel bound (more than one only when max_substeps capped the sub-steps), then bisected in
-// the piece that goes too deep. Returns false when the move was cut short.
-bool advanceConservatively(BodyId id, double dt, double allowed, double bound, const StepContext& step, Bodies& bodies,
-                           CollisionWorld& collision, RigidMotionScratch& s, StepProfiler& profiler) {
+// 3. Every moving body first goes to the end of its move; then each, in turn, checks its place
+// against the others' (moved or already cut back) and, when a stopping pair is deeper than it
+// may be, cuts its own move back: the move is tried in pieces no longer than the travel bound
+// (more than one only when the sub-steps could not follow the body), then bisected in the piece
+// that goes too deep. Bodies moving together therefore do not hold each other back. Returns
+// false when the move was cut short.
+bool settleMove(BodyId id, double dt, double slop, double bound, const StepContext& step, Bodies& bodies,
+                CollisionWorld& collision, RigidMotionScratch& s, StepProfiler& profiler) {
     Part& part = *bodies.parts[id];
     const RigidBody& body = bodies.rigid[id];
     const double pieces = std::ceil(travelOver(dt, body) / bound);
     if (!(pieces <= kMaxPieces))  // NaN too
         throw DivergenceError(id, step.time,
-                              "moves " + std::to_string(travelOver(step.timeStep, body)) + " units in one step, more than max_substeps x " +
-                                  std::to_string(kMaxPieces) + " travel bounds of " + std::to_string(bound) +
-                                  "; likely cause: a force or speed beyond what the world can follow (raise max_substeps or lower the time step)");
-    const Pose start = part.pose();
+                              "moves " + std::to_string(travelOver(step.timeStep, body)) + " units in one step, more than " +
+                                  std::to_string(int(kMaxPieces)) + " travel bounds of " + std::to_string(bound) +
+                                  " per sub-step; likely cause: a force, speed or kinematic jump beyond what max_substeps sub-steps can follow");
+    const Pose start = s.subStart[id];
     s.cachedBody.reset();
     auto fits = [&](double fraction) {
         part.setPose(advancedPose(start, fraction * dt, body));
         const std::span<const Contact> contacts = rigidContactsOf(id, bodies, collision, s, profiler);
-        if (deepestStop(id, contacts, bodies) > allowed) return false;
+        if (tooDeep(id, contacts, slop, bodies, s)) return false;
         s.cached.assign(contacts.begin(), contacts.end());  // the contacts at the pose reached
         return true;
     };
@@ -168,11 +211,12 @@ void pressDeformableParts(BodyId id, Bodies& bodies, CollisionWorld& collision, 
     profiler.enter(outer);
 }
 
-int substepCount(double h, const WorldSettings& settings, const Bodies& bodies, const RigidMotionScratch& s) {
-    const double bound = settings.maxTravelFraction * bodies.minimumThickness();
+int substepCount(double h, double bound, const WorldSettings& settings, const Bodies& bodies, const RigidMotionScratch& s) {
     double travel = 0.0;
     for (BodyId id : s.moving) travel = std::max(travel, travelOver(h, bodies.rigid[id]));
-    return int(std::clamp(std::ceil(travel / bound), 1.0, double(settings.maxSubsteps)));  // NaN: 1
+    const double count = std::ceil(travel / bound);
+    if (!(count >= 1.0)) return 1;  // NaN too (settleMove reports a diverged body)
+    return int(std::min(count, double(settings.maxSubsteps)));
 }
 
 }  // namespace
@@ -188,14 +232,17 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
     const double h = step.timeStep;
     collectMovingBodies(bodies, s);
     if (s.moving.empty()) return;
+    s.loadSpeed.assign(bodies.size(), h * step.gravity.norm());
     for (BodyId id : s.moving)
-        if (bodies.rigid[id].motion == MotionType::Dynamic) integrateVelocity(step, *bodies.parts[id], bodies.rigid[id]);
+        if (bodies.rigid[id].motion == MotionType::Dynamic) s.loadSpeed[id] = integrateVelocity(step, *bodies.parts[id], bodies.rigid[id]);
     s.stepStart.resize(bodies.size());
+    s.subStart.resize(bodies.size());
     for (BodyId id : s.moving) s.stepStart[id] = bodies.parts[id]->pose();
-    const int substeps = substepCount(h, settings, bodies, s);
+    const double thinnest = bodies.minimumThickness();
+    const double slop = settings.contactSlop * thinnest;
+    const double bound = settings.maxTravelFraction * thinnest;
+    const int substeps = substepCount(h, bound, settings, bodies, s);
     const double dt = h / substeps;
-    const double slop = settings.contactSlop * bodies.minimumThickness();
-    const double bound = settings.maxTravelFraction * bodies.minimumThickness();
     // Depth is taken out at up to one slop per step: conservative advancement keeps it below
     // the slop, so the separation only corrects drift.
     const Separation separation{kSeparationShare / dt, kLinearSlopShare * slop, slop / h};
@@ -209,7 +256,12 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
         solveVelocities(settings.contactIterations, separation, bodies, s.solver);
         profiler.enter(Stage::RigidMotion);
         for (BodyId id : s.moving) {
-            const bool reached = advanceConservatively(id, dt, std::max(slop, s.startDepth[id]), bound, step, bodies, collision, s, profiler);
+            s.subStart[id] = bodies.parts[id]->pose();
+            bodies.parts[id]->setPose(advancedPose(s.subStart[id], dt, bodies.rigid[id]));
+        }
+        s.cachedBody.reset();
+        for (BodyId id : s.moving) {
+            const bool reached = settleMove(id, dt, slop, bound, step, bodies, collision, s, profiler);
             if (!reached) {
                 s.stopped[id] = 1;
                 ++profile.cutMoves;
@@ -218,7 +270,7 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
         profiler.enter(Stage::ContactSolver);
         refreshLeverArms(bodies, s.solver);
         solveVelocities(settings.contactIterations, Separation{}, bodies, s.solver);
-        applyRestitution(settings.contactIterations, 2.0 * step.gravity.norm() * h + 1e-9, bodies, s.solver);
+        applyRestitution(settings.contactIterations, bodies, s.solver);
         profiler.enter(Stage::RigidMotion);
         if (sub + 1 < substeps)
             for (BodyId id : s.moving)

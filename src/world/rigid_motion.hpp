@@ -5,11 +5,12 @@
 // maxTravelFraction of the thinnest body per sub-step. Each sub-step:
 //   1. the dynamic bodies' contacts with parts that do not deform (NarrowPhase);
 //   2. the contact solver's first pass, which also separates penetrating points (ContactSolver);
-//   3. every moving body advances, kinematic ones first, by conservative advancement: a move
-//      that would take a body deeper than the contact slop (or than it already was) into a
-//      part that does not deform is cut to the last fraction that does not (bisection), so
-//      contact normals and depths always come from a shallow configuration and no load, speed
-//      or time step gets a body through a rigid part;
+//   3. every moving body advances by conservative advancement: all go to the end of their
+//      move, then each in turn (kinematic ones first) cuts its own move back to the last
+//      fraction (bisection) at which no pair with a part that stops it is deeper than the
+//      contact slop, or than that pair was at the sub-step's start. Contact normals and depths
+//      come from shallow configurations, so no load, speed or time step gets a body through a
+//      rigid part; bodies moving together do not hold each other back;
 //   4. the solver's relax pass and restitution;
 //   5. a kinematic body that has sub-steps left presses the deformable parts it meets, so it
 //      deforms them along its way instead of jumping through.
@@ -30,7 +31,12 @@ namespace flexfit::detail {
 struct RigidMotionScratch {
     ContactSolver solver;
     std::vector<BodyId> moving;         // kinematic bodies with a target, then dynamic ones
-    std::vector<double> startDepth;     // (nbody) deepest rigid contact at the sub-step's start
+    // Each moving body's stopping pairs and their deepest contact at the sub-step's start: body
+    // id's are startDepths[startOffset[id] .. + startCount[id]).
+    std::vector<std::pair<BodyId, double>> startDepths;
+    std::vector<std::size_t> startOffset, startCount;  // (nbody)
+    std::vector<double> loadSpeed;      // (nbody) speed the loads and gravity give in a step
+    std::vector<Pose> subStart;         // (nbody) pose at the sub-step's start
     std::vector<Pose> stepStart;        // (nbody) pose at the step's start (kinematic bodies)
     std::vector<char> stopped;          // (nbody) a sub-step of this step was cut short
     std::vector<Contact> cached;        // contacts of `cachedBody` at its current pose
