@@ -168,17 +168,11 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
         segmentTriangle(second.c, second.a, first, u1, points);
     }
     if (points.count == 0) {
-        // Coplanar or parallel within the overlap (a face resting on a face): the vertices of
-        // each that lie on the other, within the depth; the centroid of all six would put the
-        // point far from a small triangle resting on a large one.
-        const double reach2 = bestOverlap * bestOverlap * (1.0 + 1e-9);
-        auto onOther = [&](const Vec3& v, const Triangle& other) {
-            return (closestPointOnTriangle(v, other) - v).squaredNorm() <= reach2 + 1e-20 * (1 + v.squaredNorm());
-        };
+        // Coplanar (or grazing): the centroid of the vertices of each lying on the other.
         for (const Vec3& v : {first.a, first.b, first.c})
-            if (onOther(v, second)) points.push(v);
+            if ((closestPointOnTriangle(v, second) - v).squaredNorm() <= 1e-20 * (1 + v.squaredNorm())) points.push(v);
         for (const Vec3& v : {second.a, second.b, second.c})
-            if (onOther(v, first)) points.push(v);
+            if ((closestPointOnTriangle(v, first) - v).squaredNorm() <= 1e-20 * (1 + v.squaredNorm())) points.push(v);
     }
     if (points.count == 0) points.push((first.a + first.b + first.c + second.a + second.b + second.c) / 6.0);
     Vec3 point = Vec3::Zero();

@@ -9,8 +9,7 @@
 // and the 9 edge-edge cross products; in-plane edge normals when they are coplanar). When no
 // axis separates them it reports the minimum-overlap axis as the contact normal, the overlap
 // as the depth, and the centroid of the intersection points (edges of each through the other)
-// as the contact point; when no edge crosses (faces parallel within the overlap), the centroid
-// of the vertices of each that lie within the depth of the other.
+// as the contact point.
 #pragma once
 
 #include "flexfit/core.hpp"
