@@ -54,6 +54,14 @@ TEST(World, ProfilePartitionsEveryStepAmongTheStages) {
     EXPECT_LE(p.totalStepSeconds, outside);  // measured inside the calls that the clock here surrounds
 }
 
+// Two clock readings, a call and the profile's bookkeeping: about 1 us in Release; the
+// sanitizers instrument every one of them (measured 2.003 us under ASan + UBSan, with 9 stages).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kCallOverhead = 10e-6;
+#else
+constexpr double kCallOverhead = 2e-6;
+#endif
+
 TEST(World, NoWorkHappensOutsideTheProfiledInterval) {
     // The stages partition the interval between the step's first and last clock readings, so
     // they add up to lastStepSeconds by construction. What this checks independently: timed
@@ -79,7 +87,7 @@ TEST(World, NoWorkHappensOutsideTheProfiledInterval) {
     ASSERT_GT(inContact, 150);
     std::nth_element(outsideMinusInside.begin(), outsideMinusInside.begin() + 150, outsideMinusInside.end());
     EXPECT_GE(outsideMinusInside[150], 0.0);
-    EXPECT_LT(outsideMinusInside[150], 2e-6) << "work outside the stages";
+    EXPECT_LT(outsideMinusInside[150], kCallOverhead) << "work outside the stages";
 }
 
 TEST(World, DeterministicRun) {
