@@ -3,7 +3,8 @@
 // the scene, runs it (untimed) to `settle` steps after the first contact, then times
 // kTimedSteps steps in contact. Counters: steps_per_s (in contact), contacts, moving masses,
 // and the mean time per step of each stage and of the whole World::step, in microseconds (the
-// world's own profile over the timed steps).
+// world's own profile over the timed steps), and the whole step's 99th percentile (nearest rank,
+// over every timed step of every iteration): a haptic loop's worst steps, not its mean.
 #include "flexfit/scene_file.hpp"
 #include "flexfit/scene_run.hpp"
 
@@ -29,6 +30,7 @@ void stepInContact(benchmark::State& state, const char* file, bool push, int set
     double seconds = 0.0, contacts = 0.0, moving = 0.0;
     std::array<double, kStageCount> stages{};
     double stepSeconds = 0.0;
+    std::vector<double> stepMicros;  // every timed step of every iteration
     for (auto _ : state) {
         SceneRun run(base);
         World& w = run.world();
@@ -39,7 +41,10 @@ void stepInContact(benchmark::State& state, const char* file, bool push, int set
         }
         const Profile before = w.profile();
         const auto start = std::chrono::steady_clock::now();
-        for (int i = 0; i < kTimedSteps; ++i) run.step();
+        for (int i = 0; i < kTimedSteps; ++i) {
+            run.step();
+            stepMicros.push_back(1e6 * w.profile().lastStepSeconds);
+        }
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         state.SetIterationTime(elapsed);
         seconds += elapsed;
@@ -54,6 +59,7 @@ void stepInContact(benchmark::State& state, const char* file, bool push, int set
     state.counters["moving_masses"] = moving / n;
     for (std::size_t s = 0; s < stages.size(); ++s) state.counters[std::string("us_") + toString(Stage(s))] = 1e6 * stages[s] / (n * kTimedSteps);
     state.counters["us_world_step"] = 1e6 * stepSeconds / (n * kTimedSteps);
+    state.counters["us_world_step_p99"] = nearestRankPercentile(stepMicros, 99.0);
 }
 
 // Pushed with 2,500 through the mouth: the timed steps start 20 steps after the first contact,

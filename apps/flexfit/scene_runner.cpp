@@ -133,6 +133,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         if (contacts > 0) {
             ++s.contactSteps;
             s.contactWallSeconds += wall;
+            s.contactStepMicros.push_back(w.profile().lastStepSeconds * 1e6);
             s.lastContact = w.time();
             s.restored.reset();
         }
@@ -173,6 +174,9 @@ std::string summaryJson(const Scene& scene, const RunSummary& s) {
     j += fmt::format("  \"wall_seconds\": {:.6f},\n  \"steps_per_second\": {:.1f},\n", s.wallSeconds, double(s.steps) / s.wallSeconds);
     j += fmt::format("  \"contact_steps\": {},\n  \"contact_steps_per_second\": {},\n", s.contactSteps,
                      s.contactSteps ? fmt::format("{:.1f}", double(s.contactSteps) / s.contactWallSeconds) : "null");
+    for (const auto& [key, p] : {std::pair{"p50", 50.0}, std::pair{"p99", 99.0}, std::pair{"max", 100.0}})
+        j += fmt::format("  \"contact_step_us_{}\": {},\n", key,
+                         s.contactStepMicros.empty() ? std::string("null") : fmt::format("{:.3f}", nearestRankPercentile(s.contactStepMicros, p)));
     j += fmt::format("  \"max_contacts\": {},\n  \"max_zones\": {},\n  \"max_moving_masses\": {},\n  \"max_computed_springs\": {},\n",
                      s.maxContacts, s.maxZones, s.maxMovingMasses, s.maxComputedSprings);
     j += fmt::format("  \"max_deformation\": {:.9g},\n  \"last_contact\": {},\n  \"restored_at\": {},\n  \"max_coupling_force\": {:.9g},\n",

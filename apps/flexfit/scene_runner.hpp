@@ -29,6 +29,7 @@ struct RunSummary {
     // Steps in contact and their wall time (the haptic-rate figure).
     std::uint64_t contactSteps = 0;
     double contactWallSeconds = 0.0;
+    std::vector<double> contactStepMicros;  // each in-contact step's World::step, us (profile)
     Profile profile;
     std::vector<AssemblyEvent> events;
     std::uint64_t stateHash = 0;

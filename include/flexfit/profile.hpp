@@ -9,9 +9,13 @@
 
 #include "flexfit/names.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
+#include <vector>
 
 namespace flexfit {
 
@@ -49,5 +53,16 @@ struct Profile {
     std::uint64_t cutMoves = 0;  // sub-step moves cut short by the contact slop (bisected)
     std::uint64_t rigidQueries = 0;  // one body's contact queries inside the sub-steps
 };
+
+// The tail of step times a haptic loop cares about (its worst steps, not the mean): the
+// nearest-rank percentile p in (0, 100] of the values, the smallest value that at least p % of
+// them do not exceed (p = 100: the largest). NaN for no values or p outside (0, 100].
+inline double nearestRankPercentile(std::vector<double> values, double p) {
+    if (values.empty() || !(p > 0.0 && p <= 100.0)) return std::numeric_limits<double>::quiet_NaN();
+    const std::size_t rank = std::size_t(std::ceil(p / 100.0 * double(values.size())));  // 1-based, >= 1
+    const auto nth = values.begin() + std::ptrdiff_t(std::min(rank, values.size()) - 1);
+    std::nth_element(values.begin(), nth, values.end());
+    return *nth;
+}
 
 }  // namespace flexfit

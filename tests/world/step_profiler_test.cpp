@@ -5,6 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
 #include <chrono>
 
 using namespace flexfit;
@@ -61,4 +67,25 @@ TEST(StepProfiler, LastHoldsOneStepAndTotalEvery) {
     EXPECT_NEAR(profile.totalStepSeconds,
                 profile.totalSeconds[std::size_t(Stage::ZoneDynamics)] + profile.totalSeconds[std::size_t(Stage::ZoneRetirement)], 1e-12);
     EXPECT_GE(profile.totalSeconds[std::size_t(Stage::ZoneDynamics)], 3e-3);
+}
+
+TEST(StepProfiler, NearestRankPercentileAgainstItsDefinition) {
+    // The smallest value v of the list with at least p % of the values <= v, found by brute
+    // force over every value and compared with the function, on random lists with ties.
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 200; ++trial) {
+        std::vector<double> values(std::size_t(1 + rng() % 50));
+        for (double& v : values) v = double(rng() % 20);
+        for (double p : {1.0, 50.0, 99.0, 100.0, 33.3}) {
+            double expected = std::numeric_limits<double>::infinity();
+            for (double candidate : values) {
+                const auto atMost = std::count_if(values.begin(), values.end(), [&](double v) { return v <= candidate; });
+                if (double(atMost) >= p / 100.0 * double(values.size()) - 1e-12) expected = std::min(expected, candidate);
+            }
+            EXPECT_EQ(nearestRankPercentile(values, p), expected) << "p " << p << " n " << values.size();
+        }
+    }
+    EXPECT_TRUE(std::isnan(nearestRankPercentile({}, 50.0)));
+    EXPECT_TRUE(std::isnan(nearestRankPercentile({1.0}, 0.0)));
+    EXPECT_EQ(nearestRankPercentile({3.0, 1.0, 2.0}, 100.0), 3.0);
 }
