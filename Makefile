@@ -52,7 +52,8 @@ bench: release
 	  --pair BM_FclObbrssQuery/0 BM_FlexfitQuery/0/1 --pair BM_FclObbrssQuery/1 BM_FlexfitQuery/1/1 \
 	  --pair BM_FclObbrssQuery/2 BM_FlexfitQuery/2/1 --pair BM_FclObbrssQuery/3 BM_FlexfitQuery/3/1 \
 	  --pair BM_FlexfitQuery/1/0 BM_FlexfitQuery/1/1 --pair BM_FclAabbRefit BM_FlexfitRefitLocal/1 \
-	  --pair BM_BroadPhase/1 BM_BroadPhase/0
+	  --pair BM_BroadPhase/1 BM_BroadPhase/0 --pair BM_DeformingPairFclAabb/iterations:3/manual_time BM_DeformingPairFlexfit/iterations:3/manual_time \
+	  --pair BM_DeformingPairFclObbrss/iterations:1/manual_time BM_DeformingPairFlexfit/iterations:3/manual_time
 	build/release/bench/bench_world --benchmark_repetitions=3 --benchmark_out_format=csv --benchmark_out=bench/results/world.csv
 
 clean:

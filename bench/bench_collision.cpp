@@ -7,6 +7,13 @@
 //   Refit after a local deformation (a zone of a few dozen faces on the heart): Flexfit refits
 //          the changed leaves and their ancestors; FCL's AABB model refits in endUpdateModel.
 //   Broad phase over 200 moving parts: refit against rebuild.
+//   A deforming pair per step (issue 15's reference): a ball pressed into the heart while a
+//          zone there deforms, 60 steps. Each step, timed: Flexfit refits the changed leaves
+//          and queries the pair; FCL (OBBRSS or AABB, the same triangles) takes the part's
+//          positions (beginUpdateModel / updateSubModel / endUpdateModel, bottom-up refit) and
+//          collides.
+//          The deformation itself is stepped untimed; same_contacts compares the face pairs of
+//          the last step.
 #include "flexfit/flexfit.hpp"
 
 #include <benchmark/benchmark.h>
@@ -14,6 +21,7 @@
 
 #include <fmt/core.h>
 
+#include <chrono>
 #include <set>
 
 namespace {
@@ -63,8 +71,9 @@ std::shared_ptr<fcl::BVHModel<BV>> fclModel(const PartModel& model) {
     return m;
 }
 
-std::set<std::pair<Index, Index>> fclContacts(const Scene& s, const std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>>& a,
-                                              const std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>>& b, std::size_t* count) {
+template <class BV>
+std::set<std::pair<Index, Index>> fclContacts(const Scene& s, const std::shared_ptr<fcl::BVHModel<BV>>& a, const std::shared_ptr<fcl::BVHModel<BV>>& b,
+                                              std::size_t* count) {
     fcl::CollisionObjectd oa(a, toFcl(s.poseA)), ob(b, toFcl(s.poseB));
     fcl::CollisionRequestd request(1000000, true);
     fcl::CollisionResultd result;
@@ -165,6 +174,123 @@ void BM_FclAabbRefit(benchmark::State& state) {
     setQueryCounters(state, "heart / fcl aabb endUpdateModel", model->faceCount(), 0, true);
 }
 
+// The deforming pair: the heart, rigid-deformable, with a zone at mass 3000 pushed outwards, and
+// a ball of radius 2 pressed 0.3 into it there. Each benchmark replays the same steps.
+struct DeformingPair {
+    std::shared_ptr<const PartModel> heart = sceneByIndex(1).a;
+    std::shared_ptr<const PartModel> ballModel = buildPartModel(makeIcoSphere(2.0, 3));
+    Part part{heart}, ball{ballModel, [] {
+                           PartSettings s;
+                           s.mode = PartMode::Rigid;
+                           return s;
+                       }()};
+    Vec3 push;
+    static constexpr Index kMass = 3000;
+    DeformingPair() {
+        const Vec3 at = heart->restPositions[kMass];
+        Vec3 normal = Vec3::Zero();
+        for (Index f : heart->topology.facesOf(kMass)) {
+            const Face& face = heart->mesh.faces[f];
+            normal += (heart->restPositions[face[1]] - heart->restPositions[face[0]]).cross(heart->restPositions[face[2]] - heart->restPositions[face[0]]);
+        }
+        normal.normalize();
+        push = 40.0 * normal;
+        ball.setPose(Pose{Eigen::Quaterniond::Identity(), at + (2.0 - 0.3) * normal});
+        part.openZone(ZoneSeed::mass(kMass), 3);
+    }
+    void deform() {
+        part.applyForce(kMass, push);
+        part.step();
+    }
+    std::vector<fcl::Vector3d> positions() const { return {part.state().positions.begin(), part.state().positions.end()}; }
+};
+
+constexpr int kDeformingSteps = 60;
+
+// The CSV reporter needs every benchmark's counters alike: the time per step is real_time / 60.
+void setPairCounters(benchmark::State& state, const std::string& label, std::size_t contacts, bool same) {
+    setQueryCounters(state, label + fmt::format(" ({} steps a run)", kDeformingSteps), contacts, 0, same);
+}
+
+template <class BV>
+std::set<std::pair<Index, Index>> fclPairContacts(const DeformingPair& d, const std::shared_ptr<fcl::BVHModel<BV>>& ball,
+                                                  const std::shared_ptr<fcl::BVHModel<BV>>& heart, std::size_t* count) {
+    const Scene s{"", d.ballModel, d.heart, d.ball.pose(), d.part.pose()};
+    return fclContacts(s, ball, heart, count);
+}
+
+void BM_DeformingPairFlexfit(benchmark::State& state) {
+    std::size_t contacts = 0;
+    bool same = false;
+    for (auto _ : state) {
+        DeformingPair d;
+        PartCollider heart(d.part, BoundingVolumeKind::Aabb), ball(d.ball, BoundingVolumeKind::Aabb);
+        std::vector<Contact> found;
+        QueryStats stats;
+        double iteration = 0.0;
+        for (int i = 0; i < kDeformingSteps; ++i) {
+            d.deform();
+            const auto start = std::chrono::steady_clock::now();
+            heart.refit(d.part, d.part.changedMasses());
+            found.clear();
+            queryPair(0, d.ball, ball, 1, d.part, heart, ExactTest::TriangleTriangle, found, stats);
+            iteration += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            d.part.clearChangedMasses();
+        }
+        state.SetIterationTime(iteration);
+        contacts = found.size();
+        std::set<std::pair<Index, Index>> ours;
+        for (const Contact& c : found) ours.insert({c.faceA, c.faceB});
+        const auto fb = fclModel<fcl::OBBRSSd>(*d.ballModel);
+        auto fh = fclModel<fcl::OBBRSSd>(*d.heart);
+        fh->beginUpdateModel();
+        fh->updateSubModel(d.positions());
+        fh->endUpdateModel(true, true);
+        std::size_t fclCount = 0;
+        same = ours == fclPairContacts(d, fb, fh, &fclCount);
+    }
+    setPairCounters(state, "heart deforming under a ball / flexfit aabb, local refit", contacts, same);
+}
+
+// FCL's two choices: OBBRSS (its fastest query, costly to refit) and AABB (cheap to refit).
+template <class BV>
+void BM_DeformingPairFcl(benchmark::State& state, const char* label) {
+    std::size_t contacts = 0;
+    bool same = false;
+    for (auto _ : state) {
+        DeformingPair d;
+        const auto fb = fclModel<BV>(*d.ballModel);
+        auto fh = fclModel<BV>(*d.heart);
+        std::vector<fcl::Vector3d> positions;
+        std::set<std::pair<Index, Index>> found;
+        double iteration = 0.0;
+        for (int i = 0; i < kDeformingSteps; ++i) {
+            d.deform();
+            positions = d.positions();  // the part's state, as a user's mesh would hand it over
+            const auto start = std::chrono::steady_clock::now();
+            fh->beginUpdateModel();
+            fh->updateSubModel(positions);
+            fh->endUpdateModel(true, true);
+            std::size_t count = 0;
+            found = fclPairContacts(d, fb, fh, &count);
+            iteration += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            contacts = count;
+        }
+        state.SetIterationTime(iteration);
+        // The same pair in Flexfit's hierarchies, at the last step.
+        PartCollider heart(d.part, BoundingVolumeKind::Aabb), ball(d.ball, BoundingVolumeKind::Aabb);
+        std::vector<Contact> ours;
+        QueryStats stats;
+        queryPair(0, d.ball, ball, 1, d.part, heart, ExactTest::TriangleTriangle, ours, stats);
+        std::set<std::pair<Index, Index>> pairs;
+        for (const Contact& c : ours) pairs.insert({c.faceA, c.faceB});
+        same = pairs == found;
+    }
+    setPairCounters(state, label, contacts, same);
+}
+void BM_DeformingPairFclObbrss(benchmark::State& s) { BM_DeformingPairFcl<fcl::OBBRSSd>(s, "heart deforming under a ball / fcl obbrss, endUpdateModel + collide"); }
+void BM_DeformingPairFclAabb(benchmark::State& s) { BM_DeformingPairFcl<fcl::AABBd>(s, "heart deforming under a ball / fcl aabb, endUpdateModel + collide"); }
+
 // 200 parts moving every step: refit the broad-phase tree, or rebuild it.
 void BM_BroadPhase(benchmark::State& state) {
     const auto model = buildPartModel(makeIcoSphere(1.0, 1));
@@ -193,6 +319,9 @@ BENCHMARK(BM_FclObbrssQuery)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 BENCHMARK(BM_FlexfitRefitLocal)->Arg(0)->Arg(1);
 BENCHMARK(BM_FclAabbRefit);
 BENCHMARK(BM_BroadPhase)->Arg(0)->Arg(1);
+BENCHMARK(BM_DeformingPairFlexfit)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(3);
+BENCHMARK(BM_DeformingPairFclObbrss)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(1);
+BENCHMARK(BM_DeformingPairFclAabb)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(3);
 
 }  // namespace
 
