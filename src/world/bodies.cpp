@@ -46,6 +46,7 @@ BodyId Bodies::add(std::unique_ptr<Part> part, const RigidBody& body) {
     parts.push_back(std::move(part));
     rigid.push_back(body);
     kinematicTargets.emplace_back();
+    if (body.thickness > 0.0) thinnest_ = std::min(thinnest_, body.thickness);
     ++poseEpoch;
     return BodyId(parts.size() - 1);
 }
@@ -55,13 +56,6 @@ void Bodies::reserve(std::size_t count) {
     rigid.reserve(count);
     kinematicTargets.reserve(count);
     massAdr.reserve(count + 1);
-}
-
-double Bodies::minimumThickness() const {
-    double thinnest = std::numeric_limits<double>::infinity();
-    for (const RigidBody& b : rigid)
-        if (b.thickness > 0.0) thinnest = std::min(thinnest, b.thickness);
-    return thinnest;
 }
 
 void clearRefittedChanges(const CollisionWorld& collision, Bodies& bodies) {

@@ -6,6 +6,8 @@
 #include "flexfit/collision_world.hpp"
 #include "flexfit/part.hpp"
 
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -24,6 +26,7 @@ struct Bodies {
     std::uint64_t poseEpoch = 0;
 
     std::size_t size() const { return parts.size(); }
+    bool dynamic(BodyId id) const { return rigid[id].motion == MotionType::Dynamic; }
     Index massCount() const { return massAdr.back(); }
     Index worldMass(BodyId body, Index mass) const { return massAdr[body] + mass; }
 
@@ -34,9 +37,20 @@ struct Bodies {
     Vec3 centreOfMass(BodyId id) const { return parts[id]->pose().apply(rigid[id].centreOfMass); }
     // The thinnest body's thickness (the no-tunnelling bound's scale). Flat parts (thickness 0:
     // a quad floor) do not count: a body moving less than its own thickness per sub-step
-    // cannot cross them unseen. Infinity when every part is flat.
-    double minimumThickness() const;
+    // cannot cross them unseen. Infinity when every part is flat. Kept by add(): thicknesses
+    // are fixed when a body is added.
+    double minimumThickness() const { return thinnest_; }
+
+private:
+    double thinnest_ = std::numeric_limits<double>::infinity();
 };
+
+// The rotation as axis and angle in (-pi, pi]: the short way round.
+inline Eigen::AngleAxisd shortestTurn(const Eigen::Quaterniond& q) {
+    Eigen::AngleAxisd turn(q);
+    if (turn.angle() > M_PI) turn.angle() -= 2.0 * M_PI;
+    return turn;
+}
 
 // After a collision query: the parts whose hierarchy it refitted forget the changes it used.
 void clearRefittedChanges(const CollisionWorld& collision, Bodies& bodies);

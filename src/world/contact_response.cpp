@@ -78,8 +78,8 @@ Vec3 frictionForce(const PairTerms& t, const Vec3& sliding, double pressing, dou
 // approach, never pulling; Coulomb friction against the body's sliding over the surface, which
 // the mass feels the opposite of; the body gets the force and its torque.
 void applyReactionForces(const StepContext& step, double dampingRatio, Bodies& bodies, ContactResponse& r) {
-    for (RigidBody& b : bodies.rigid) b.deformableContactForce.setZero();
-    r.reactionCount.assign(bodies.size(), 0u);
+    r.reactionCount.resize(bodies.size(), 0u);
+    for (const ContactResponse::Reaction& reaction : r.reactions) r.reactionCount[reaction.body] = 0;
     for (const ContactResponse::Reaction& reaction : r.reactions) ++r.reactionCount[reaction.body];
     const double h = step.timeStep;
     std::optional<PairTerms> terms;
@@ -120,11 +120,12 @@ void applyDeformableReactions(const StepContext& step, double dampingRatio, std:
     r.reacting.growTo(bodies.massCount());
     r.reactionOwner.resize(bodies.massCount(), 0u);
     r.reacting.clear();
+    for (const ContactResponse::Reaction& reaction : r.reactions) bodies.rigid[reaction.body].deformableContactForce.setZero();  // last step's
     r.reactions.clear();
     for (const Contact& c : contacts)
         for (const auto& [body, part, face, mass] :
              {std::tuple{c.partA, c.partB, c.faceB, c.massB}, std::tuple{c.partB, c.partA, c.faceA, kNoMass}}) {
-            if (bodies.rigid[body].motion != MotionType::Dynamic || !bodies.parts[part]->deforms()) continue;
+            if (!bodies.dynamic(body) || !bodies.parts[part]->deforms()) continue;
             if (solvedByImpulses(bodies, body, part)) continue;  // the contact solver answered it
             // Contacts come grouped by pair, so a mass pressed by two bodies counts once for each.
             for (Index m : pressedMasses(bodies.parts[part]->model().mesh.faces[face], mass)) {

@@ -57,7 +57,7 @@ struct ContactResponse {
         Index mass;
     };
     std::vector<Reaction> reactions;
-    std::vector<std::uint32_t> reactionCount;  // (nbody) masses each body presses
+    std::vector<std::uint32_t> reactionCount;  // (nbody) masses each body presses; valid for the reactions' bodies
 };
 
 // Deformable pushes, then the reactions dynamic bodies feel, for the contacts of this step.

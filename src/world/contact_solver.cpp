@@ -7,8 +7,6 @@
 namespace flexfit::detail {
 namespace {
 
-bool isDynamic(const Bodies& bodies, BodyId id) { return bodies.rigid[id].motion == MotionType::Dynamic; }
-
 // Velocity of the body's material point at r from its centre of mass.
 Vec3 pointVelocity(const RigidBody& body, const Vec3& r) { return body.linearVelocity + body.angularVelocity.cross(r); }
 
@@ -20,7 +18,7 @@ Vec3 relativeVelocity(const Bodies& bodies, const SolverContact& c) {
 double effectiveMass(const Bodies& bodies, const ContactSolver& s, const SolverContact& c, const Vec3& direction) {
     double inverse = 0.0;
     for (const auto& [id, r] : {std::pair{c.a, c.ra}, std::pair{c.b, c.rb}}) {
-        if (!isDynamic(bodies, id)) continue;
+        if (!bodies.dynamic(id)) continue;
         const Vec3 rn = r.cross(direction);
         inverse += bodies.rigid[id].inverseMass + rn.dot(s.inverseInertia[id] * rn);
     }
@@ -29,12 +27,12 @@ double effectiveMass(const Bodies& bodies, const ContactSolver& s, const SolverC
 
 // Impulse p on a at the point, -p on b.
 void applyImpulse(const Vec3& p, const ContactSolver& s, const SolverContact& c, Bodies& bodies) {
-    if (isDynamic(bodies, c.a)) {
+    if (bodies.dynamic(c.a)) {
         RigidBody& a = bodies.rigid[c.a];
         a.linearVelocity += a.inverseMass * p;
         a.angularVelocity += s.inverseInertia[c.a] * c.ra.cross(p);
     }
-    if (isDynamic(bodies, c.b)) {
+    if (bodies.dynamic(c.b)) {
         RigidBody& b = bodies.rigid[c.b];
         b.linearVelocity -= b.inverseMass * p;
         b.angularVelocity -= s.inverseInertia[c.b] * c.rb.cross(p);
@@ -80,21 +78,18 @@ void solveNormal(SolverContact& c, double targetSpeed, const ContactSolver& s, B
 // meets them as a rigid body's would; the response deforms it there).
 bool solvedByImpulses(const Bodies& bodies, BodyId a, BodyId b) {
     const bool da = bodies.parts[a]->deforms(), db = bodies.parts[b]->deforms();
-    if (!da && !db) return isDynamic(bodies, a) || isDynamic(bodies, b);
+    if (!da && !db) return bodies.dynamic(a) || bodies.dynamic(b);
     if (da && db) return false;
-    return isDynamic(bodies, da ? a : b);
+    return bodies.dynamic(da ? a : b);
 }
 
 double combinedFriction(double a, double b) { return std::sqrt(a * b); }
 double combinedRestitution(double a, double b) { return std::max(a, b); }
 
-void updateInverseInertia(const Bodies& bodies, ContactSolver& solver) {
-    solver.inverseInertia.resize(bodies.size());
-    for (BodyId id = 0; id < bodies.size(); ++id) {
-        if (!isDynamic(bodies, id)) {
-            solver.inverseInertia[id].setZero();
-            continue;
-        }
+void updateInverseInertia(std::span<const BodyId> moving, const Bodies& bodies, ContactSolver& solver) {
+    solver.inverseInertia.resize(bodies.size(), Eigen::Matrix3d::Zero());
+    for (BodyId id : moving) {
+        if (!bodies.dynamic(id)) continue;
         const Eigen::Matrix3d r = bodies.parts[id]->pose().rotation.toRotationMatrix();
         solver.inverseInertia[id] = r * bodies.rigid[id].inverseInertia * r.transpose();
     }

@@ -57,8 +57,9 @@ struct ContactSolver {
 double combinedFriction(double a, double b);
 double combinedRestitution(double a, double b);
 
-// World inverse inertia of every dynamic body at its current pose (zero for the others).
-void updateInverseInertia(const Bodies& bodies, ContactSolver& solver);
+// World inverse inertia of the dynamic bodies among `moving` (every dynamic body moves) at
+// their current pose; the others' entries are never read.
+void updateInverseInertia(std::span<const BodyId> moving, const Bodies& bodies, ContactSolver& solver);
 
 // Appends one solver point per contact, with its effective masses and approach speed. Skips
 // the contacts the solver does not own (see above).

@@ -30,8 +30,9 @@ void checkFinite(const StepContext& step, const Bodies& bodies) {
         checkMassesFinite(part.model(), used, part.state(), part.movingMasses(), id, step.time);
     }
     for (BodyId id = 0; id < bodies.size(); ++id) {
-        const Pose& pose = bodies.parts[id]->pose();
         const RigidBody& body = bodies.rigid[id];
+        if (body.motion == MotionType::Static) continue;  // never moves, takes no load (added finite)
+        const Pose& pose = bodies.parts[id]->pose();
         // Causes before effects: loads, then velocities, then the pose they moved.
         checkRigid(id, step.time, "accumulated force", body.force);
         checkRigid(id, step.time, "accumulated torque", body.torque);

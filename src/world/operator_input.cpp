@@ -12,13 +12,6 @@ namespace {
 
 const std::string kSource = "world";
 
-// The rotation as axis and angle in (-pi, pi]: the short way round.
-Eigen::AngleAxisd shortestTurn(const Eigen::Quaterniond& q) {
-    Eigen::AngleAxisd turn(q);
-    if (turn.angle() > M_PI) turn.angle() -= 2.0 * M_PI;
-    return turn;
-}
-
 CouplingGains couplingGains(const RigidBody& body, const GrabSettings& g, double h) {
     const double omega = std::min(2.0 * M_PI * g.frequency, 0.4 / h);
     const double smallestInertia = 1.0 / Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(body.inverseInertia).eigenvalues().maxCoeff();

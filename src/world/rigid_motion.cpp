@@ -54,7 +54,7 @@ void collectMovingBodies(const Bodies& bodies, RigidMotionScratch& s) {
     for (BodyId id = 0; id < bodies.size(); ++id)
         if (bodies.rigid[id].motion == MotionType::Kinematic && bodies.kinematicTargets[id]) s.moving.push_back(id);
     for (BodyId id = 0; id < bodies.size(); ++id)
-        if (bodies.rigid[id].motion == MotionType::Dynamic) s.moving.push_back(id);
+        if (bodies.dynamic(id)) s.moving.push_back(id);
 }
 
 // A kinematic body is stopped by static and kinematic rigid parts; a dynamic one by the parts
@@ -63,8 +63,8 @@ void collectMovingBodies(const Bodies& bodies, RigidMotionScratch& s) {
 // yield (contact_response).
 bool stops(const Bodies& bodies, BodyId mover, BodyId other) {
     if (bodies.parts[other]->deforms()) return false;
-    if (bodies.rigid[mover].motion == MotionType::Dynamic) return solvedByImpulses(bodies, mover, other);
-    return bodies.rigid[other].motion != MotionType::Dynamic;
+    if (bodies.dynamic(mover)) return solvedByImpulses(bodies, mover, other);
+    return !bodies.dynamic(other);
 }
 
 BodyId partnerOf(BodyId id, const Contact& c) { return c.partA == id ? c.partB : c.partA; }
@@ -113,25 +113,29 @@ std::span<const Contact> rigidContactsOf(BodyId id, Bodies& bodies, CollisionWor
     return contacts;
 }
 
+// The speed the loads and gravity give a body in a step: its own when it is dynamic (every
+// dynamic body moves), gravity's for the others.
+double loadSpeedOf(BodyId id, const Bodies& bodies, const RigidMotionScratch& s) {
+    return bodies.dynamic(id) ? s.loadSpeed[id] : s.gravitySpeed;
+}
+
 // 1. The dynamic bodies' rigid contacts into the solver, each pair once, with their
 // restitution threshold; every moving body's stopping pairs' depths.
 void gatherContacts(Bodies& bodies, CollisionWorld& collision, RigidMotionScratch& s, StepProfiler& profiler) {
     s.solver.contacts.clear();
-    updateInverseInertia(bodies, s.solver);
-    s.startDepths.clear();
-    s.startOffset.assign(bodies.size(), 0);
-    s.startCount.assign(bodies.size(), 0);
+    updateInverseInertia(s.moving, bodies, s.solver);
+    s.startDepths.clear();  // recordStartDepths sets each mover's offset and count
     for (BodyId id : s.moving) {
         const std::span<const Contact> contacts = rigidContactsOf(id, bodies, collision, s, profiler);
         recordStartDepths(id, contacts, bodies, s);
-        if (bodies.rigid[id].motion != MotionType::Dynamic) continue;
+        if (!bodies.dynamic(id)) continue;
         // A pair of dynamic bodies is added by the lower id's query, when that query saw it
         // (queries skip deforming partners).
         s.unseen.clear();
         const bool seenByLower = !bodies.parts[id]->deforms();
         for (const Contact& c : contacts) {
             const BodyId other = partnerOf(id, c);
-            if (other > id || bodies.rigid[other].motion != MotionType::Dynamic || !seenByLower) s.unseen.push_back(c);
+            if (other > id || !bodies.dynamic(other) || !seenByLower) s.unseen.push_back(c);
         }
         const std::size_t first = s.solver.contacts.size();
         addContacts(s.unseen, bodies, s.solver);
@@ -139,7 +143,7 @@ void gatherContacts(Bodies& bodies, CollisionWorld& collision, RigidMotionScratc
         // step: a resting contact under any load does not.
         for (std::size_t k = first; k < s.solver.contacts.size(); ++k) {
             SolverContact& c = s.solver.contacts[k];
-            c.bounceThreshold = 2.0 * std::max(s.loadSpeed[c.a], s.loadSpeed[c.b]) + 1e-9;
+            c.bounceThreshold = 2.0 * std::max(loadSpeedOf(c.a, bodies, s), loadSpeedOf(c.b, bodies, s)) + 1e-9;
         }
     }
 }
@@ -232,12 +236,17 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
     const double h = step.timeStep;
     collectMovingBodies(bodies, s);
     if (s.moving.empty()) return;
-    s.loadSpeed.assign(bodies.size(), h * step.gravity.norm());
-    for (BodyId id : s.moving)
-        if (bodies.rigid[id].motion == MotionType::Dynamic) s.loadSpeed[id] = integrateVelocity(step, *bodies.parts[id], bodies.rigid[id]);
+    s.gravitySpeed = h * step.gravity.norm();
+    for (std::vector<std::size_t>* v : {&s.startOffset, &s.startCount}) v->resize(bodies.size());
+    s.loadSpeed.resize(bodies.size());
     s.stepStart.resize(bodies.size());
     s.subStart.resize(bodies.size());
-    for (BodyId id : s.moving) s.stepStart[id] = bodies.parts[id]->pose();
+    s.stopped.resize(bodies.size());
+    for (BodyId id : s.moving) {
+        if (bodies.dynamic(id)) s.loadSpeed[id] = integrateVelocity(step, *bodies.parts[id], bodies.rigid[id]);
+        s.stepStart[id] = bodies.parts[id]->pose();
+        s.stopped[id] = 0;
+    }
     const double thinnest = bodies.minimumThickness();
     const double slop = settings.contactSlop * thinnest;
     const double bound = settings.maxTravelFraction * thinnest;
@@ -246,7 +255,6 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
     // Depth is taken out at up to one slop per step: conservative advancement keeps it below
     // the slop, so the separation only corrects drift.
     const Separation separation{kSeparationShare / dt, kLinearSlopShare * slop, slop / h};
-    s.stopped.assign(bodies.size(), 0);
     // The last mover's contacts stay valid into this step unless something moved it or a part
     // it may touch since: a body at rest costs one query per step.
     if (s.cacheEpoch != bodies.poseEpoch) s.cachedBody.reset();
@@ -259,7 +267,6 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
             s.subStart[id] = bodies.parts[id]->pose();
             bodies.parts[id]->setPose(advancedPose(s.subStart[id], dt, bodies.rigid[id]));
         }
-        s.cachedBody.reset();
         for (BodyId id : s.moving) {
             const bool reached = settleMove(id, dt, slop, bound, step, bodies, collision, s, profiler);
             if (!reached) {
@@ -290,9 +297,7 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
         RigidBody& body = bodies.rigid[id];
         const Pose& start = s.stepStart[id];
         const Pose& end = bodies.parts[id]->pose();
-        Eigen::Quaterniond rotation = end.rotation * start.rotation.conjugate();
-        if (rotation.w() < 0.0) rotation.coeffs() *= -1.0;  // the short way round
-        const Eigen::AngleAxisd turn(rotation);
+        const Eigen::AngleAxisd turn = shortestTurn(end.rotation * start.rotation.conjugate());
         body.linearVelocity = (end.apply(body.centreOfMass) - start.apply(body.centreOfMass)) / h;
         body.angularVelocity = turn.axis() * (turn.angle() / h);
     }

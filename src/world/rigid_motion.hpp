@@ -35,7 +35,8 @@ struct RigidMotionScratch {
     // id's are startDepths[startOffset[id] .. + startCount[id]).
     std::vector<std::pair<BodyId, double>> startDepths;
     std::vector<std::size_t> startOffset, startCount;  // (nbody)
-    std::vector<double> loadSpeed;      // (nbody) speed the loads and gravity give in a step
+    std::vector<double> loadSpeed;      // (nbody) speed the loads and gravity give a dynamic body in a step
+    double gravitySpeed = 0.0;          // gravity's alone, this step
     std::vector<Pose> subStart;         // (nbody) pose at the sub-step's start
     std::vector<Pose> stepStart;        // (nbody) pose at the step's start (kinematic bodies)
     std::vector<char> stopped;          // (nbody) a sub-step of this step was cut short

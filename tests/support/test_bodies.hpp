@@ -5,6 +5,9 @@
 #include "flexfit/world.hpp"
 #include "flexfit/generators.hpp"
 
+#include <algorithm>
+#include <vector>
+
 namespace flexfit::testing {
 
 inline PartSettings rigidPart() {
@@ -31,6 +34,24 @@ struct BallTorus {
         ball = world.add(buildPartModel(makeIcoSphere(diameter / 2, 3)), rigidPart(), dynamicBody(velocity), at(Vec3(0, startHeight, 0)));
     }
     double ballHeight() const { return world.centreOfMass(ball).y(); }
+};
+
+// How far some bodies stray from the poses they had when it was made: the largest translation
+// and rotation (radians) seen by record().
+struct PoseDrift {
+    std::vector<BodyId> bodies;
+    std::vector<Pose> rest;
+    double translation = 0.0, rotation = 0.0;
+    PoseDrift(const World& world, std::vector<BodyId> ids) : bodies(std::move(ids)) {
+        for (BodyId id : bodies) rest.push_back(world.part(id).pose());
+    }
+    void record(const World& world) {
+        for (std::size_t k = 0; k < bodies.size(); ++k) {
+            const Pose& pose = world.part(bodies[k]).pose();
+            translation = std::max(translation, (pose.translation - rest[k].translation).norm());
+            rotation = std::max(rotation, pose.rotation.angularDistance(rest[k].rotation));
+        }
+    }
 };
 
 }  // namespace flexfit::testing

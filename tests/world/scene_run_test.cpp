@@ -5,6 +5,7 @@
 #include "flexfit/scene_file.hpp"
 #include "flexfit/scene_run.hpp"
 #include "golden.hpp"
+#include "test_bodies.hpp"
 
 #include <gtest/gtest.h>
 
@@ -238,19 +239,14 @@ TEST(SceneRun, StackStaysInItsSettledPose) {
     SceneRun run(scene);
     const World& w = run.world();
     runFor(run, 0.2);  // settle into the contacts (each box starts 1e-4 above the one below)
-    std::vector<Pose> settled;
-    for (BodyId id : boxes) settled.push_back(w.part(id).pose());
-    EXPECT_LT((settled[0].translation - scene.parts[boxes[0]].pose.translation).norm(), 1e-3);  // settled where it was put
-    double drift = 0.0, turn = 0.0;
+    flexfit::testing::PoseDrift drift(w, boxes);
+    EXPECT_LT((drift.rest[0].translation - scene.parts[boxes[0]].pose.translation).norm(), 1e-3);  // settled where it was put
     while (!run.finished()) {
         run.step();
-        for (std::size_t k = 0; k < boxes.size(); ++k) {
-            drift = std::max(drift, (w.part(boxes[k]).pose().translation - settled[k].translation).norm());
-            turn = std::max(turn, w.part(boxes[k]).pose().rotation.angularDistance(settled[k].rotation));
-        }
+        drift.record(w);
     }
-    EXPECT_LT(drift, 1e-3);
-    EXPECT_LT(turn, 1e-3);
+    EXPECT_LT(drift.translation, 1e-3);
+    EXPECT_LT(drift.rotation, 1e-3);
 }
 
 TEST(SceneRun, FrictionSlowsTheBallThroughTheMouthButItStillPasses) {
