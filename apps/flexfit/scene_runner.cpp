@@ -183,6 +183,7 @@ std::string summaryJson(const Scene& scene, const RunSummary& s) {
                      s.maxDeformation, optionalJson(s.lastContact), optionalJson(s.restored), s.maxCouplingForce);
     j += fmt::format("  \"substeps\": {},\n  \"cut_moves\": {},\n  \"rigid_queries\": {},\n", s.profile.substeps, s.profile.cutMoves,
                      s.profile.rigidQueries);
+    j += fmt::format("  \"face_queries\": {},\n  \"face_traversals\": {},\n", s.profile.faceQueries, s.profile.faceTraversals);
     j += fmt::format("  \"world_step_seconds\": {:.9f},\n  \"stage_seconds\": {{", s.profile.totalStepSeconds);
     for (std::size_t i = 0; i < kStageCount; ++i)
         j += fmt::format("{}{}: {:.9f}", i ? ", " : "", jsonString(toString(Stage(i))), s.profile.totalSeconds[i]);

@@ -96,6 +96,7 @@ public:
     }
 
     const std::vector<Node>& nodes() const { return nodes_; }
+    const BV& leafVolume(Index item) const { return nodes_[leafOf_[item]].volume; }
     bool empty() const { return nodes_.empty(); }
     const BV& rootVolume() const { return nodes_.front().volume; }
     std::size_t refitNodeCount() const { return refitNodes_; }  // nodes recomputed by refits so far

@@ -10,7 +10,10 @@
 // collision.csv): rebuild 105.6 us, refit 116.5 us per update, because merged spheres are looser
 // than the top-down enclosure and the queries then visit more nodes.
 //
-// Narrow phase: per candidate pair, the two face hierarchies traversed together (collision.hpp).
+// Narrow phase: per candidate pair, the two face hierarchies traversed together (collision.hpp),
+// or, by default, the pair's candidates from its last traversal while they still cover it
+// (queryPairCoherent: exactly the same contacts). The world keeps one PairCoherence per pair
+// that a face query has met, and drops those the broad phase has not paired for a while.
 // Part A of a pair is the pressing one: the rigid part when exactly one is deformable, otherwise
 // the lower id. With ExactTest::SphereTriangle A's faces are spheres and B's triangles.
 //
@@ -27,6 +30,7 @@
 #include "flexfit/distance_field.hpp"
 
 #include <memory>
+#include <unordered_map>
 
 namespace flexfit {
 
@@ -57,6 +61,9 @@ struct CollisionSettings {
     ExactTest exactTest = ExactTest::TriangleTriangle;
     BroadPhaseUpdate broadPhase = BroadPhaseUpdate::Rebuild;
     RigidDeformableQuery rigidDeformable = RigidDeformableQuery::Faces;
+    // Face queries start from what the pair's last query found (queryPairCoherent): the same
+    // contacts as a full traversal, at O(candidates) while the pair moves little.
+    bool coherent = true;
 };
 
 class CollisionWorld {
@@ -107,11 +114,17 @@ public:
     // The bodies whose hierarchy the last narrowPhase() or contactsOf() refitted from their
     // part's changed masses: those parts' lists can be cleared (Part::clearChangedMasses).
     std::span<const BodyId> refittedBodies() const { return refitted_.members(); }
+    // Face queries answered so far, and how many of them needed a traversal (coherent
+    // queries reuse the pair's candidates otherwise).
+    std::uint64_t faceQueries() const { return faceQueries_; }
+    std::uint64_t faceTraversals() const { return faceTraversals_; }
 
 private:
     bool pressesFirst(BodyId a, BodyId b) const;
     // Contacts of the pair (a presses b) appended to `out`, by the query the settings choose.
     void queryPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats);
+    // Forgets the coherence of pairs no query has used lately (broad_phase.cpp).
+    void dropStaleCoherence();
     // Refits the body's hierarchy from its part's changed masses, once per query call.
     void refitChanged(BodyId id);
 
@@ -127,6 +140,13 @@ private:
     std::vector<std::int32_t> stack_;    // broad-phase traversal
     IndexSet refitted_;                  // (nbody) refitted by the last query call
     QueryStats stats_;
+    struct KeptCoherence {
+        PairCoherence coherence;
+        std::uint64_t lastUpdate = 0;  // the update() count when last used
+    };
+    std::unordered_map<std::uint64_t, KeptCoherence> coherence_;  // by (a << 32 | b), a presses b
+    std::uint64_t updates_ = 0;
+    std::uint64_t faceQueries_ = 0, faceTraversals_ = 0;
 };
 
 }  // namespace flexfit

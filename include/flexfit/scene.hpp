@@ -10,7 +10,8 @@
 // or out of range; see examples/*.toml and the README for a complete table):
 //   [world]      time_step, gravity, duration, max_travel_fraction, max_substeps,
 //                contact_iterations, contact_slop, contact_damping,
-//                exact_test = "triangle" | "sphere", rigid_deformable_query
+//                exact_test = "triangle" | "sphere", rigid_deformable_query,
+//                coherent_collision (true/false)
 //   [[part]]     name, mesh (path relative to the scene) or generator ("torus1", "torus2",
 //                "heart", "container-mouth", or a table {type = "torus" | "sphere" | "box" |
 //                "plate", ...}),

@@ -38,6 +38,17 @@ void CollisionWorld::update() {
         }
     }
     std::sort(pairs_.begin(), pairs_.end());
+    dropStaleCoherence();
+}
+
+// A pair unused for this many updates loses its coherence (it is rebuilt by one traversal if
+// it comes back).
+constexpr std::uint64_t kCoherenceKeptFor = 64;
+
+void CollisionWorld::dropStaleCoherence() {
+    ++updates_;
+    if (updates_ % kCoherenceKeptFor != 0) return;
+    std::erase_if(coherence_, [&](const auto& entry) { return updates_ - entry.second.lastUpdate > kCoherenceKeptFor; });
 }
 
 }  // namespace flexfit

@@ -59,6 +59,7 @@ void CollisionWorld::setExactTest(ExactTest test) {
         if (!colliders_[i].restPointTree().empty()) rebuilt.buildRestPointTree(*parts_[i]);
         colliders_[i] = std::move(rebuilt);
     }
+    coherence_.clear();  // the candidates were of the old hierarchies
 }
 
 bool CollisionWorld::pressesFirst(BodyId a, BodyId b) const {

@@ -52,7 +52,16 @@ void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, Qu
         return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(), out, stats);
     refitChanged(a);
     refitChanged(b);
-    flexfit::queryPair(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, out, stats);
+    ++faceQueries_;
+    if (!settings_.coherent) {
+        ++faceTraversals_;
+        return flexfit::queryPair(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, out, stats);
+    }
+    KeptCoherence& kept = coherence_[std::uint64_t(a) << 32 | b];
+    kept.lastUpdate = updates_;
+    const std::uint64_t traversals = kept.coherence.traversals;
+    queryPairCoherent(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, kept.coherence, out, stats);
+    faceTraversals_ += kept.coherence.traversals - traversals;
 }
 
 void CollisionWorld::refitChanged(BodyId id) {

@@ -58,6 +58,12 @@ public:
         if (!(v >= 0.0)) fail(*table_.get(key), key, "must be >= 0");
         return v;
     }
+    bool flag(const std::string& key, bool fallback) {
+        const toml::node* n = node(key);
+        if (!n) return fallback;
+        if (!n->is_boolean()) fail(*n, key, "expected true or false");
+        return n->value<bool>().value();
+    }
     int integer(const std::string& key, int fallback, int lo, int hi) {
         const toml::node* n = node(key);
         if (!n) return fallback;
@@ -411,6 +417,7 @@ void readWorld(Table& root, Scene& scene) {
     s.contactDamping = w.nonNegative("contact_damping", s.contactDamping);
     s.collision.exactTest = w.choice("exact_test", ExactTest::TriangleTriangle);
     s.collision.rigidDeformable = w.choice("rigid_deformable_query", RigidDeformableQuery::Faces);
+    s.collision.coherent = w.flag("coherent_collision", s.collision.coherent);
     w.finish();
     try {
         validateSettings(s);

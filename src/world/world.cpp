@@ -188,6 +188,8 @@ void World::step() {
     d.time += d.settings.timeStep;
     ++d.stepIndex;
     ++d.profile.steps;
+    d.profile.faceQueries = d.collision.faceQueries();
+    d.profile.faceTraversals = d.collision.faceTraversals();
 }
 
 double World::time() const { return data_->time; }

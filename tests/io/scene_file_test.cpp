@@ -365,3 +365,10 @@ TEST(SceneFile, PlateHoleLargerThanThePlateIsReported) {
     const std::string hole = errorOf(withMouthGenerator("generator = { type = \"plate\", hole_x = -1 }"));
     EXPECT_NE(hole.find("scene.toml:9: part 1.generator, key 'hole_x': must be > 0"), std::string::npos) << hole;
 }
+
+TEST(SceneFile, CoherentCollisionIsAFlag) {
+    EXPECT_TRUE(parseScene(kBall, "scene.toml", ".").world.collision.coherent);  // default
+    EXPECT_FALSE(parseScene(withLine("duration = 2.5", "coherent_collision = false"), "scene.toml", ".").world.collision.coherent);
+    const std::string e = errorOf(withLine("duration = 2.5", "coherent_collision = \"no\""));
+    EXPECT_NE(e.find(":6: scene.world, key 'coherent_collision': expected true or false"), std::string::npos) << e;
+}

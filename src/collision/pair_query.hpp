@@ -1,0 +1,249 @@
+// Internal to src/collision: the pieces the full and the coherent pair queries share
+// (collision.hpp): the simultaneous traversal of two hierarchies, the cheap rejection by an
+// at-rest face's planes, and the exact test of one leaf pair.
+#pragma once
+
+#include "collision/triangle_queries.hpp"
+#include "flexfit/collision.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+namespace flexfit::detail {
+
+inline Triangle triangleOf(std::span<const Vec3> positions, const Face& f) { return {positions[f[0]], positions[f[1]], positions[f[2]]}; }
+
+inline double volumeSize(const Sphere& s) { return 2.0 * s.radius; }
+inline double volumeSize(const Aabb& b) { return b.size(); }
+
+inline Sphere grown(const Sphere& s, double margin) { return {s.centre, s.radius + margin}; }
+inline Aabb grown(const Aabb& b, double margin) { return {b.min.array() - margin, b.max.array() + margin}; }
+
+// Simultaneous depth-first traversal; leafPair(faceA, faceB) for every overlapping leaf pair.
+// prune(faceA, volumeB) may cut a subtree of B that cannot touch A's leaf face. A margin > 0
+// grows A's volumes by it (for the coherent query's candidates); which side descends depends
+// on the volumes alone, not on the margin.
+template <class BA, class BB, class LeafPair, class Prune>
+void traverse(const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, QueryStats& stats, LeafPair leafPair, Prune prune,
+              double margin) {
+    if (a.empty() || b.empty()) return;
+    thread_local std::vector<std::pair<std::int32_t, std::int32_t>> stack;
+    stack.clear();
+    stack.emplace_back(0, 0);
+    const auto& na = a.nodes();
+    const auto& nb = b.nodes();
+    while (!stack.empty()) {
+        const auto [i, j] = stack.back();
+        stack.pop_back();
+        const auto& x = na[std::size_t(i)];
+        const auto& y = nb[std::size_t(j)];
+        ++stats.volumeTests;
+        if (!(margin > 0.0 ? overlap(grown(x.volume, margin), y.volume, bInA) : overlap(x.volume, y.volume, bInA))) continue;
+        if (x.isLeaf() && !y.isLeaf() && prune(x.item, y.volume)) continue;
+        if (x.isLeaf() && y.isLeaf()) {
+            ++stats.candidatePairs;
+            leafPair(x.item, y.item);
+        } else if (x.isLeaf() || (!y.isLeaf() && volumeSize(y.volume) > volumeSize(x.volume))) {
+            stack.emplace_back(i, y.right);
+            stack.emplace_back(i, y.left);
+        } else {
+            stack.emplace_back(x.right, j);
+            stack.emplace_back(x.left, j);
+        }
+    }
+}
+
+template <class Visit>
+void dispatch(const PartCollider& a, const PartCollider& b, Visit visit) {
+    if (a.spheres() && b.spheres()) return visit(*a.spheres(), *b.spheres());
+    if (a.spheres() && b.boxes()) return visit(*a.spheres(), *b.boxes());
+    if (a.boxes() && b.spheres()) return visit(*a.boxes(), *b.spheres());
+    return visit(*a.boxes(), *b.boxes());
+}
+
+// Cheap rejection before the triangle test, when A's face is at rest (its planes are cached
+// in A's frame, and moved to B's frame once per face and query): B's triangle entirely beyond
+// the face's plane (either side) or beyond one of its edge planes is separated from it along
+// that direction, and needs no transform. The margin is far wider than the triangle test's
+// own tolerance, so only pairs that test would also reject are skipped.
+class RestPlaneFilter {
+public:
+    RestPlaneFilter(const Part& a, const PartCollider& colliderA, const RelativePose& bInA) : a_(a), collider_(colliderA), bInA_(bInA) {
+        movedPlanes_.clear();
+        movedPlanes_.growTo(a.model().faceCount());
+        if (planesInB_.size() < a.model().faceCount()) planesInB_.resize(a.model().faceCount());
+    }
+    bool separated(Index fa, std::span<const Vec3> pb, const Face& fb) {
+        if (!atRest(fa)) return false;
+        const auto& planes = planesInB(fa);
+        for (std::size_t k = 0; k < planes.size(); ++k) {
+            const Vec3 n = planes[k].head<3>();
+            const double margin = 1e-9 * (1.0 + std::abs(collider_.restPlanes(fa)[k][3]));
+            const double d0 = n.dot(pb[fb[0]]) - planes[k][3], d1 = n.dot(pb[fb[1]]) - planes[k][3], d2 = n.dot(pb[fb[2]]) - planes[k][3];
+            if (d0 > margin && d1 > margin && d2 > margin) return true;
+            if (k == 0 && d0 < -margin && d1 < -margin && d2 < -margin) return true;
+        }
+        return false;
+    }
+
+    // A subtree of B whose volume lies entirely beyond one of A's face planes holds no
+    // triangle the face can touch (each would be rejected by separated()).
+    template <class Volume>
+    bool separated(Index fa, const Volume& volumeB, double extra = 0.0) {
+        if (!atRest(fa)) return false;
+        const auto& planes = planesInB(fa);
+        for (std::size_t k = 0; k < planes.size(); ++k) {
+            const Vec3 n = planes[k].head<3>();
+            const double margin = 1e-9 * (1.0 + std::abs(collider_.restPlanes(fa)[k][3])) + extra;
+            const auto [lowest, highest] = extent(volumeB, n);
+            if (lowest - planes[k][3] > margin) return true;
+            if (k == 0 && highest - planes[k][3] < -margin) return true;
+        }
+        return false;
+    }
+
+    // How far B's triangle lies beyond one of the planes of A's face, less the margin
+    // separated() keeps: while A does not deform and B's vertices move less than that (in A's
+    // frame), separated() rejects the pair on that plane. 0 when no plane separates them, or A
+    // deforms.
+    // Stops early once the gap exceeds `enough`.
+    double separation(Index fa, std::span<const Vec3> pb, const Face& fb, double enough) {
+        if (a_.mode() != PartMode::Rigid) return 0.0;
+        const auto& planes = planesInB(fa);
+        double gap = 0.0;
+        for (std::size_t k = 0; k < planes.size(); ++k) {
+            const Vec3 n = planes[k].head<3>();
+            const double margin = 1e-9 * (1.0 + std::abs(collider_.restPlanes(fa)[k][3]));
+            const double d0 = n.dot(pb[fb[0]]) - planes[k][3], d1 = n.dot(pb[fb[1]]) - planes[k][3], d2 = n.dot(pb[fb[2]]) - planes[k][3];
+            gap = std::max(gap, std::min({d0, d1, d2}) - margin);
+            if (k == 0) gap = std::max(gap, -std::max({d0, d1, d2}) - margin);
+            if (gap > enough) break;
+        }
+        return gap * (1.0 - 1e-12);
+    }
+
+private:
+    bool atRest(Index fa) const {
+        const Face& f = a_.model().mesh.faces[fa];
+        return a_.mode() == PartMode::Rigid || !(a_.isMoving(f[0]) || a_.isMoving(f[1]) || a_.isMoving(f[2]));
+    }
+    // Range of n.x over the volume.
+    static std::pair<double, double> extent(const Aabb& box, const Vec3& n) {
+        const double centre = n.dot(box.centre()), reach = n.cwiseAbs().dot(box.halfExtents());
+        return {centre - reach, centre + reach};
+    }
+    static std::pair<double, double> extent(const Sphere& sphere, const Vec3& n) {
+        const double centre = n.dot(sphere.centre);
+        return {centre - sphere.radius, centre + sphere.radius};
+    }
+    // n.(R x + t) = d  <=>  (R^T n).x = d - n.t
+    const std::array<Eigen::Vector4d, 4>& planesInB(Index fa) {
+        if (movedPlanes_.insert(fa)) {
+            const auto& planes = collider_.restPlanes(fa);
+            for (std::size_t k = 0; k < planes.size(); ++k) {
+                const Vec3 n = planes[k].head<3>();
+                planesInB_[fa][k] << bInA_.rotation.transpose() * n, planes[k][3] - n.dot(bInA_.translation);
+            }
+        }
+        return planesInB_[fa];
+    }
+    const Part& a_;
+    const PartCollider& collider_;
+    const RelativePose& bInA_;
+    static thread_local std::vector<std::array<Eigen::Vector4d, 4>> planesInB_;
+    static thread_local IndexSet movedPlanes_;  // faces whose planes are in planesInB_ for this query
+};
+
+
+inline RelativePose relativePose(const Part& a, const Part& b) {
+    // B's frame seen from A's: x_A = Ra^T (Rb x_B + tb - ta).
+    const Eigen::Matrix3d ra = a.pose().rotation.toRotationMatrix(), rb = b.pose().rotation.toRotationMatrix();
+    return RelativePose(ra.transpose() * rb, ra.transpose() * (b.pose().translation - a.pose().translation));
+}
+
+// The exact test of one leaf pair (face of A, face of B) at the parts' current shapes and poses,
+// shared by the full and the coherent query.
+class LeafPairTester {
+public:
+    LeafPairTester(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
+                   ExactTest test, const RelativePose& bInA, std::vector<Contact>& contacts, QueryStats& stats)
+        : idA_(idA), idB_(idB), a_(a), b_(b), test_(test), bInA_(bInA), ra_(a.pose().rotation.toRotationMatrix()),
+          filter_(a, colliderA, bInA), contacts_(contacts), stats_(stats) {}
+
+    void operator()(Index fa, Index fb) {
+        const std::span<const Vec3> pa = a_.state().positions, pb = b_.state().positions;
+        const Face& f = b_.model().mesh.faces[fb];
+        ++stats_.exactTests;
+        if (test_ == ExactTest::TriangleTriangle && filter_.separated(fa, pb, f)) return;
+        const Triangle tb{bInA_.apply(pb[f[0]]), bInA_.apply(pb[f[1]]), bInA_.apply(pb[f[2]])};
+        std::optional<TriangleContact> hit;
+        if (test_ == ExactTest::SphereTriangle) {
+            const Sphere s = faceSphere(pa, a_.model().mesh.faces[fa]);
+            hit = sphereTriangleContact(s.centre, s.radius, tb);
+        } else {
+            hit = intersectTriangles(triangleOf(pa, a_.model().mesh.faces[fa]), tb);
+        }
+        if (!hit) return;
+        ++stats_.contacts;
+        contacts_.push_back({idA_, idB_, fa, fb, a_.pose().apply(hit->point), ra_ * hit->normal, hit->depth});
+    }
+    // Subtrees of B that A's at-rest leaf face cannot touch (RestPlaneFilter).
+    template <class Volume>
+    bool prunes(Index fa, const Volume& volumeB) {
+        return test_ == ExactTest::TriangleTriangle && filter_.separated(fa, volumeB);
+    }
+    // How far B's face may move (its vertices, in A's frame) before the exact test could find
+    // a contact with A's face (A rigid).
+    double separationByA(Index fa, Index fb, double enough) {
+        return test_ == ExactTest::TriangleTriangle ? filter_.separation(fa, b_.state().positions, b_.model().mesh.faces[fb], enough) : 0.0;
+    }
+    // How far A's face may move (its vertices, in B's frame) before it reaches the plane of B's
+    // face as it is now, less a margin far above the exact test's tolerance: while it stays
+    // strictly on one side, intersectTriangles rejects the pair at once.
+    double separationByB(Index fa, Index fb) {
+        if (test_ != ExactTest::TriangleTriangle) return 0.0;
+        const std::span<const Vec3> pa = a_.state().positions, pb = b_.state().positions;
+        const Face& f = b_.model().mesh.faces[fb];
+        const Vec3 n = (pb[f[1]] - pb[f[0]]).cross(pb[f[2]] - pb[f[0]]);
+        const double length = n.norm();
+        if (!(length > 0.0)) return 0.0;
+        const Vec3 unit = n / length;
+        const double offset = unit.dot(pb[f[0]]);
+        double lowest = std::numeric_limits<double>::infinity(), highest = -lowest, reach2 = 0.0;
+        const Face& g = a_.model().mesh.faces[fa];
+        for (int i = 0; i < 3; ++i) {
+            const Vec3 p = bInA_.rotation.transpose() * (pa[g[i]] - bInA_.translation);  // A's vertex in B's frame
+            const double d = unit.dot(p) - offset;
+            lowest = std::min(lowest, d);
+            highest = std::max(highest, d);
+            reach2 = std::max({reach2, (pa[g[i]] - pa[g[(i + 1) % 3]]).squaredNorm(), (pb[f[i]] - pb[f[(i + 1) % 3]]).squaredNorm()});
+        }
+        const double margin = 1e-8 * (1.0 + std::abs(offset) + reach2);
+        return std::max({0.0, lowest - margin, -highest - margin}) * (1.0 - 1e-12);
+    }
+    // B's subtrees beyond a plane of A's (rigid) leaf face by more than `margin`.
+    template <class Volume>
+    bool prunesBeyond(Index fa, const Volume& volumeB, double margin) {
+        return test_ == ExactTest::TriangleTriangle && a_.mode() == PartMode::Rigid && filter_.separated(fa, volumeB, margin);
+    }
+
+private:
+    std::uint32_t idA_, idB_;
+    const Part& a_;
+    const Part& b_;
+    ExactTest test_;
+    const RelativePose& bInA_;
+    Eigen::Matrix3d ra_;
+    RestPlaneFilter filter_;
+    std::vector<Contact>& contacts_;
+    QueryStats& stats_;
+};
+
+inline void requireBuiltFor(const PartCollider& colliderA, const PartCollider& colliderB, ExactTest test) {
+    if (colliderA.exactTest() != test || colliderB.exactTest() != test)
+        throw std::invalid_argument("queryPair: a collider was built for another exact test");
+}
+
+}  // namespace flexfit::detail

@@ -1,0 +1,232 @@
+// The coherent pair query (coherent_query.cpp) against the full query it stands for, contact for
+// contact (faces, point, normal, depth, order), and against brute force over every face pair,
+// on random motion sequences: rigid pairs, a rigid tool over a deforming part, two deforming
+// parts; both bounding volumes and both exact tests. Then what makes it coherent: a pair at
+// rest stops traversing, a moving pair traverses far less often than it queries, and a
+// rebuilt hierarchy is never answered from the old candidates.
+#include "collision/triangle_queries.hpp"
+#include "flexfit/flexfit.hpp"
+#include "test_bodies.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+
+using namespace flexfit;
+using flexfit::testing::rigidPart;
+
+namespace {
+
+// Every field, bit for bit, in order.
+void expectSameContacts(const std::vector<Contact>& got, const std::vector<Contact>& want, int step) {
+    ASSERT_EQ(got.size(), want.size()) << "step " << step;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        EXPECT_EQ(got[i].faceA, want[i].faceA) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].faceB, want[i].faceB) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].point, want[i].point) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].normal, want[i].normal) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].depth, want[i].depth) << "step " << step << " contact " << i;
+    }
+}
+
+// Face pairs in contact by testing every pair (no hierarchy).
+std::set<std::pair<Index, Index>> bruteForceContacts(const Part& a, const Part& b, ExactTest test) {
+    const Eigen::Matrix3d ra = a.pose().rotation.toRotationMatrix(), rb = b.pose().rotation.toRotationMatrix();
+    const RelativePose bInA(ra.transpose() * rb, ra.transpose() * (b.pose().translation - a.pose().translation));
+    const auto& pa = a.state().positions;
+    const auto& pb = b.state().positions;
+    std::set<std::pair<Index, Index>> out;
+    for (Index fa = 0; fa < a.model().faceCount(); ++fa)
+        for (Index fb = 0; fb < b.model().faceCount(); ++fb) {
+            const Face& x = a.model().mesh.faces[fa];
+            const Face& y = b.model().mesh.faces[fb];
+            const Triangle ty{bInA.apply(pb[y[0]]), bInA.apply(pb[y[1]]), bInA.apply(pb[y[2]])};
+            const Sphere s = faceSphere(pa, x);
+            const bool hit = test == ExactTest::SphereTriangle ? sphereTriangleContact(s.centre, s.radius, ty).has_value()
+                                                               : intersectTriangles({pa[x[0]], pa[x[1]], pa[x[2]]}, ty).has_value();
+            if (hit) out.insert({fa, fb});
+        }
+    return out;
+}
+
+std::set<std::pair<Index, Index>> pairsOf(const std::vector<Contact>& contacts) {
+    std::set<std::pair<Index, Index>> out;
+    for (const Contact& c : contacts) out.insert({c.faceA, c.faceB});
+    return out;
+}
+
+// A small random rigid motion: a turn of up to `turn` radians about a random axis (about the
+// part's origin) and a shift of up to `shift`; now and then (1 in 25) a jump ten times as large.
+Pose nudged(const Pose& pose, std::mt19937& rng, double shift, double turn) {
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const double scale = std::uniform_int_distribution<int>(0, 24)(rng) == 0 ? 10.0 : 1.0;
+    Pose next = pose;
+    const Vec3 axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+    next.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(scale * turn * u(rng), axis)) * pose.rotation).normalized();
+    next.translation += scale * shift * Vec3(u(rng), u(rng), u(rng));
+    return next;
+}
+
+struct Variant {
+    BoundingVolumeKind kind;
+    ExactTest test;
+};
+
+class CoherentQuery : public ::testing::TestWithParam<Variant> {};
+
+// Runs `steps` queries of the pair (a presses b): the coherent answer must be the full one,
+// every step; every tenth step, also brute force's face pairs. Returns the traversals made.
+struct PairRun {
+    Part& a;
+    Part& b;
+    PartCollider ca, cb;
+    ExactTest test;
+    PairCoherence coherence;
+
+    PairRun(Part& a_, Part& b_, Variant v) : a(a_), b(b_), ca(a_, v.kind, v.test), cb(b_, v.kind, v.test), test(v.test) {}
+
+    void refit() {
+        for (auto [part, collider] : {std::pair{&a, &ca}, std::pair{&b, &cb}}) {
+            collider->refit(*part, part->changedMasses());
+            part->clearChangedMasses();
+        }
+    }
+    std::size_t check(int step, bool bruteForce) {
+        std::vector<Contact> coherent, full;
+        QueryStats s1, s2;
+        queryPairCoherent(0, a, ca, 1, b, cb, test, coherence, coherent, s1);
+        queryPair(0, a, ca, 1, b, cb, test, full, s2);
+        expectSameContacts(coherent, full, step);
+        if (bruteForce) {
+            EXPECT_EQ(pairsOf(coherent), bruteForceContacts(a, b, test)) << "step " << step;
+        }
+        return coherent.size();
+    }
+};
+
+}  // namespace
+
+TEST_P(CoherentQuery, RigidPairsInRandomMotionGetTheFullQuerysContacts) {
+    // A level-2 sphere tumbling and drifting against the (rigid) container-mouth-like torus: 400
+    // queries, small moves with occasional jumps.
+    std::mt19937 rng(11);
+    Part torus(buildPartModel(makeTorus(3.0, 1.0, 32, 16)), rigidPart());
+    Part ball(buildPartModel(makeIcoSphere(1.5, 2)), rigidPart());
+    ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(3.0, 2.2, 0.0)});
+    PairRun run(torus, ball, GetParam());
+    std::size_t contacts = 0;
+    for (int step = 0; step < 400; ++step) {
+        Pose next = nudged(ball.pose(), rng, 0.002, 0.002);
+        // Stay near the tube: pulled back towards a point on it.
+        next.translation += 0.05 * (Vec3(3.0, 2.0, 0.0) - next.translation);
+        ball.setPose(next);
+        contacts += run.check(step, step % 40 == 0);
+    }
+    EXPECT_GT(contacts, 0u);  // the sequence does touch
+    EXPECT_LT(run.coherence.traversals, 400u / 3) << "the candidates are reused";
+}
+
+TEST_P(CoherentQuery, ARigidToolOverADeformingPartGetsTheFullQuerysContacts) {
+    // A ball pressed into a torus while a zone there deforms (forces on the masses under it),
+    // and the ball drifts and turns: the part's hierarchy refits every step.
+    std::mt19937 rng(5);
+    Part torus(buildPartModel(makeTorus(3.0, 1.0, 32, 16)));
+    Part ball(buildPartModel(makeIcoSphere(1.0, 2)), rigidPart());
+    const Index pressed = 0;  // a mass on the outer equator, at (4, 0, 0)
+    ball.setPose(Pose{Eigen::Quaterniond::Identity(), torus.model().restPositions[pressed] + Vec3(0.9, 0.0, 0.0)});
+    torus.openZone(ZoneSeed::mass(pressed), 2);
+    PairRun run(ball, torus, GetParam());
+    std::size_t contacts = 0;
+    for (int step = 0; step < 200; ++step) {
+        torus.applyForce(pressed, Vec3(-20.0, 0.0, 0.0));
+        torus.step();
+        ball.setPose(nudged(ball.pose(), rng, 0.004, 0.01));
+        run.refit();
+        contacts += run.check(step, step % 25 == 0);
+    }
+    EXPECT_GT(contacts, 0u);
+    EXPECT_LT(run.coherence.traversals, 200u);
+}
+
+TEST_P(CoherentQuery, TwoDeformingPartsGetTheFullQuerysContacts) {
+    // Two tori interlocked face to face, each with a zone pushed towards the other.
+    std::mt19937 rng(9);
+    const auto model = buildPartModel(makeTorus(3.0, 1.0, 24, 12));
+    Part a(model), b(model);
+    b.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(0.0, 1.9, 0.0)});
+    const Index top = 3, bottom = 9;  // masses on the upper and lower rings of the tube (v = 90, 270 degrees)
+    a.openZone(ZoneSeed::mass(top), 2);
+    b.openZone(ZoneSeed::mass(bottom), 2);
+    PairRun run(a, b, GetParam());
+    std::size_t contacts = 0;
+    for (int step = 0; step < 150; ++step) {
+        a.applyForce(top, Vec3(0.0, 5.0, 0.0));
+        b.applyForce(bottom, Vec3(0.0, -5.0, 0.0));
+        a.step();
+        b.step();
+        b.setPose(nudged(b.pose(), rng, 0.002, 0.002));
+        run.refit();
+        contacts += run.check(step, step % 30 == 0);
+    }
+    EXPECT_GT(contacts, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(VolumesAndTests, CoherentQuery,
+                         ::testing::Values(Variant{BoundingVolumeKind::Aabb, ExactTest::TriangleTriangle},
+                                           Variant{BoundingVolumeKind::Sphere, ExactTest::TriangleTriangle},
+                                           Variant{BoundingVolumeKind::Aabb, ExactTest::SphereTriangle}),
+                         [](const auto& variant) {
+                             return std::string(toString(variant.param.kind)) + "_" + std::string(toString(variant.param.test));
+                         });
+
+TEST(CoherentQueryCost, APairAtRestStopsTraversing) {
+    // A ball resting in the torus's hole: after a few queries, none traverses, and each
+    // query tests a few dozen candidates, not the hierarchies.
+    Part torus(buildPartModel(makeTorus(3.0, 1.0, 64, 32)), rigidPart());
+    Part ball(buildPartModel(makeIcoSphere(2.2, 3)), rigidPart());
+    ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(0.0, 1.0, 0.0)});
+    PartCollider ct(torus, BoundingVolumeKind::Aabb), cb(ball, BoundingVolumeKind::Aabb);
+    PairCoherence coherence;
+    std::vector<Contact> contacts, full;
+    QueryStats coherentStats, fullStats;
+    for (int i = 0; i < 10; ++i) queryPairCoherent(0, torus, ct, 1, ball, cb, ExactTest::TriangleTriangle, coherence, contacts, coherentStats);
+    const std::uint64_t settled = coherence.traversals;
+    for (int i = 0; i < 100; ++i) {
+        contacts.clear();
+        coherentStats = {};
+        queryPairCoherent(0, torus, ct, 1, ball, cb, ExactTest::TriangleTriangle, coherence, contacts, coherentStats);
+    }
+    queryPair(0, torus, ct, 1, ball, cb, ExactTest::TriangleTriangle, full, fullStats);
+    EXPECT_EQ(coherence.traversals, settled);
+    ASSERT_FALSE(contacts.empty());
+    EXPECT_EQ(pairsOf(contacts), pairsOf(full));
+    // What it costs: the candidates it tested against the full query's node visits.
+    EXPECT_LT(coherentStats.volumeTests * 5, fullStats.volumeTests) << coherentStats.volumeTests << " vs " << fullStats.volumeTests;
+}
+
+TEST(CoherentQueryCost, ARebuiltHierarchyIsTraversedAgain) {
+    Part torus(buildPartModel(makeTorus(3.0, 1.0, 32, 16)));
+    Part ball(buildPartModel(makeIcoSphere(1.0, 2)), rigidPart());
+    ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(4.8, 0.0, 0.0)});
+    PartCollider ct(torus, BoundingVolumeKind::Aabb), cb(ball, BoundingVolumeKind::Aabb);
+    PairCoherence coherence;
+    std::vector<Contact> contacts;
+    QueryStats stats;
+    queryPairCoherent(0, ball, cb, 1, torus, ct, ExactTest::TriangleTriangle, coherence, contacts, stats);
+    queryPairCoherent(0, ball, cb, 1, torus, ct, ExactTest::TriangleTriangle, coherence, contacts, stats);
+    EXPECT_EQ(coherence.traversals, 1u);
+    // The torus moves its masses without a refit, then is rebuilt: new hierarchy, new candidates.
+    for (Index m = 0; m < torus.model().massCount(); ++m) torus.displaceMass(m, Vec3(-0.3, 0.0, 0.0));
+    ct.rebuild(torus);
+    contacts.clear();
+    queryPairCoherent(0, ball, cb, 1, torus, ct, ExactTest::TriangleTriangle, coherence, contacts, stats);
+    EXPECT_EQ(coherence.traversals, 2u);
+    std::vector<Contact> full;
+    queryPair(0, ball, cb, 1, torus, ct, ExactTest::TriangleTriangle, full, stats);
+    expectSameContacts(contacts, full, 0);
+    // A collider built for the other exact test is refused, as by the full query.
+    PartCollider spheres(torus, BoundingVolumeKind::Aabb, ExactTest::SphereTriangle);
+    EXPECT_THROW(queryPairCoherent(0, ball, cb, 1, torus, spheres, ExactTest::TriangleTriangle, coherence, contacts, stats),
+                 std::invalid_argument);
+}
