@@ -206,4 +206,44 @@ class SignedDistanceField;
 void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField& fieldA, std::uint32_t idB, const Part& b,
                      const Bvh<Aabb>& restPointsB, std::vector<Contact>& contacts, QueryStats& stats);
 
+// Temporal coherence of a point-shell pair (queryPointShellCoherent). Starts empty.
+struct PointShellCoherence {
+    // A walk of B's rest-point tree at a fixed relative pose with the field's reach grown by a
+    // margin: the leaves it reached, in its order, with the distance each rest position samples
+    // there (infinity outside the grid). Resumable: `stack` holds what is left.
+    struct Walk {
+        std::vector<std::int32_t> stack;
+        std::vector<std::pair<Index, double>> masses;
+        RelativePose pose;
+        double margin = 0.0;
+        std::size_t nodes = 0;
+        bool active = false;
+    };
+    std::vector<std::pair<Index, double>> restMasses;  // the last complete walk's masses
+    RelativePose pose;                                 // and its pose and margin
+    double margin = 0.0;
+    bool valid = false;
+    std::size_t traversalCost = 0;                     // its nodes
+    std::uint64_t traversals = 0;                      // walks completed
+    Walk walk;                                         // the next list, under way
+    // By mass of B: the point (A's frame) and distance of its last sample as a moving mass
+    // (distance -1: none).
+    std::vector<Vec3> lastPoint;
+    std::vector<double> lastDistance;
+};
+
+// queryPointShell()'s contacts, in the same order, sampling only the masses that may touch.
+// The field is fixed in A's frame and its interpolant's slope is at most sqrt(3), so a mass
+// that sampled d > 0 cannot sample <= 0 within d / sqrt(3) of that point: a moving mass is
+// skipped while it stays that close to its last sample, and a mass at rest while B's rest
+// sphere (restSphereB, B's frame) has moved less than that in A's frame since the traversal
+// that listed it. The rest masses come from a walk of the rest-point tree with the field's
+// reach grown by a margin of 2 cells; the next list's walk starts when B's rest sphere has
+// moved 0.4 of the margin and is spread over the following queries (1/16 of a walk each),
+// so a query pays a whole walk only when the motion outruns the margin. A haptic tool held
+// still or sliding then samples only the masses near its surface, with no traversal spikes.
+void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDistanceField& fieldA, std::uint32_t idB, const Part& b,
+                             const Bvh<Aabb>& restPointsB, const Sphere& restSphereB, PointShellCoherence& coherence,
+                             std::vector<Contact>& contacts, QueryStats& stats);
+
 }  // namespace flexfit

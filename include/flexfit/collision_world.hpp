@@ -61,8 +61,9 @@ struct CollisionSettings {
     ExactTest exactTest = ExactTest::TriangleTriangle;
     BroadPhaseUpdate broadPhase = BroadPhaseUpdate::Rebuild;
     RigidDeformableQuery rigidDeformable = RigidDeformableQuery::Faces;
-    // Face queries start from what the pair's last query found (queryPairCoherent): the same
-    // contacts as a full traversal, at O(candidates) while the pair moves little.
+    // Queries start from what the pair's last query found (queryPairCoherent,
+    // queryPointShellCoherent): the same contacts as full ones, at the cost of what may touch
+    // while the pair moves little.
     bool coherent = true;
 };
 
@@ -142,6 +143,7 @@ private:
     QueryStats stats_;
     struct KeptCoherence {
         PairCoherence coherence;
+        PointShellCoherence pointShell;
         std::uint64_t lastUpdate = 0;  // the update() count when last used
     };
     std::unordered_map<std::uint64_t, KeptCoherence> coherence_;  // by (a << 32 | b), a presses b

@@ -25,16 +25,6 @@ constexpr double kMinMarginShare = 1e-4;
 constexpr double kMaxMarginShare = 0.05;
 constexpr double kScanBudget = 1.0;
 
-// How far a point of B (within its bounding sphere) can have moved, in A's frame, between the
-// relative poses `before` and `now`: |(R1 - R0) c + t1 - t0| + |R1 - R0| r, where the spectral
-// norm |R1 - R0| = |R1 R0^T - I| = 2 sin(angle / 2) = 2 |q.vec| of the turn's quaternion.
-double relativeMotion(const RelativePose& before, const RelativePose& now, const Sphere& localSphereB) {
-    const Eigen::Matrix3d turn = now.rotation - before.rotation;
-    const Eigen::Quaterniond q(Eigen::Matrix3d(now.rotation * before.rotation.transpose()));
-    const double spectral = 2.0 * q.vec().norm() * (1.0 + 1e-12) + 1e-15;
-    return (turn * localSphereB.centre + now.translation - before.translation).norm() + spectral * localSphereB.radius;
-}
-
 // B's leaves as a ball metric: a box leaf within its earlier box grown by d along each axis is
 // within sqrt(3) d of it.
 double ballDrift(const PartCollider& collider, double drift) {

@@ -1,7 +1,6 @@
 #include "flexfit/collision.hpp"
 
 #include "collision/pair_query.hpp"
-#include "flexfit/distance_field.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -177,48 +176,6 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
         traverse(bvhA, bvhB, bInA, stats, leafPair, prune, 0.0);
     });
     sortContacts(contacts, first);
-}
-
-void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField& fieldA, std::uint32_t idB, const Part& b,
-                     const Bvh<Aabb>& restPointsB, std::vector<Contact>& contacts, QueryStats& stats) {
-    const Eigen::Matrix3d ra = a.pose().rotation.toRotationMatrix(), rb = b.pose().rotation.toRotationMatrix();
-    const RelativePose bInA(ra.transpose() * rb, ra.transpose() * (b.pose().translation - a.pose().translation));
-    const std::span<const Vec3> pb = b.state().positions;
-    const Topology& topology = b.model().topology;
-    auto sampleMass = [&](Index m) {
-        if (topology.facesOf(m).empty()) return;  // a free vertex: no surface to push
-        const Vec3 p = bInA.apply(pb[m]);
-        ++stats.candidatePairs;
-        if (!fieldA.inGrid(p)) return;
-        ++stats.exactTests;
-        const SignedDistanceField::Interpolated s = fieldA.sample(p);
-        if (s.distance > 0.0) return;
-        // The gradient is the outward normal (zero only on a symmetry plane of the field,
-        // where the exact closest point decides).
-        const double g = s.gradient.norm();
-        const Vec3 outward = g > 1e-9 ? Vec3(s.gradient / g) : fieldA.query(p).normal;
-        ++stats.contacts;
-        contacts.push_back({idA, idB, 0, topology.facesOf(m)[0], a.pose().apply(p), -(ra * outward), -s.distance, m});
-    };
-    for (Index m : b.movingMasses()) sampleMass(m);
-    // The masses at rest, through the tree of rest positions (their current positions).
-    if (restPointsB.empty()) return;
-    const auto& nodes = restPointsB.nodes();
-    thread_local std::vector<std::int32_t> stack;
-    stack.assign(1, 0);
-    while (!stack.empty()) {
-        const auto& node = nodes[std::size_t(stack.back())];
-        stack.pop_back();
-        ++stats.volumeTests;
-        if (node.isLeaf()) {
-            if (!b.isMoving(node.item)) sampleMass(node.item);
-            continue;
-        }
-        if (!fieldA.clearOf(bInA.apply(node.volume.centre()), node.volume.halfExtents().norm())) {
-            stack.push_back(node.right);
-            stack.push_back(node.left);
-        }
-    }
 }
 
 }  // namespace flexfit

@@ -10,6 +10,9 @@
 namespace flexfit {
 namespace {
 
+// Nodes computed when the field is built: those within this many cells of a face's box.
+constexpr int kBandCells = 6;
+
 double squaredDistance(const Aabb& box, const Vec3& p) {
     return (box.min - p).cwiseMax(p - box.max).cwiseMax(0.0).squaredNorm();
 }
@@ -68,7 +71,7 @@ SignedDistanceField::SignedDistanceField(const TriMesh& mesh, const Topology& to
     bvh_.build(leaves);
 
     setUpGrid(fine_, cellSize > 0.0 ? cellSize : 0.125 * edgeSum / double(3 * faces_.size()), std::size_t(1) << 21);
-    fillBand(fine_, 3);
+    fillBand(fine_, kBandCells);
     setUpGrid(coarse_, 8.0 * fine_.cell, std::size_t(1) << 15);
     for (int k = 0; k < coarse_.dims[2]; ++k)
         for (int j = 0; j < coarse_.dims[1]; ++j)

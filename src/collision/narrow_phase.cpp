@@ -48,8 +48,13 @@ const std::vector<Contact>& CollisionWorld::contactsOf(BodyId id, bool rigidPart
 
 void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats) {
     // A field exists only for a rigid part under the point-shell setting.
-    if (const SignedDistanceField* field = fields_[a].get(); field != nullptr && parts_[b]->deforms())
-        return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(), out, stats);
+    if (const SignedDistanceField* field = fields_[a].get(); field != nullptr && parts_[b]->deforms()) {
+        if (!settings_.coherent) return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(), out, stats);
+        KeptCoherence& kept = coherence_[std::uint64_t(a) << 32 | b];
+        kept.lastUpdate = updates_;
+        return queryPointShellCoherent(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(), colliders_[b].localSphere(),
+                                       kept.pointShell, out, stats);
+    }
     refitChanged(a);
     refitChanged(b);
     ++faceQueries_;

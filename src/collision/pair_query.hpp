@@ -157,6 +157,16 @@ private:
 };
 
 
+// How far a point of B (within its bounding sphere) can have moved, in A's frame, between the
+// relative poses `before` and `now`: |(R1 - R0) c + t1 - t0| + |R1 - R0| r, where the spectral
+// norm |R1 - R0| = |R1 R0^T - I| = 2 sin(angle / 2) = 2 |q.vec| of the turn's quaternion.
+inline double relativeMotion(const RelativePose& before, const RelativePose& now, const Sphere& localSphereB) {
+    const Eigen::Matrix3d turn = now.rotation - before.rotation;
+    const Eigen::Quaterniond q(Eigen::Matrix3d(now.rotation * before.rotation.transpose()));
+    const double spectral = 2.0 * q.vec().norm() * (1.0 + 1e-12) + 1e-15;
+    return (turn * localSphereB.centre + now.translation - before.translation).norm() + spectral * localSphereB.radius;
+}
+
 inline RelativePose relativePose(const Part& a, const Part& b) {
     // B's frame seen from A's: x_A = Ra^T (Rb x_B + tb - ta).
     const Eigen::Matrix3d ra = a.pose().rotation.toRotationMatrix(), rb = b.pose().rotation.toRotationMatrix();

@@ -336,10 +336,9 @@ TEST_P(GoldenSceneRun, GoldenHashWithEveryKernel) {
 }
 
 // The coherent narrow phase answers exactly what full traversals answer: the same trajectory,
-// bit for bit, with it turned off (one kernel; the scenes whose contacts are face queries).
+// bit for bit, with it turned off (one kernel), by face and by point-shell queries.
 TEST_P(GoldenSceneRun, TheSameHashWithoutCoherentCollision) {
     Scene scene = exampleScene(GetParam().file);
-    if (scene.world.collision.rigidDeformable == RigidDeformableQuery::PointShell) GTEST_SKIP() << "point-shell contacts";
     scene.world.collision.coherent = false;
     const detail::ScopedBlockKernel chosen(kSceneKernels.front());
     SceneRun run(scene);

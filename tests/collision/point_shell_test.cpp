@@ -1,0 +1,111 @@
+// The coherent point-shell query (point_shell.cpp) against the full one, contact for contact, and
+// against brute force (every mass sampled), while a rigid ball wanders over a torus whose masses
+// a zone moves; then that a ball held still samples only the masses near it.
+#include "flexfit/flexfit.hpp"
+#include "test_bodies.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+
+using namespace flexfit;
+using flexfit::testing::rigidPart;
+
+namespace {
+
+void expectSameContacts(const std::vector<Contact>& got, const std::vector<Contact>& want, int step) {
+    ASSERT_EQ(got.size(), want.size()) << "step " << step;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        EXPECT_EQ(got[i].massB, want[i].massB) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].faceB, want[i].faceB) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].point, want[i].point) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].normal, want[i].normal) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].depth, want[i].depth) << "step " << step << " contact " << i;
+    }
+}
+
+// Masses whose sample is <= 0, by sampling every one.
+std::set<Index> bruteForce(const Part& ball, const SignedDistanceField& field, const Part& torus) {
+    const Eigen::Matrix3d ra = ball.pose().rotation.toRotationMatrix();
+    std::set<Index> out;
+    for (Index m = 0; m < torus.model().massCount(); ++m) {
+        const Vec3 p = ra.transpose() * (torus.pose().apply(torus.state().positions[m]) - ball.pose().translation);
+        if (field.inGrid(p) && field.sample(p).distance <= 0.0) out.insert(m);
+    }
+    return out;
+}
+
+struct BallOverTorus {
+    std::shared_ptr<const PartModel> ballModel = buildPartModel(makeIcoSphere(0.9, 2));
+    SignedDistanceField field{ballModel->mesh, ballModel->topology};
+    Part ball{ballModel, rigidPart()};
+    Part torus{buildPartModel(makeTorus(1.0, 0.35, 48, 16))};
+    PartCollider collider{torus, BoundingVolumeKind::Aabb};
+    BallOverTorus() { collider.buildRestPointTree(torus); }
+
+    std::vector<Contact> coherent(PointShellCoherence& c, QueryStats& stats) {
+        std::vector<Contact> out;
+        queryPointShellCoherent(0, ball, field, 1, torus, collider.restPointTree(), collider.localSphere(), c, out, stats);
+        return out;
+    }
+    std::vector<Contact> full() {
+        std::vector<Contact> out;
+        QueryStats stats;
+        queryPointShell(0, ball, field, 1, torus, collider.restPointTree(), out, stats);
+        return out;
+    }
+};
+
+}  // namespace
+
+TEST(PointShellCoherent, AWanderingBallOverADeformingTorusGetsTheFullQuerysContacts) {
+    // The ball drifts over the tube (small steps, a jump now and then, turning); a zone under it
+    // is pushed in and released, so masses move, come to rest and move again.
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    BallOverTorus s;
+    s.ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(1.0, 1.1, 0.0)});
+    PointShellCoherence coherence;
+    std::size_t contacts = 0;
+    for (int step = 0; step < 300; ++step) {
+        if (step % 100 < 60) s.torus.applyForce(12, Vec3(0.0, -2.0, 0.0));  // mass 12: top of the tube at u = 0
+        s.torus.step();
+        const double scale = step % 37 == 0 ? 10.0 : 1.0;
+        Pose next = s.ball.pose();
+        next.translation += scale * 0.004 * Vec3(u(rng), u(rng), u(rng)) + 0.02 * (Vec3(1.0, 1.1, 0.0) - next.translation);
+        next.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(scale * 0.01 * u(rng), Vec3(u(rng), u(rng), 1.0).normalized())) * next.rotation).normalized();
+        s.ball.setPose(next);
+        QueryStats stats;
+        const std::vector<Contact> got = s.coherent(coherence, stats);
+        expectSameContacts(got, s.full(), step);
+        if (step % 20 == 0) {
+            std::set<Index> masses;
+            for (const Contact& c : got) masses.insert(c.massB);
+            EXPECT_EQ(masses, bruteForce(s.ball, s.field, s.torus)) << "step " << step;
+        }
+        contacts += got.size();
+    }
+    EXPECT_GT(contacts, 0u);
+    EXPECT_LT(coherence.traversals, 300u / 2) << "the rest masses' list is reused";
+}
+
+TEST(PointShellCoherent, ABallHeldStillSamplesOnlyTheMassesNearIt) {
+    // Pressed into the tube, the zone there moving: after a few queries, the samples are about
+    // the contacts (masses near the surface), not every moving mass and every reached rest mass.
+    BallOverTorus s;
+    s.ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(1.0, 1.1, 0.0)});
+    s.torus.openZone(ZoneSeed::mass(12), 4);
+    PointShellCoherence coherence;
+    QueryStats first, last;
+    for (int step = 0; step < 40; ++step) {
+        s.torus.applyForce(12, Vec3(0.0, -0.5, 0.0));
+        s.torus.step();
+        QueryStats stats;
+        const std::vector<Contact> got = s.coherent(coherence, stats);
+        expectSameContacts(got, s.full(), step);
+        (step == 0 ? first : last) = stats;
+    }
+    ASSERT_GT(last.contacts, 0u);
+    EXPECT_LT(last.exactTests, first.exactTests / 2) << last.exactTests << " samples against " << first.exactTests;
+}
