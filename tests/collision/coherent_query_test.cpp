@@ -6,6 +6,7 @@
 // rebuilt hierarchy is never answered from the old candidates.
 #include "collision/triangle_queries.hpp"
 #include "flexfit/flexfit.hpp"
+#include "same_contacts.hpp"
 #include "test_bodies.hpp"
 
 #include <gtest/gtest.h>
@@ -14,21 +15,10 @@
 #include <set>
 
 using namespace flexfit;
+using flexfit::testing::expectSameContacts;
 using flexfit::testing::rigidPart;
 
 namespace {
-
-// Every field, bit for bit, in order.
-void expectSameContacts(const std::vector<Contact>& got, const std::vector<Contact>& want, int step) {
-    ASSERT_EQ(got.size(), want.size()) << "step " << step;
-    for (std::size_t i = 0; i < got.size(); ++i) {
-        EXPECT_EQ(got[i].faceA, want[i].faceA) << "step " << step << " contact " << i;
-        EXPECT_EQ(got[i].faceB, want[i].faceB) << "step " << step << " contact " << i;
-        EXPECT_EQ(got[i].point, want[i].point) << "step " << step << " contact " << i;
-        EXPECT_EQ(got[i].normal, want[i].normal) << "step " << step << " contact " << i;
-        EXPECT_EQ(got[i].depth, want[i].depth) << "step " << step << " contact " << i;
-    }
-}
 
 // Face pairs in contact by testing every pair (no hierarchy).
 std::set<std::pair<Index, Index>> bruteForceContacts(const Part& a, const Part& b, ExactTest test) {

@@ -2,6 +2,7 @@
 // against brute force (every mass sampled), while a rigid ball wanders over a torus whose masses
 // a zone moves; then that a ball held still samples only the masses near it.
 #include "flexfit/flexfit.hpp"
+#include "same_contacts.hpp"
 #include "test_bodies.hpp"
 
 #include <gtest/gtest.h>
@@ -10,20 +11,10 @@
 #include <set>
 
 using namespace flexfit;
+using flexfit::testing::expectSameContacts;
 using flexfit::testing::rigidPart;
 
 namespace {
-
-void expectSameContacts(const std::vector<Contact>& got, const std::vector<Contact>& want, int step) {
-    ASSERT_EQ(got.size(), want.size()) << "step " << step;
-    for (std::size_t i = 0; i < got.size(); ++i) {
-        EXPECT_EQ(got[i].massB, want[i].massB) << "step " << step << " contact " << i;
-        EXPECT_EQ(got[i].faceB, want[i].faceB) << "step " << step << " contact " << i;
-        EXPECT_EQ(got[i].point, want[i].point) << "step " << step << " contact " << i;
-        EXPECT_EQ(got[i].normal, want[i].normal) << "step " << step << " contact " << i;
-        EXPECT_EQ(got[i].depth, want[i].depth) << "step " << step << " contact " << i;
-    }
-}
 
 // Masses whose sample is <= 0, by sampling every one.
 std::set<Index> bruteForce(const Part& ball, const SignedDistanceField& field, const Part& torus) {

@@ -1,0 +1,24 @@
+// Two queries' contacts compared field for field, bit for bit, in order.
+#pragma once
+
+#include "flexfit/collision.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace flexfit::testing {
+
+inline void expectSameContacts(const std::vector<Contact>& got, const std::vector<Contact>& want, int step) {
+    ASSERT_EQ(got.size(), want.size()) << "step " << step;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        EXPECT_EQ(got[i].faceA, want[i].faceA) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].faceB, want[i].faceB) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].massB, want[i].massB) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].point, want[i].point) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].normal, want[i].normal) << "step " << step << " contact " << i;
+        EXPECT_EQ(got[i].depth, want[i].depth) << "step " << step << " contact " << i;
+    }
+}
+
+}  // namespace flexfit::testing
