@@ -6,13 +6,9 @@
 // when that leaves a side empty), down to one item per leaf. Nodes live in one array, children
 // after their parent, with parent links for refits.
 //
-// refit() updates the leaves of the items that changed and then their ancestors bottom-up, and
-// stops climbing where a volume came out unchanged (a leaf moving inside its parent's box), so
-// a local deformation costs O(changed x the depth its changes reach), at most O(changed x
-// depth), not O(items). The result is the same as refitting every ancestor: a node is
-// recomputed whenever one of its children changed. The dirty ancestors are a compact index set
-// and a heap by node index (children come after their parent): a refit allocates nothing once
-// it has grown.
+// refit() updates the leaves of the items that changed and then only their ancestors, bottom-up
+// in order of depth, so a local deformation costs O(changed x depth), not O(items). The dirty
+// ancestors are a compact index set: a refit allocates nothing once it has grown.
 #pragma once
 
 #include "flexfit/bounding_volume.hpp"
@@ -31,8 +27,6 @@ Sphere encloseAll(std::span<const Sphere> volumes, std::span<const Index> which)
 Aabb encloseAll(std::span<const Aabb> volumes, std::span<const Index> which);
 inline Sphere mergeVolumes(const Sphere& a, const Sphere& b) { return Sphere::merge(a, b); }
 inline Aabb mergeVolumes(const Aabb& a, const Aabb& b) { return Aabb::merge(a, b); }
-inline bool sameVolume(const Sphere& a, const Sphere& b) { return a.centre == b.centre && a.radius == b.radius; }
-inline bool sameVolume(const Aabb& a, const Aabb& b) { return a.min == b.min && a.max == b.max; }
 inline Vec3 centreOf(const Sphere& s) { return s.centre; }
 inline Vec3 centreOf(const Aabb& b) { return b.centre(); }
 
@@ -61,38 +55,33 @@ public:
         dirty_.reset(nodes_.size());
     }
 
-    // Leaves of `items` get new volumes from leafVolume(item); their ancestors are refitted as
-    // far as the changes reach.
+    // Leaves of `items` get new volumes from leafVolume(item); their ancestors are refitted.
     template <class LeafVolume>
     void refit(std::span<const Index> items, LeafVolume leafVolume) {
         if (nodes_.empty()) return;
         dirty_.clear();
-        heap_.clear();
-        auto markParent = [&](const Node& node) {
-            if (node.parent >= 0 && dirty_.insert(Index(node.parent))) {
-                heap_.push_back(node.parent);
-                std::push_heap(heap_.begin(), heap_.end());
-            }
-        };
         for (Index item : items) {
             Node& leaf = nodes_[leafOf_[item]];
-            const BV volume = leafVolume(item);
+            leaf.volume = leafVolume(item);
             ++refitNodes_;
-            if (sameVolume(volume, leaf.volume)) continue;
-            leaf.volume = volume;
-            markParent(leaf);
+            // Its ancestors, up to the first one already marked (whose ancestors are marked too).
+            std::int32_t n = leaf.parent;
+            while (n >= 0 && dirty_.insert(Index(n))) n = nodes_[std::size_t(n)].parent;
         }
-        // Highest index first: every child of a node is done before it.
-        while (!heap_.empty()) {
-            std::pop_heap(heap_.begin(), heap_.end());
-            Node& node = nodes_[std::size_t(heap_.back())];
-            heap_.pop_back();
-            const BV volume = mergeVolumes(nodes_[std::size_t(node.left)].volume, nodes_[std::size_t(node.right)].volume);
-            ++refitNodes_;
-            if (sameVolume(volume, node.volume)) continue;
-            node.volume = volume;
-            markParent(node);
+        // Children come after their parent in the node array: descending index is bottom-up.
+        // Many dirty nodes: one backward scan of the marks beats sorting them.
+        auto merge = [&](std::size_t n) {
+            Node& node = nodes_[n];
+            node.volume = mergeVolumes(nodes_[std::size_t(node.left)].volume, nodes_[std::size_t(node.right)].volume);
+        };
+        if (dirty_.size() * 16 > nodes_.size()) {
+            for (std::size_t n = nodes_.size(); n-- > 0;)
+                if (dirty_.contains(Index(n))) merge(n);
+        } else {
+            dirty_.sort();
+            for (std::size_t s = dirty_.size(); s-- > 0;) merge(dirty_[s]);
         }
+        refitNodes_ += dirty_.size();
     }
 
     // Every leaf from leafVolume(item), then every internal node, bottom-up.
@@ -155,7 +144,6 @@ private:
     std::vector<Node> nodes_;
     std::vector<Index> leafOf_;          // item -> leaf node
     IndexSet dirty_;                     // (nodes) ancestors to merge in a refit
-    std::vector<std::int32_t> heap_;     // the same, by index (max-heap)
     std::size_t refitNodes_ = 0;
 };
 
