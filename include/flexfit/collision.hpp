@@ -105,9 +105,10 @@ public:
 
     // How far the leaves may have grown since the hierarchy was built: every leaf now lies
     // within its volume of any earlier time t grown by drift() - drift at t (box leaves: by that
-    // much along each axis of the part frame; sphere leaves: in radius). Refits add the largest
-    // growth of a leaf they recompute; generation() changes when rebuild() starts afresh.
-    double drift() const { return drift_; }
+    // much along each axis of the part frame; sphere leaves: in radius), from the vertices'
+    // moves (vertexDrift): a triangle's box grows by at most a vertex's move, a face sphere (or
+    // its box) by three times it. generation() changes when rebuild() starts afresh.
+    double drift() const { return leafDriftPerMove_ * vertexDrift_; }
     std::uint64_t generation() const { return generation_; }
     // How far the part's vertices may have moved (part frame) since the hierarchy was built:
     // each refit adds the largest move of a changed mass since the refit before.
@@ -123,7 +124,7 @@ private:
     std::variant<Bvh<Sphere>, Bvh<Aabb>> bvh_;
     Sphere restSphere_;
     double maxDisplacement_ = 0.0;
-    double drift_ = 0.0;
+    double leafDriftPerMove_ = 1.0;
     std::uint64_t generation_ = 0;
     double vertexDrift_ = 0.0;
     std::vector<Vec3> seenPositions_;  // (V) positions at the last refit that changed them
@@ -178,7 +179,9 @@ struct PairCoherence {
     std::size_t testedAfterTraversal = 0;             // candidates tested by the query that traversed
     std::size_t scanCost = 0;                         // candidates tested since beyond that many, summed
     bool valid = false;
-    std::uint64_t traversals = 0;                     // full traversals made (for statistics)
+    std::uint32_t plainQueriesLeft = 0;               // answered by plain traversals (outrun)
+    std::uint64_t traversals = 0;                     // traversals that took candidates
+    std::uint64_t plainSpells = 0;                    // times the motion outran the widest margin
 };
 
 // queryPair()'s contacts, in the same order, from the pair's last candidates while they still
@@ -196,6 +199,8 @@ struct PairCoherence {
 // motion left it, twice the motion seen (at most half the margin) when the added tests spent
 // their budget (within [1e-4, 0.05] of the smaller mean leaf size). So the queries between two
 // traversals cost at most about two traversals, and a pair at rest never traverses again.
+// When the motion outruns the widest margin within one query (a part deforming fast), the next
+// 16 queries are plain queryPair() calls, cheaper than taking candidates that serve one query.
 // stats: volumeTests counts the traversal's nodes and the candidates tested; candidatePairs
 // the candidates whose leaves overlap now.
 void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,

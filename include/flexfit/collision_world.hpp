@@ -85,8 +85,9 @@ public:
     // --- Broad phase (broad_phase.cpp) ---
     // Updates every body's bounding sphere, then the broad-phase tree and its pairs.
     void update();
-    // Updates every body's bounding sphere (the first half of update()).
+    // Updates every body's bounding sphere (the first half of update()), or one body's.
     void updateBounds();
+    void updateBound(BodyId id);
     // Broad-phase candidate pairs (a < b), from the last update.
     const std::vector<std::pair<BodyId, BodyId>>& candidatePairs() const { return pairs_; }
     // The broad phase's hierarchy of part spheres (world frame), as of the last update.

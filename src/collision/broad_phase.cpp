@@ -6,11 +6,13 @@
 
 namespace flexfit {
 
+void CollisionWorld::updateBound(BodyId id) {
+    colliders_[id].updateDisplacementBound(*parts_[id]);
+    partSpheres_[id] = colliders_[id].worldSphere(*parts_[id]);
+}
+
 void CollisionWorld::updateBounds() {
-    for (std::size_t i = 0; i < parts_.size(); ++i) {
-        colliders_[i].updateDisplacementBound(*parts_[i]);
-        partSpheres_[i] = colliders_[i].worldSphere(*parts_[i]);
-    }
+    for (BodyId i = 0; i < parts_.size(); ++i) updateBound(i);
 }
 
 void CollisionWorld::update() {

@@ -24,14 +24,6 @@ void buildHierarchy(Bvh<BV>& bvh, const Part& part, ExactTest test) {
     bvh.build(leaves);
 }
 
-// How far `now` reaches beyond `before`: now lies within before grown by it (boxes: along each
-// axis; spheres: in radius).
-double growth(const Sphere& before, const Sphere& now) {
-    return std::max(0.0, (now.centre - before.centre).norm() + now.radius - before.radius);
-}
-double growth(const Aabb& before, const Aabb& now) {
-    return std::max(0.0, std::max((now.max - before.max).maxCoeff(), (before.min - now.min).maxCoeff()));
-}
 
 }  // namespace
 
@@ -61,6 +53,9 @@ Aabb faceSphereBox(std::span<const Vec3> positions, const Face& face) {
 }
 
 PartCollider::PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest test) : kind_(kind), test_(test) {
+    // A triangle's box moves with its vertices; a face sphere's centre moves as far and its
+    // radius changes by at most twice that (as does the box around it).
+    leafDriftPerMove_ = kind == BoundingVolumeKind::Aabb && test == ExactTest::TriangleTriangle ? 1.0 : 3.0;
     if (kind == BoundingVolumeKind::Aabb) bvh_.emplace<Bvh<Aabb>>();
     restSphere_ = Sphere::around(part.model().restPositions);
     changedFaces_.reset(part.model().faceCount());
@@ -91,7 +86,6 @@ void PartCollider::rebuild(const Part& part) {
         },
         bvh_);
     ++generation_;
-    drift_ = 0.0;
     vertexDrift_ = 0.0;
     seenPositions_.assign(part.state().positions.begin(), part.state().positions.end());
     updateDisplacementBound(part);
@@ -118,13 +112,7 @@ void PartCollider::refit(const Part& part, std::span<const Index> changedMasses)
     std::visit(
         [&](auto& bvh) {
             using BV = std::decay_t<decltype(bvh.rootVolume())>;
-            double grew = 0.0;
-            bvh.refit(changedFaces_.members(), [&](Index f) {
-                const BV now = leafVolume((const BV*)nullptr, positions, model.mesh.faces[f], test_);
-                grew = std::max(grew, growth(bvh.leafVolume(f), now));
-                return now;
-            });
-            drift_ += grew;
+            bvh.refit(changedFaces_.members(), [&](Index f) { return leafVolume((const BV*)nullptr, positions, model.mesh.faces[f], test_); });
         },
         bvh_);
     updateDisplacementBound(part);
@@ -146,15 +134,31 @@ std::size_t PartCollider::refitNodeCount() const {
     return std::visit([](const auto& bvh) { return bvh.refitNodeCount(); }, bvh_);
 }
 
-thread_local std::vector<std::array<Eigen::Vector4d, 4>> RestPlaneFilter::planesInB_;
-thread_local IndexSet RestPlaneFilter::movedPlanes_;
+namespace detail {
+RestPlaneFilter::Scratch& restPlaneScratch() {
+    thread_local RestPlaneFilter::Scratch scratch;
+    return scratch;
+}
+}  // namespace detail
 
 namespace {
 
 // Contacts in (faceA, faceB) order: the same whatever order a traversal met them in.
+// Sorts (face pair, position) keys, then moves each contact once: a contact is 80 bytes.
 void sortContacts(std::vector<Contact>& contacts, std::size_t first) {
-    std::sort(contacts.begin() + std::ptrdiff_t(first), contacts.end(),
-              [](const Contact& x, const Contact& y) { return std::tie(x.faceA, x.faceB) < std::tie(y.faceA, y.faceB); });
+    const std::size_t n = contacts.size() - first;
+    thread_local std::vector<std::pair<std::uint64_t, std::uint32_t>> keys;
+    thread_local std::vector<Contact> sorted;
+    keys.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Contact& c = contacts[first + i];
+        keys[i] = {std::uint64_t(c.faceA) << 32 | c.faceB, std::uint32_t(i)};
+    }
+    if (std::is_sorted(keys.begin(), keys.end())) return;
+    std::sort(keys.begin(), keys.end());
+    sorted.clear();
+    for (const auto& key : keys) sorted.push_back(contacts[first + key.second]);
+    std::copy(sorted.begin(), sorted.end(), contacts.begin() + std::ptrdiff_t(first));
 }
 
 }  // namespace

@@ -30,14 +30,17 @@ const std::vector<Contact>& CollisionWorld::findContacts() {
 }
 
 const std::vector<Contact>& CollisionWorld::contactsOf(BodyId id, bool rigidPartnersOnly) {
-    updateBounds();
     refitted_.clear();
     bodyContacts_.clear();
     const RelativePose identity;
+    updateBound(id);
     // Other bodies in ascending id: the same pairs, in the same order, as the broad phase gives.
+    // Only the bounds this query reads are brought up to date (a deforming part's costs
+    // O(its moving masses)).
     for (BodyId other = 0; other < parts_.size(); ++other) {
-        if (other == id || !overlap(partSpheres_[id], partSpheres_[other], identity)) continue;
-        if (rigidPartnersOnly && parts_[other]->deforms()) continue;
+        if (other == id || (rigidPartnersOnly && parts_[other]->deforms())) continue;
+        updateBound(other);
+        if (!overlap(partSpheres_[id], partSpheres_[other], identity)) continue;
         BodyId a = std::min(id, other), b = std::max(id, other);
         if (!pressesFirst(a, b)) std::swap(a, b);
         QueryStats ignored;

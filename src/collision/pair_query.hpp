@@ -70,7 +70,14 @@ void dispatch(const PartCollider& a, const PartCollider& b, Visit visit) {
 // own tolerance, so only pairs that test would also reject are skipped.
 class RestPlaneFilter {
 public:
-    RestPlaneFilter(const Part& a, const PartCollider& colliderA, const RelativePose& bInA) : a_(a), collider_(colliderA), bInA_(bInA) {
+    // The planes moved to B's frame, kept between queries so a query allocates nothing: one
+    // per thread (restPlaneScratch()), handed to each filter once.
+    struct Scratch {
+        std::vector<std::array<Eigen::Vector4d, 4>> planesInB;  // (F of A)
+        IndexSet moved;                                         // faces whose planes are in planesInB for this query
+    };
+    RestPlaneFilter(const Part& a, const PartCollider& colliderA, const RelativePose& bInA, Scratch& scratch)
+        : a_(a), collider_(colliderA), bInA_(bInA), planesInB_(scratch.planesInB), movedPlanes_(scratch.moved) {
         movedPlanes_.clear();
         movedPlanes_.growTo(a.model().faceCount());
         if (planesInB_.size() < a.model().faceCount()) planesInB_.resize(a.model().faceCount());
@@ -152,8 +159,8 @@ private:
     const Part& a_;
     const PartCollider& collider_;
     const RelativePose& bInA_;
-    static thread_local std::vector<std::array<Eigen::Vector4d, 4>> planesInB_;
-    static thread_local IndexSet movedPlanes_;  // faces whose planes are in planesInB_ for this query
+    std::vector<std::array<Eigen::Vector4d, 4>>& planesInB_;
+    IndexSet& movedPlanes_;
 };
 
 
@@ -173,6 +180,9 @@ inline RelativePose relativePose(const Part& a, const Part& b) {
     return RelativePose(ra.transpose() * rb, ra.transpose() * (b.pose().translation - a.pose().translation));
 }
 
+// This thread's scratch of the rest-plane filter (collision.cpp).
+RestPlaneFilter::Scratch& restPlaneScratch();
+
 // The exact test of one leaf pair (face of A, face of B) at the parts' current shapes and poses,
 // shared by the full and the coherent query.
 class LeafPairTester {
@@ -180,20 +190,20 @@ public:
     LeafPairTester(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
                    ExactTest test, const RelativePose& bInA, std::vector<Contact>& contacts, QueryStats& stats)
         : idA_(idA), idB_(idB), a_(a), b_(b), test_(test), bInA_(bInA), ra_(a.pose().rotation.toRotationMatrix()),
-          filter_(a, colliderA, bInA), contacts_(contacts), stats_(stats) {}
+          pa_(a.state().positions), pb_(b.state().positions), facesA_(a.model().mesh.faces), facesB_(b.model().mesh.faces),
+          filter_(a, colliderA, bInA, restPlaneScratch()), contacts_(contacts), stats_(stats) {}
 
     void operator()(Index fa, Index fb) {
-        const std::span<const Vec3> pa = a_.state().positions, pb = b_.state().positions;
-        const Face& f = b_.model().mesh.faces[fb];
+        const Face& f = facesB_[fb];
         ++stats_.exactTests;
-        if (test_ == ExactTest::TriangleTriangle && filter_.separated(fa, pb, f)) return;
-        const Triangle tb{bInA_.apply(pb[f[0]]), bInA_.apply(pb[f[1]]), bInA_.apply(pb[f[2]])};
+        if (test_ == ExactTest::TriangleTriangle && filter_.separated(fa, pb_, f)) return;
+        const Triangle tb{bInA_.apply(pb_[f[0]]), bInA_.apply(pb_[f[1]]), bInA_.apply(pb_[f[2]])};
         std::optional<TriangleContact> hit;
         if (test_ == ExactTest::SphereTriangle) {
-            const Sphere s = faceSphere(pa, a_.model().mesh.faces[fa]);
+            const Sphere s = faceSphere(pa_, facesA_[fa]);
             hit = sphereTriangleContact(s.centre, s.radius, tb);
         } else {
-            hit = intersectTriangles(triangleOf(pa, a_.model().mesh.faces[fa]), tb);
+            hit = intersectTriangles(triangleOf(pa_, facesA_[fa]), tb);
         }
         if (!hit) return;
         ++stats_.contacts;
@@ -246,6 +256,8 @@ private:
     ExactTest test_;
     const RelativePose& bInA_;
     Eigen::Matrix3d ra_;
+    std::span<const Vec3> pa_, pb_;
+    std::span<const Face> facesA_, facesB_;
     RestPlaneFilter filter_;
     std::vector<Contact>& contacts_;
     QueryStats& stats_;
