@@ -163,9 +163,10 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
 struct PairCoherence {
     struct Candidate {
         Index faceA = 0, faceB = 0;
-        // How far B's face lay beyond one of the planes of A's face when taken (A rigid), and
-        // A's face beyond the plane of B's face; 0 when none separated them.
-        double separationByA = 0.0, separationByB = 0.0;
+        // The gap between the two faces when taken: how far B's face lay beyond a plane of A's
+        // face (A rigid), A's beyond the plane of B's, or the two apart along a separating axis
+        // of the triangles, whichever is widest; 0 when none separated them.
+        double separation = 0.0;
     };
     std::vector<Candidate> candidates;                // sorted by (faceA, faceB)
     RelativePose pose;                                // B's frame in A's when taken
@@ -190,9 +191,10 @@ struct PairCoherence {
 // stays within their margin. A's leaf volumes grown by the margin contain every position its
 // leaves can reach meanwhile, so a leaf pair that overlaps now was a candidate; each candidate
 // is tested as the full query tests a leaf pair (volume overlap now, then the exact test).
-// When A is rigid, a candidate whose B face lay farther beyond one of the A face's planes than
-// B's vertices have moved since (relative motion plus B's vertexDrift) is skipped: the full
-// query's exact test would reject it on that plane. So a body at rest on another costs O(its
+// A candidate whose faces were farther apart (beyond a plane of either face, or along a
+// separating axis of the triangles) than their vertices have moved relative to each other since
+// (relative motion plus both vertexDrifts) is skipped: the full query's exact test would find
+// them apart. So a body at rest on another costs O(its
 // candidates' scan + the pairs near contact), not a traversal.
 // Otherwise, or once the tests that motion added since have cost as much as the traversal that
 // took them, the candidates are taken again by one traversal: with twice the margin when the

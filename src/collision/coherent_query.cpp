@@ -73,12 +73,16 @@ template <class BA, class BB>
 void takeCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const PartCollider& colliderA, const PartCollider& colliderB,
                     const RelativePose& bInA, double margin, LeafPairTester& tester, PairCoherence& c, QueryStats& stats) {
     c.candidates.clear();
-    // A pair separated by more than the margin stays so while the candidates are used.
+    // A pair separated by more than the margin stays so while the candidates are used: by a
+    // plane of A's face (A rigid), by the plane of B's face, or along a separating axis of the
+    // two triangles (the dearest, tried last).
     auto record = [&](Index fa, Index fb) {
-        const double byA = tester.separationByA(fa, fb, margin);
-        if (byA > margin) return;
-        const double byB = tester.separationByB(fa, fb);
-        if (byB <= margin) c.candidates.push_back({fa, fb, byA, byB});
+        double separation = tester.separationByA(fa, fb, margin);
+        if (separation > margin) return;
+        separation = std::max(separation, tester.separationByB(fa, fb));
+        if (separation > margin) return;
+        separation = std::max(separation, tester.separationOfTriangles(fa, fb));
+        if (separation <= margin) c.candidates.push_back({fa, fb, separation});
     };
     auto beyondMargin = [&](Index fa, const auto& volumeB) { return tester.prunesBeyond(fa, volumeB, margin); };
     QueryStats traversal;
@@ -101,21 +105,15 @@ void takeCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const PartCollider
     ++c.traversals;
 }
 
-// How far B's vertices can have moved in A's frame, and A's vertices relative to B's faces,
-// since the candidates were taken.
-struct Reach {
-    double byA = 0.0, byB = 0.0;
-};
-
 // Tests the candidates as the full query tests its leaf pairs; those whose separation exceeds
 // `reach` cannot touch and are skipped.
 template <class BA, class BB>
-void scanCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const RelativePose& bInA, const Reach& reach, LeafPairTester& tester,
+void scanCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const RelativePose& bInA, double reach, LeafPairTester& tester,
                     PairCoherence& c, QueryStats& stats) {
     c.tested = 0;
     c.overlapping = 0;
     for (const PairCoherence::Candidate& k : c.candidates) {
-        if (k.separationByA > reach.byA || k.separationByB > reach.byB) continue;
+        if (k.separation > reach) continue;
         ++c.tested;
         if (!overlap(bvhA.leafVolume(k.faceA), bvhB.leafVolume(k.faceB), bInA)) continue;
         ++c.overlapping;
@@ -143,15 +141,16 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
     LeafPairTester tester(idA, a, colliderA, idB, b, test, bInA, contacts, stats);
     dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) {
         // A's leaves grown by the margin cover A's drift and the motion of B's leaves. A candidate
-        // separated by one of the planes of A's face (A rigid) stays so while B's vertices move
-        // less than the gap in A's frame; by the plane of B's face, while B's vertices have not
-        // moved and A's move less than the gap in B's frame.
+        // separated by a gap (a plane of A's face, A rigid; the plane of B's face; or an axis)
+        // stays so while the two faces' vertices move, relative to each other, less than it:
+        // A's by its own moves, B's by the relative motion in A's frame and its own moves (for
+        // B's plane, the other way round: A's points in B's frame).
         const double motion = motionSince(colliderA, colliderB, bInA, coherence);
         const double moveA = colliderA.vertexDrift() - coherence.vertexDriftA, moveB = colliderB.vertexDrift() - coherence.vertexDriftB;
-        const Reach reach{motion + moveB, motionOfA(bInA, colliderA, coherence) + moveA + moveB};
+        const double reach = std::max(motion, motionOfA(bInA, colliderA, coherence)) + moveA + moveB;
         const double leaves = motion + (colliderA.drift() - coherence.driftA) + ballDrift(colliderB, colliderB.drift() - coherence.driftB);
-        // Candidates separated by more than the margin were dropped: every reach stays within it.
-        const double slack = std::max({leaves, reach.byA, reach.byB});
+        // Candidates separated by more than the margin were dropped: the reach stays within it.
+        const double slack = std::max(leaves, reach);
         if (!(slack <= coherence.margin) && coherence.valid && coherence.queriesSince <= 1 &&
             coherence.margin >= maxMargin(colliderA, colliderB)) {
             coherence.valid = false;  // outrun: plain traversals for a while
@@ -161,7 +160,7 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
         }
         if (!(slack <= coherence.margin) || scansSpentBudget(coherence)) {
             takeCandidates(bvhA, bvhB, colliderA, colliderB, bInA, nextMargin(colliderA, colliderB, slack, coherence), tester, coherence, stats);
-            return scanCandidates(bvhA, bvhB, bInA, Reach{}, tester, coherence, stats);
+            return scanCandidates(bvhA, bvhB, bInA, 0.0, tester, coherence, stats);
         }
         scanCandidates(bvhA, bvhB, bInA, reach, tester, coherence, stats);
     });

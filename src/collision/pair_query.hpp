@@ -243,6 +243,16 @@ public:
         const double margin = 1e-8 * (1.0 + std::abs(offset) + reach2);
         return std::max({0.0, lowest - margin, -highest - margin}) * (1.0 - 1e-12);
     }
+    // How far apart the two faces are along the best separating axis (triangleGap), less a
+    // margin far above intersectTriangles' rounding; 0 when none separates them.
+    double separationOfTriangles(Index fa, Index fb) {
+        if (test_ != ExactTest::TriangleTriangle) return 0.0;
+        const Face& f = facesB_[fb];
+        const Triangle tb{bInA_.apply(pb_[f[0]]), bInA_.apply(pb_[f[1]]), bInA_.apply(pb_[f[2]])};
+        const Triangle ta = triangleOf(pa_, facesA_[fa]);
+        const double scale = std::max({ta.a.norm(), ta.b.norm(), ta.c.norm(), tb.a.norm(), tb.b.norm(), tb.c.norm()});
+        return std::max(0.0, triangleGap(ta, tb) - 1e-9 * (1.0 + scale));
+    }
     // B's subtrees beyond a plane of A's (rigid) leaf face by more than `margin`.
     template <class Volume>
     bool prunesBeyond(Index fa, const Volume& volumeB, double margin) {

@@ -117,6 +117,26 @@ std::optional<TriangleContact> sphereTriangleContact(const Vec3& centre, double 
     return TriangleContact{q, normal, radius - distance};
 }
 
+double triangleGap(const Triangle& first, const Triangle& second) {
+    const std::array<Vec3, 3> e1{first.b - first.a, first.c - first.b, first.a - first.c};
+    const std::array<Vec3, 3> e2{second.b - second.a, second.c - second.b, second.a - second.c};
+    std::array<Vec3, 11> axes;
+    axes[0] = e1[0].cross(-e1[2]);
+    axes[1] = e2[0].cross(-e2[2]);
+    std::size_t count = 2;
+    for (const Vec3& a : e1)
+        for (const Vec3& b : e2) axes[count++] = a.cross(b);
+    double gap = 0.0;
+    for (const Vec3& axis : axes) {
+        const double length = axis.norm();
+        if (!(length > 0.0)) continue;
+        const Vec3 unit = axis / length;
+        const Interval i1 = project(first, unit), i2 = project(second, unit);
+        gap = std::max({gap, i2.min - i1.max, i1.min - i2.max});
+    }
+    return gap;
+}
+
 std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second) {
     const std::array<Vec3, 3> e1{first.b - first.a, first.c - first.b, first.a - first.c};
     const std::array<Vec3, 3> e2{second.b - second.a, second.c - second.b, second.a - second.c};

@@ -45,4 +45,11 @@ std::optional<TriangleContact> sphereTriangleContact(const Vec3& centre, double 
 // intersecting). Normal: pushing `first` by depth * normal separates it from `second`.
 std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second);
 
+// How far apart two triangles are along the best of intersectTriangles' axes (both normals and
+// the nine edge-edge cross products, unit): a lower bound on their distance. While no vertex
+// of either side's vertices moves by more than the gap in total (along a fixed axis, the gap
+// shrinks by at most the two sides' largest moves), they stay apart. 0 when no axis separates
+// them.
+double triangleGap(const Triangle& first, const Triangle& second);
+
 }  // namespace flexfit

@@ -132,8 +132,9 @@ void refreshLeverArms(const Bodies& bodies, ContactSolver& solver) {
 void solveVelocities(int iterations, const Separation& separation, Bodies& bodies, ContactSolver& solver) {
     for (int iteration = 0; iteration < iterations; ++iteration)
         for (SolverContact& c : solver.contacts) {
-            // Friction first, within the normal impulse of the last pass (Box2D's order).
-            solveFriction(c, solver, bodies);
+            // Friction first, within the normal impulse of the last pass (Box2D's order); a
+            // frictionless pair's tangent impulses stay zero.
+            if (c.staticFriction > 0.0 || c.kineticFriction > 0.0) solveFriction(c, solver, bodies);
             solveNormal(c, std::min(separation.rate * std::max(c.depth - separation.slop, 0.0), separation.maxSpeed), solver, bodies);
         }
 }
