@@ -130,3 +130,36 @@ TEST(TriangleTriangle, CoplanarAndTouching) {
     ASSERT_TRUE(pierce);
     EXPECT_NEAR(pierce->point.z(), 0.0, 1e-9);
 }
+
+TEST(TriangleGap, ALowerBoundOnTheDistanceThatKeepsPairsApart) {
+    // Random pairs: intersecting ones have no gap; separated ones a gap no wider than their
+    // distance (sampled: the closest sampled point of one to each vertex and edge sample of the
+    // other bounds it from above), and any move shorter than the gap leaves them apart.
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int apart = 0;
+    for (int k = 0; k < 3000; ++k) {
+        const Triangle x{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+        const Triangle y{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+        const double gap = triangleGap(x, y);
+        ASSERT_GE(gap, 0.0);
+        if (intersectTriangles(x, y)) {
+            EXPECT_EQ(gap, 0.0) << "pair " << k;
+            continue;
+        }
+        ++apart;
+        double distance = std::numeric_limits<double>::infinity();
+        for (const Triangle* t : {&x, &y}) {
+            const Triangle& other = t == &x ? y : x;
+            for (int i = 0; i <= 40; ++i) {
+                const double s = i / 40.0;
+                for (const Vec3& p : {Vec3(t->a + s * (t->b - t->a)), Vec3(t->b + s * (t->c - t->b)), Vec3(t->c + s * (t->a - t->c))})
+                    distance = std::min(distance, (closestPointOnTriangle(p, other) - p).norm());
+            }
+        }
+        EXPECT_LE(gap, distance * (1 + 1e-9) + 1e-12) << "pair " << k;
+        const Vec3 direction = Vec3(u(rng), u(rng), u(rng)).normalized();
+        EXPECT_FALSE(intersectTriangles(shifted(x, (0.999 * gap) * direction), y)) << "pair " << k;
+    }
+    EXPECT_GT(apart, 1000);
+}
