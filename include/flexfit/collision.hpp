@@ -168,21 +168,31 @@ struct PairCoherence {
         // of the triangles, whichever is widest; 0 when none separated them.
         double separation = 0.0;
     };
-    std::vector<Candidate> candidates;                // sorted by (faceA, faceB)
-    RelativePose pose;                                // B's frame in A's when taken
-    double margin = 0.0;
-    double driftA = 0.0, driftB = 0.0;                // the colliders' drift() when taken
-    double vertexDriftA = 0.0, vertexDriftB = 0.0;    // the colliders' vertexDrift() when taken
-    std::uint64_t generationA = 0, generationB = 0;   // and their generation()
-    std::uint32_t queriesSince = 0;                   // queries answered since taken
-    std::size_t tested = 0, overlapping = 0;          // at the last query: candidates tested, and whose leaves overlapped
-    std::size_t traversalCost = 0;                    // node pairs the traversal visited
-    std::size_t testedAfterTraversal = 0;             // candidates tested by the query that traversed
-    std::size_t scanCost = 0;                         // candidates tested since beyond that many, summed
+    // What a traversal took, and what it assumed: the relative pose it tested at, its margin,
+    // and the colliders' drifts and generations when it began. A traversal may be spread over
+    // several queries (`stack` holds the node pairs left); it tests every node at `pose`.
+    struct Take {
+        std::vector<Candidate> candidates;  // sorted by (faceA, faceB) once complete
+        RelativePose pose;
+        double margin = 0.0;
+        double driftA = 0.0, driftB = 0.0, vertexDriftA = 0.0, vertexDriftB = 0.0;
+        std::uint64_t generationA = 0, generationB = 0;
+        std::vector<std::pair<std::int32_t, std::int32_t>> stack;
+        std::size_t nodes = 0;              // node pairs visited
+        std::uint64_t startQuery = 0;       // the query that began it (PairCoherence::queries)
+    };
+    Take list;                             // the candidates in use
     bool valid = false;
-    std::uint32_t plainQueriesLeft = 0;               // answered by plain traversals (outrun)
-    std::uint64_t traversals = 0;                     // traversals that took candidates
-    std::uint64_t plainSpells = 0;                    // times the motion outran the widest margin
+    Take next;                             // the next list, being taken
+    bool walking = false;
+    std::uint64_t queries = 0;             // coherent queries so far
+    std::uint32_t queriesSince = 0;        // queries answered from the list
+    std::size_t tested = 0, overlapping = 0;  // at the last query: candidates tested, and whose leaves overlapped
+    std::size_t testedAfterTraversal = 0;  // candidates tested by the query that took the list
+    std::size_t scanCost = 0;              // candidates tested since beyond that many, summed
+    std::uint32_t plainQueriesLeft = 0;    // answered by plain traversals (outrun)
+    std::uint64_t traversals = 0;          // lists taken
+    std::uint64_t plainSpells = 0;         // times the motion outran the widest margin
 };
 
 // queryPair()'s contacts, in the same order, from the pair's last candidates while they still
@@ -196,13 +206,14 @@ struct PairCoherence {
 // (relative motion plus both vertexDrifts) is skipped: the full query's exact test would find
 // them apart. So a body at rest on another costs O(its
 // candidates' scan + the pairs near contact), not a traversal.
-// Otherwise, or once the tests that motion added since have cost as much as the traversal that
-// took them, the candidates are taken again by one traversal: with twice the margin when the
-// motion left it, twice the motion seen (at most half the margin) when the added tests spent
-// their budget (within [1e-4, 0.05] of the smaller mean leaf size). So the queries between two
-// traversals cost at most about two traversals, and a pair at rest never traverses again.
-// When the motion outruns the widest margin within one query (a part deforming fast), the next
-// 16 queries are plain queryPair() calls, cheaper than taking candidates that serve one query.
+// The next list is taken by a traversal at a fixed pose, spread over the queries (1/8 of the
+// last traversal's node pairs each) from when the motion reaches 0.25 of the margin: no query
+// pays a whole traversal unless the motion outruns that walk (then it finishes it, or takes a
+// list at once). Its margin: twice the last when the motion left it, twice the motion seen (at
+// most half the margin) once the tests motion added have cost as much as a traversal (then it
+// is taken at once); within [1e-4, 0.05] of the smaller mean leaf size. A pair at rest never
+// traverses again. When the widest margin is outrun within 4 queries of a list's pose, plain
+// queryPair() calls answer the next 16.
 // stats: volumeTests counts the traversal's nodes and the candidates tested; candidatePairs
 // the candidates whose leaves overlap now.
 void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,

@@ -24,11 +24,12 @@ constexpr double kFirstMarginShare = 0.02;
 constexpr double kMinMarginShare = 1e-4;
 constexpr double kMaxMarginShare = 0.05;
 constexpr double kScanBudget = 1.0;
-// When the motion outruns the widest margin within a query (a part deforming fast), taking
-// candidates costs more than a plain traversal and saves nothing: this many queries are
-// answered by plain traversals before candidates are tried again (measured: a tool pressed
-// into a 60,000-face part whose zone moves every step, 80 against 62 us a step).
+// When a list is outrun with the widest margin within kShortLived queries of its pose (a part
+// deforming fast), taking lists costs more than it saves: the next kPlainQueries queries are
+// plain traversals (measured: a tool pressed into a 60,000-face part whose zone moves every
+// step, 80 against 62 us a step without them).
 constexpr std::uint32_t kPlainQueries = 16;
+constexpr std::uint64_t kShortLived = 4;
 
 // B's leaves as a ball metric: a box leaf within its earlier box grown by d along each axis is
 // within sqrt(3) d of it.
@@ -36,23 +37,37 @@ double ballDrift(const PartCollider& collider, double drift) {
     return collider.kind() == BoundingVolumeKind::Aabb ? std::sqrt(3.0) * drift : drift;
 }
 
-// How far B's frame has moved in A's since the candidates were taken (for points of B's
-// bounding sphere), or infinity when they cannot be used.
-double motionSince(const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA, const PairCoherence& c) {
-    if (!c.valid || c.generationA != colliderA.generation() || c.generationB != colliderB.generation())
-        return std::numeric_limits<double>::infinity();
-    return relativeMotion(c.pose, bInA, colliderB.localSphere());
+// How far B's frame has moved in A's since the take's pose (for points of B's bounding sphere),
+// or infinity when its hierarchies were rebuilt since.
+double motionSince(const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA, const PairCoherence::Take& t) {
+    if (t.generationA != colliderA.generation() || t.generationB != colliderB.generation()) return std::numeric_limits<double>::infinity();
+    return relativeMotion(t.pose, bInA, colliderB.localSphere());
 }
 
-// How far A's frame has moved in B's (for points of A's bounding sphere); the candidates are
-// valid (motionSince is finite).
-double motionOfA(const RelativePose& bInA, const PartCollider& colliderA, const PairCoherence& c) {
-    const Eigen::Matrix3d before = c.pose.rotation.transpose(), now = bInA.rotation.transpose();
-    return relativeMotion(RelativePose(before, -(before * c.pose.translation)), RelativePose(now, -(now * bInA.translation)),
+// How far A's frame has moved in B's (for points of A's bounding sphere).
+double motionOfA(const RelativePose& bInA, const PartCollider& colliderA, const PairCoherence::Take& t) {
+    const Eigen::Matrix3d before = t.pose.rotation.transpose(), now = bInA.rotation.transpose();
+    return relativeMotion(RelativePose(before, -(before * t.pose.translation)), RelativePose(now, -(now * bInA.translation)),
                           colliderA.localSphere());
 }
 
-bool scansSpentBudget(const PairCoherence& c) { return double(c.scanCost) > kScanBudget * double(c.traversalCost); }
+// What a take must still cover now: `leaves` for its leaf pairs (A's grown leaves hold A's
+// drift and B's leaves' motion), `reach` for its gaps (the faces' vertices' largest relative
+// move since). Both within the margin: it answers exactly.
+struct Coverage {
+    double leaves = 0.0, reach = 0.0;
+    double slack() const { return std::max(leaves, reach); }
+};
+
+Coverage coverageOf(const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA, const PairCoherence::Take& t) {
+    const double motion = motionSince(colliderA, colliderB, bInA, t);
+    if (!std::isfinite(motion)) return {motion, motion};
+    const double moveA = colliderA.vertexDrift() - t.vertexDriftA, moveB = colliderB.vertexDrift() - t.vertexDriftB;
+    return {motion + (colliderA.drift() - t.driftA) + ballDrift(colliderB, colliderB.drift() - t.driftB),
+            std::max(motion, motionOfA(bInA, colliderA, t)) + moveA + moveB};
+}
+
+bool scansSpentBudget(const PairCoherence& c) { return double(c.scanCost) > kScanBudget * double(c.list.nodes); }
 
 double maxMargin(const PartCollider& colliderA, const PartCollider& colliderB) {
     return kMaxMarginShare * std::min(colliderA.leafScale(), colliderB.leafScale());
@@ -60,59 +75,78 @@ double maxMargin(const PartCollider& colliderA, const PartCollider& colliderB) {
 
 double nextMargin(const PartCollider& colliderA, const PartCollider& colliderB, double slack, const PairCoherence& c) {
     const double scale = std::min(colliderA.leafScale(), colliderB.leafScale());
-    if (!c.valid || !std::isfinite(slack)) return c.margin > 0.0 ? std::min(c.margin, maxMargin(colliderA, colliderB)) : kFirstMarginShare * scale;
-    double margin = c.margin;
+    if (!c.valid || !std::isfinite(slack)) return c.list.margin > 0.0 ? std::min(c.list.margin, maxMargin(colliderA, colliderB)) : kFirstMarginShare * scale;
+    double margin = c.list.margin;
     if (scansSpentBudget(c))
-        margin = std::min(2.0 * slack, 0.5 * c.margin);
-    else if (double(c.scanCost) < 0.5 * kScanBudget * double(c.traversalCost))
-        margin = 2.0 * c.margin;
+        margin = std::min(2.0 * slack, 0.5 * c.list.margin);
+    else if (double(c.scanCost) < 0.5 * kScanBudget * double(c.list.nodes))
+        margin = 2.0 * c.list.margin;
     return std::clamp(margin, kMinMarginShare * scale, maxMargin(colliderA, colliderB));
 }
 
+// Begins a take at the current pose and state.
+void startTake(PairCoherence::Take& t, const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA, double margin,
+               std::uint64_t query) {
+    t.startQuery = query;
+    t.candidates.clear();
+    t.stack.assign(1, {0, 0});
+    t.nodes = 0;
+    t.pose = bInA;
+    t.margin = margin;
+    t.driftA = colliderA.drift();
+    t.driftB = colliderB.drift();
+    t.vertexDriftA = colliderA.vertexDrift();
+    t.vertexDriftB = colliderB.vertexDrift();
+    t.generationA = colliderA.generation();
+    t.generationB = colliderB.generation();
+}
+
+// Goes on with the take for up to `budget` node pairs, at its pose; true once complete (its
+// candidates then sorted). `tester` must be at the take's pose. A pair separated by more than
+// the margin stays so while the take is used: by a plane of A's face (A rigid), by the plane
+// of B's face, or along a separating axis of the two triangles (the dearest, tried last).
 template <class BA, class BB>
-void takeCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const PartCollider& colliderA, const PartCollider& colliderB,
-                    const RelativePose& bInA, double margin, LeafPairTester& tester, PairCoherence& c, QueryStats& stats) {
-    c.candidates.clear();
-    // A pair separated by more than the margin stays so while the candidates are used: by a
-    // plane of A's face (A rigid), by the plane of B's face, or along a separating axis of the
-    // two triangles (the dearest, tried last).
+bool advanceTake(PairCoherence::Take& t, std::size_t budget, const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, LeafPairTester& tester,
+                 QueryStats& stats) {
+    const double margin = t.margin;
     auto record = [&](Index fa, Index fb) {
         double separation = tester.separationByA(fa, fb, margin);
         if (separation > margin) return;
         separation = std::max(separation, tester.separationByB(fa, fb));
         if (separation > margin) return;
         separation = std::max(separation, tester.separationOfTriangles(fa, fb));
-        if (separation <= margin) c.candidates.push_back({fa, fb, separation});
+        if (separation <= margin) t.candidates.push_back({fa, fb, separation});
     };
     auto beyondMargin = [&](Index fa, const auto& volumeB) { return tester.prunesBeyond(fa, volumeB, margin); };
-    QueryStats traversal;
-    traverse(bvhA, bvhB, bInA, traversal, record, beyondMargin, margin);
-    stats.volumeTests += traversal.volumeTests;
-    c.traversalCost = traversal.volumeTests;
-    c.scanCost = 0;
-    std::sort(c.candidates.begin(), c.candidates.end(),
+    QueryStats walk;
+    if (!bvhA.empty() && !bvhB.empty()) traverseFrom(t.stack, budget, bvhA, bvhB, t.pose, walk, record, beyondMargin, margin);
+    else t.stack.clear();
+    stats.volumeTests += walk.volumeTests;
+    t.nodes += walk.volumeTests;
+    if (!t.stack.empty()) return false;
+    std::sort(t.candidates.begin(), t.candidates.end(),
               [](const PairCoherence::Candidate& x, const PairCoherence::Candidate& y) { return std::tie(x.faceA, x.faceB) < std::tie(y.faceA, y.faceB); });
-    c.pose = bInA;
-    c.margin = margin;
-    c.driftA = colliderA.drift();
-    c.driftB = colliderB.drift();
-    c.vertexDriftA = colliderA.vertexDrift();
-    c.vertexDriftB = colliderB.vertexDrift();
-    c.generationA = colliderA.generation();
-    c.generationB = colliderB.generation();
-    c.queriesSince = 0;
+    return true;
+}
+
+// The next take becomes the list.
+void useNext(PairCoherence& c) {
+    std::swap(c.list, c.next);
+    c.walking = false;
     c.valid = true;
+    c.queriesSince = 0;
+    c.scanCost = 0;
     ++c.traversals;
 }
 
-// Tests the candidates as the full query tests its leaf pairs; those whose separation exceeds
-// `reach` cannot touch and are skipped.
+// Tests the list's candidates as the full query tests its leaf pairs; those whose separation
+// exceeds `reach` cannot touch and are skipped.
 template <class BA, class BB>
 void scanCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const RelativePose& bInA, double reach, LeafPairTester& tester,
                     PairCoherence& c, QueryStats& stats) {
     c.tested = 0;
     c.overlapping = 0;
-    for (const PairCoherence::Candidate& k : c.candidates) {
+    for (const PairCoherence::Candidate& k : c.list.candidates) {
         if (k.separation > reach) continue;
         ++c.tested;
         if (!overlap(bvhA.leafVolume(k.faceA), bvhB.leafVolume(k.faceB), bInA)) continue;
@@ -127,44 +161,70 @@ void scanCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const RelativePose
         c.scanCost += c.tested - std::min(c.tested, c.testedAfterTraversal);
 }
 
+// The next list's walk: started at kWalkStart of the margin, 1 / kWalkShare of the last
+// traversal's node pairs a query (at least kMinWalkNodes).
+constexpr double kWalkStart = 0.25;
+constexpr std::size_t kWalkShare = 8;
+constexpr std::size_t kMinWalkNodes = 256;
+
+// The walk's own rest-plane scratch (a query's tester at the current pose uses the other).
+RestPlaneFilter::Scratch& walkScratch() {
+    thread_local RestPlaneFilter::Scratch scratch;
+    return scratch;
+}
+
 }  // namespace
 
 void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
-                       const PartCollider& colliderB, ExactTest test, PairCoherence& coherence, std::vector<Contact>& contacts,
+                       const PartCollider& colliderB, ExactTest test, PairCoherence& c, std::vector<Contact>& contacts,
                        QueryStats& stats) {
     requireBuiltFor(colliderA, colliderB, test);
-    if (coherence.plainQueriesLeft > 0) {
-        --coherence.plainQueriesLeft;
+    if (c.plainQueriesLeft > 0) {
+        --c.plainQueriesLeft;
         return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
     }
     const RelativePose bInA = relativePose(a, b);
-    LeafPairTester tester(idA, a, colliderA, idB, b, test, bInA, contacts, stats);
+    Coverage now = c.valid ? coverageOf(colliderA, colliderB, bInA, c.list) : Coverage{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    const bool outrun = !(now.slack() <= c.list.margin);
+    ++c.queries;
+    // Outrun with the widest margin by the motion of a few queries since the list's pose.
+    if (outrun && c.valid && c.queries - c.list.startQuery <= kShortLived && c.list.margin >= maxMargin(colliderA, colliderB)) {
+        c.valid = c.walking = false;  // the motion outruns the widest margin: plain traversals for a while
+        c.plainQueriesLeft = kPlainQueries;
+        ++c.plainSpells;
+        return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
+    }
     dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) {
-        // A's leaves grown by the margin cover A's drift and the motion of B's leaves. A candidate
-        // separated by a gap (a plane of A's face, A rigid; the plane of B's face; or an axis)
-        // stays so while the two faces' vertices move, relative to each other, less than it:
-        // A's by its own moves, B's by the relative motion in A's frame and its own moves (for
-        // B's plane, the other way round: A's points in B's frame).
-        const double motion = motionSince(colliderA, colliderB, bInA, coherence);
-        const double moveA = colliderA.vertexDrift() - coherence.vertexDriftA, moveB = colliderB.vertexDrift() - coherence.vertexDriftB;
-        const double reach = std::max(motion, motionOfA(bInA, colliderA, coherence)) + moveA + moveB;
-        const double leaves = motion + (colliderA.drift() - coherence.driftA) + ballDrift(colliderB, colliderB.drift() - coherence.driftB);
-        // Candidates separated by more than the margin were dropped: the reach stays within it.
-        const double slack = std::max(leaves, reach);
-        if (!(slack <= coherence.margin) && coherence.valid && coherence.queriesSince <= 1 &&
-            coherence.margin >= maxMargin(colliderA, colliderB)) {
-            coherence.valid = false;  // outrun: plain traversals for a while
-            coherence.plainQueriesLeft = kPlainQueries;
-            ++coherence.plainSpells;
+        // The next list: finished now when the current one no longer covers (if it covers, else
+        // taken afresh) or its tests spent their budget; else walked a slice, from 0.4 margin.
+        const bool atOnce = outrun || scansSpentBudget(c);
+        if (atOnce && c.walking && !(coverageOf(colliderA, colliderB, bInA, c.next).slack() <= c.next.margin)) c.walking = false;
+        if (!c.walking && (atOnce || now.slack() > kWalkStart * c.list.margin)) {
+            startTake(c.next, colliderA, colliderB, bInA, nextMargin(colliderA, colliderB, now.slack(), c), c.queries);
+            c.walking = true;
+        }
+        if (c.walking) {
+            const std::size_t budget = atOnce ? std::numeric_limits<std::size_t>::max() : std::max(kMinWalkNodes, c.list.nodes / kWalkShare);
+            std::vector<Contact> none;
+            LeafPairTester walker(idA, a, colliderA, idB, b, test, c.next.pose, none, stats, walkScratch());
+            if (advanceTake(c.next, budget, bvhA, bvhB, walker, stats)) {
+                const Coverage next = coverageOf(colliderA, colliderB, bInA, c.next);
+                if (next.slack() <= c.next.margin) {
+                    useNext(c);
+                    now = next;
+                } else {
+                    c.walking = false;  // outrun while walking: the next query takes one at once
+                }
+            }
+        }
+        if (!(now.slack() <= c.list.margin)) {  // only when a list taken at once was outrun as it was taken: never at one pose
+            c.valid = false;
             return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
         }
-        if (!(slack <= coherence.margin) || scansSpentBudget(coherence)) {
-            takeCandidates(bvhA, bvhB, colliderA, colliderB, bInA, nextMargin(colliderA, colliderB, slack, coherence), tester, coherence, stats);
-            return scanCandidates(bvhA, bvhB, bInA, 0.0, tester, coherence, stats);
-        }
-        scanCandidates(bvhA, bvhB, bInA, reach, tester, coherence, stats);
+        LeafPairTester tester(idA, a, colliderA, idB, b, test, bInA, contacts, stats);
+        scanCandidates(bvhA, bvhB, bInA, now.reach, tester, c, stats);
     });
-    ++coherence.queriesSince;
+    ++c.queriesSince;
 }
 
 }  // namespace flexfit

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace flexfit::detail {
@@ -24,17 +25,17 @@ inline Aabb grown(const Aabb& b, double margin) { return {b.min.array() - margin
 // Simultaneous depth-first traversal; leafPair(faceA, faceB) for every overlapping leaf pair.
 // prune(faceA, volumeB) may cut a subtree of B that cannot touch A's leaf face. A margin > 0
 // grows A's volumes by it (for the coherent query's candidates); which side descends depends
-// on the volumes alone, not on the margin.
+// on the volumes alone, not on the margin. traverseFrom() goes on from the node pairs left in
+// `stack`, at most `budget` of them, and can be resumed (the coherent query spreads a traversal
+// over several queries); traverse() is one whole traversal.
+using NodePairStack = std::vector<std::pair<std::int32_t, std::int32_t>>;
+
 template <class BA, class BB, class LeafPair, class Prune>
-void traverse(const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, QueryStats& stats, LeafPair leafPair, Prune prune,
-              double margin) {
-    if (a.empty() || b.empty()) return;
-    thread_local std::vector<std::pair<std::int32_t, std::int32_t>> stack;
-    stack.clear();
-    stack.emplace_back(0, 0);
+void traverseFrom(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA,
+                  QueryStats& stats, LeafPair leafPair, Prune prune, double margin) {
     const auto& na = a.nodes();
     const auto& nb = b.nodes();
-    while (!stack.empty()) {
+    for (std::size_t visited = 0; !stack.empty() && visited < budget; ++visited) {
         const auto [i, j] = stack.back();
         stack.pop_back();
         const auto& x = na[std::size_t(i)];
@@ -53,6 +54,15 @@ void traverse(const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, Quer
             stack.emplace_back(x.left, j);
         }
     }
+}
+
+template <class BA, class BB, class LeafPair, class Prune>
+void traverse(const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, QueryStats& stats, LeafPair leafPair, Prune prune,
+              double margin) {
+    if (a.empty() || b.empty()) return;
+    thread_local NodePairStack stack;
+    stack.assign(1, {0, 0});
+    traverseFrom(stack, std::numeric_limits<std::size_t>::max(), a, b, bInA, stats, leafPair, prune, margin);
 }
 
 template <class Visit>
@@ -188,10 +198,11 @@ RestPlaneFilter::Scratch& restPlaneScratch();
 class LeafPairTester {
 public:
     LeafPairTester(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
-                   ExactTest test, const RelativePose& bInA, std::vector<Contact>& contacts, QueryStats& stats)
+                   ExactTest test, const RelativePose& bInA, std::vector<Contact>& contacts, QueryStats& stats,
+                   RestPlaneFilter::Scratch& scratch = restPlaneScratch())
         : idA_(idA), idB_(idB), a_(a), b_(b), test_(test), bInA_(bInA), ra_(a.pose().rotation.toRotationMatrix()),
           pa_(a.state().positions), pb_(b.state().positions), facesA_(a.model().mesh.faces), facesB_(b.model().mesh.faces),
-          filter_(a, colliderA, bInA, restPlaneScratch()), contacts_(contacts), stats_(stats) {}
+          filter_(a, colliderA, bInA, scratch), contacts_(contacts), stats_(stats) {}
 
     void operator()(Index fa, Index fb) {
         const Face& f = facesB_[fb];
