@@ -39,6 +39,7 @@ BENCH_FLAGS := --benchmark_repetitions=12 --benchmark_enable_random_interleaving
 	--benchmark_report_aggregates_only=true --benchmark_min_time=0.2 \
 	--benchmark_out_format=csv
 bench: release
+	@scripts/install-deps.sh --bench
 	build/release/bench/bench_msd_step $(BENCH_FLAGS) --benchmark_out=bench/results/msd_step.csv
 	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitFullStep BM_NaiveFullStep
 	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitSweep BM_NaiveFullStep
@@ -53,7 +54,13 @@ bench: release
 	  --pair BM_FclObbrssQuery/2 BM_FlexfitQuery/2/1 --pair BM_FclObbrssQuery/3 BM_FlexfitQuery/3/1 \
 	  --pair BM_FlexfitQuery/1/0 BM_FlexfitQuery/1/1 --pair BM_FclAabbRefit BM_FlexfitRefitLocal/1 \
 	  --pair BM_BroadPhase/1 BM_BroadPhase/0 --pair BM_DeformingPairFclAabb/iterations:3/manual_time BM_DeformingPairFlexfit/iterations:3/manual_time \
-	  --pair BM_DeformingPairFclObbrss/iterations:1/manual_time BM_DeformingPairFlexfit/iterations:3/manual_time
+	  --pair BM_DeformingPairFclObbrss/iterations:1/manual_time BM_DeformingPairFlexfit/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/0/1/iterations:3/manual_time BM_ToolIntoPart/0/0/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/1/1/iterations:3/manual_time BM_ToolIntoPart/1/0/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/2/1/iterations:3/manual_time BM_ToolIntoPart/2/0/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/0/2/iterations:3/manual_time BM_ToolIntoPart/0/0/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/1/2/iterations:3/manual_time BM_ToolIntoPart/1/0/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/2/2/iterations:3/manual_time BM_ToolIntoPart/2/0/iterations:3/manual_time
 	build/release/bench/bench_world --benchmark_repetitions=3 --benchmark_out_format=csv --benchmark_out=bench/results/world.csv
 
 clean:

@@ -14,6 +14,15 @@
 //          collides.
 //          The deformation itself is stepped untimed; same_contacts compares the face pairs of
 //          the last step.
+//   A tool pressed into a deforming part, as users deliver parts (issue 15's goals): Wuson, a
+//          third-party mesh (Debian's assimp-testmodels, 3,732 faces, open), its vertices
+//          shuffled, at 1x, 4x and 16x its faces (midpoint subdivision). A level-3 icosphere of
+//          radius 4 % of the part's box diagonal is pressed 20 % of its radius into the surface
+//          and slides slowly along it while a zone under it deforms, 60 steps. Timed per step:
+//          the part's refit and the pair query, coherent (queryPairCoherent), full (queryPair,
+//          the traversal 6d7824d made every step) and FCL AABB (endUpdateModel + collide).
+//          same_contacts: the coherent query's face pairs equal the full query's at every step
+//          and FCL's at the last.
 #include "flexfit/flexfit.hpp"
 
 #include <benchmark/benchmark.h>
@@ -22,7 +31,11 @@
 #include <fmt/core.h>
 
 #include <chrono>
+#include <filesystem>
+#include <map>
 #include <set>
+
+#include "shuffled_mesh.hpp"
 
 namespace {
 
@@ -291,6 +304,151 @@ void BM_DeformingPairFcl(benchmark::State& state, const char* label) {
 void BM_DeformingPairFclObbrss(benchmark::State& s) { BM_DeformingPairFcl<fcl::OBBRSSd>(s, "heart deforming under a ball / fcl obbrss, endUpdateModel + collide"); }
 void BM_DeformingPairFclAabb(benchmark::State& s) { BM_DeformingPairFcl<fcl::AABBd>(s, "heart deforming under a ball / fcl aabb, endUpdateModel + collide"); }
 
+// Each face split in four at its edges' midpoints (shared by the faces of an edge).
+TriMesh subdivided(const TriMesh& mesh) {
+    TriMesh out;
+    out.name = mesh.name;
+    out.vertices = mesh.vertices;
+    std::map<std::pair<Index, Index>, Index> midpoints;
+    auto midpoint = [&](Index a, Index b) {
+        const auto key = std::minmax(a, b);
+        const auto [it, added] = midpoints.try_emplace({key.first, key.second}, Index(out.vertices.size()));
+        if (added) out.vertices.push_back(0.5 * (mesh.vertices[a] + mesh.vertices[b]));
+        return it->second;
+    };
+    for (const Face& f : mesh.faces) {
+        const Index ab = midpoint(f[0], f[1]), bc = midpoint(f[1], f[2]), ca = midpoint(f[2], f[0]);
+        out.faces.push_back({f[0], ab, ca});
+        out.faces.push_back({ab, f[1], bc});
+        out.faces.push_back({ca, bc, f[2]});
+        out.faces.push_back({ab, bc, ca});
+    }
+    return out;
+}
+
+const char* const kThirdPartyPart = "/usr/share/assimp/models/OFF/Wuson.off";
+
+// Wuson subdivided `levels` times (1x, 4x, 16x the faces), vertices shuffled; null when the
+// file is not installed.
+std::shared_ptr<const PartModel> thirdPartyPart(int levels) {
+    static std::map<int, std::shared_ptr<const PartModel>> cache;
+    if (!std::filesystem::exists(kThirdPartyPart)) return nullptr;
+    auto& model = cache[levels];
+    if (!model) {
+        TriMesh mesh = readMesh(kThirdPartyPart).mesh;
+        for (int i = 0; i < levels; ++i) mesh = subdivided(mesh);
+        model = buildPartModel(flexfit::testing::shuffledVertices(std::move(mesh), 7));
+    }
+    return model;
+}
+
+// The tool and the part, pressed together; each step pushes the zone and slides the tool.
+struct ToolIntoPart {
+    std::shared_ptr<const PartModel> partModel;
+    std::shared_ptr<const PartModel> toolModel;
+    Part part, tool;
+    Index pressed = 0;
+    Vec3 normal, slide, push;
+    double radius = 0.0;
+
+    explicit ToolIntoPart(std::shared_ptr<const PartModel> model)
+        : partModel(std::move(model)), toolModel(buildPartModel(makeIcoSphere(toolRadius(*partModel), 3))), part(partModel),
+          tool(toolModel, [] {
+              PartSettings s;
+              s.mode = PartMode::Rigid;
+              return s;
+          }()) {
+        radius = toolRadius(*partModel);
+        // The mass nearest the top of the part's box (a surface point the tool can reach).
+        const auto& rest = partModel->restPositions;
+        for (Index m = 0; m < rest.size(); ++m)
+            if (!partModel->topology.facesOf(m).empty() && rest[m].y() > rest[pressed].y()) pressed = m;
+        normal = Vec3::UnitY();
+        slide = 0.002 * radius * Vec3::UnitX();
+        push = -0.5 * normal;
+        tool.setPose(Pose{Eigen::Quaterniond::Identity(), rest[pressed] + (0.8 * radius) * normal});
+        part.openZone(ZoneSeed::mass(pressed), 3);
+    }
+    static double toolRadius(const PartModel& m) { return 0.04 * Aabb::around(m.restPositions).size(); }
+    void step() {
+        part.applyForce(pressed, push);
+        part.step();
+        tool.translate(slide);
+    }
+    std::vector<fcl::Vector3d> positions() const { return {part.state().positions.begin(), part.state().positions.end()}; }
+};
+
+constexpr int kToolSteps = 60;
+
+std::set<std::pair<Index, Index>> facePairs(const std::vector<Contact>& contacts) {
+    std::set<std::pair<Index, Index>> pairs;
+    for (const Contact& c : contacts) pairs.insert({c.faceA, c.faceB});
+    return pairs;
+}
+
+// range(0): subdivision levels (0, 1, 2); range(1): 0 coherent, 1 full, 2 FCL AABB.
+void BM_ToolIntoPart(benchmark::State& state) {
+    const auto model = thirdPartyPart(int(state.range(0)));
+    if (!model) {
+        state.SkipWithError("assimp-testmodels is not installed (Debian package)");
+        return;
+    }
+    const int method = int(state.range(1));
+    std::size_t contacts = 0;
+    bool same = true;
+    for (auto _ : state) {
+        ToolIntoPart t(model);
+        PartCollider part(t.part, BoundingVolumeKind::Aabb), tool(t.tool, BoundingVolumeKind::Aabb);
+        const auto fclTool = fclModel<fcl::AABBd>(*t.toolModel);
+        auto fclPart = fclModel<fcl::AABBd>(*t.partModel);
+        PairCoherence coherence;
+        std::vector<Contact> found, full;
+        std::set<std::pair<Index, Index>> fclFound;
+        QueryStats stats;
+        double seconds = 0.0;
+        for (int i = 0; i < kToolSteps; ++i) {
+            t.step();
+            std::vector<fcl::Vector3d> positions = method == 2 ? t.positions() : std::vector<fcl::Vector3d>{};
+            found.clear();
+            const auto start = std::chrono::steady_clock::now();
+            if (method == 2) {
+                fclPart->beginUpdateModel();
+                fclPart->updateSubModel(positions);
+                fclPart->endUpdateModel(true, true);
+                const Scene s{"", t.toolModel, t.partModel, t.tool.pose(), t.part.pose()};
+                fclFound = fclContacts(s, fclTool, fclPart, &contacts);
+            } else {
+                part.refit(t.part, t.part.changedMasses());
+                if (method == 0)
+                    queryPairCoherent(0, t.tool, tool, 1, t.part, part, ExactTest::TriangleTriangle, coherence, found, stats);
+                else
+                    queryPair(0, t.tool, tool, 1, t.part, part, ExactTest::TriangleTriangle, found, stats);
+            }
+            seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            t.part.clearChangedMasses();
+            if (method != 2) {
+                contacts = found.size();
+                full.clear();
+                QueryStats ignored;
+                queryPair(0, t.tool, tool, 1, t.part, part, ExactTest::TriangleTriangle, full, ignored);
+                same = same && facePairs(found) == facePairs(full);
+            }
+        }
+        state.SetIterationTime(seconds);
+        if (method != 2) {
+            std::size_t count = 0;
+            fclPart->beginUpdateModel();
+            fclPart->updateSubModel(t.positions());
+            fclPart->endUpdateModel(true, true);
+            const Scene s{"", t.toolModel, t.partModel, t.tool.pose(), t.part.pose()};
+            same = same && facePairs(found) == fclContacts(s, fclTool, fclPart, &count);
+        }
+    }
+    static const char* const kMethods[] = {"coherent", "full query", "fcl aabb, endUpdateModel + collide"};
+    setPairCounters(state, fmt::format("wuson x{} ({} faces) pressed by a tool / {}", 1 << (2 * state.range(0)), model->faceCount(), kMethods[method]),
+                    contacts, same);
+}
+
 // 200 parts moving every step: refit the broad-phase tree, or rebuild it.
 void BM_BroadPhase(benchmark::State& state) {
     const auto model = buildPartModel(makeIcoSphere(1.0, 1));
@@ -322,6 +480,7 @@ BENCHMARK(BM_BroadPhase)->Arg(0)->Arg(1);
 BENCHMARK(BM_DeformingPairFlexfit)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(3);
 BENCHMARK(BM_DeformingPairFclObbrss)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(1);
 BENCHMARK(BM_DeformingPairFclAabb)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(3);
+BENCHMARK(BM_ToolIntoPart)->ArgsProduct({{0, 1, 2}, {0, 1, 2}})->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(3);
 
 }  // namespace
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian packages Flexfit needs to build, test and run its demo.
+# Installs the Debian packages Flexfit needs to build, test and run its demo (with --bench, also
+# what the benchmarks read: third-party meshes).
 # Idempotent and quiet: when every package is present it prints nothing and exits 0.
 set -euo pipefail
 
@@ -20,6 +21,9 @@ packages=(
   libpng-dev                           # viewer: PNG screenshots
   xvfb xauth                           # viewer tests: a virtual X server
 )
+if [[ "${1:-}" == "--bench" ]]; then
+  packages+=(assimp-testmodels)        # third-party meshes the benchmarks press tools into
+fi
 
 missing=()
 for p in "${packages[@]}"; do

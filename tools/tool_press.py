@@ -1,0 +1,205 @@
+#!/usr/bin/python3
+"""A tool pressed into a user's part, in a world, by one or more flexfit binaries side by side.
+
+The part is Wuson (Debian's assimp-testmodels, a third-party mesh of 3,732 faces, open, 51
+pieces), its vertices shuffled (seeded), at 1x, 4x and 16x its faces (midpoint subdivision). A
+kinematic level-3 icosphere of radius 4 % of the part's box diagonal comes down onto its
+highest vertex, presses 20 % of its radius in, and slides along it while the part deforms
+(face query, rigid-deformable part). For each binary and size: the in-contact steps' mean
+narrow phase and World::step, and the step's p50 / p99 (nearest rank), from metrics.csv. Runs
+alternate between binaries, `--rounds` times; the medians are reported.
+
+  tools/tool_press.py --flexfit new=build/release/apps/flexfit/flexfit \
+      --flexfit old=/tmp/base/build/apps/flexfit/flexfit --csv bench/results/tool_press.csv
+A path ending in "+plain" runs that binary with coherent_collision = false.
+"""
+import argparse
+import csv
+import math
+import os
+import random
+import statistics
+import subprocess
+import tempfile
+
+WUSON = "/usr/share/assimp/models/OFF/Wuson.off"
+
+
+def read_off(path):
+    words = []
+    with open(path) as f:
+        for line in f:
+            line = line.split("#", 1)[0].split()
+            words.extend(line)
+    assert words[0] == "OFF", path
+    nv, nf = int(words[1]), int(words[2])
+    at = 4
+    vertices = [tuple(float(w) for w in words[at + 3 * i: at + 3 * i + 3]) for i in range(nv)]
+    at += 3 * nv
+    faces = []
+    for _ in range(nf):
+        n = int(words[at])
+        poly = [int(w) for w in words[at + 1: at + 1 + n]]
+        at += 1 + n
+        faces.extend((poly[0], poly[k], poly[k + 1]) for k in range(1, n - 1))
+    return vertices, faces
+
+
+def subdivide(vertices, faces):
+    vertices = list(vertices)
+    mids = {}
+
+    def mid(a, b):
+        key = (min(a, b), max(a, b))
+        if key not in mids:
+            mids[key] = len(vertices)
+            vertices.append(tuple(0.5 * (x + y) for x, y in zip(vertices[a], vertices[b])))
+        return mids[key]
+
+    out = []
+    for a, b, c in faces:
+        ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+        out += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca)]
+    return vertices, out
+
+
+def shuffled(vertices, faces, seed):
+    order = list(range(len(vertices)))
+    random.Random(seed).shuffle(order)  # vertex v becomes order[v]
+    moved = [None] * len(vertices)
+    for v, p in enumerate(vertices):
+        moved[order[v]] = p
+    return moved, [tuple(order[v] for v in f) for f in faces]
+
+
+def write_obj(path, vertices, faces):
+    with open(path, "w") as f:
+        for p in vertices:
+            f.write("v %.17g %.17g %.17g\n" % p)
+        for a, b, c in faces:
+            f.write("f %d %d %d\n" % (a + 1, b + 1, c + 1))
+
+
+SCENE = """[world]
+time_step = 0.001
+gravity = [0, 0, 0]
+duration = 2.0
+
+[[part]]
+name = "part"
+mesh = "{mesh}"
+mode = "rigid-deformable"
+motion = "static"
+restoration = "constraint"
+constraint_fraction = 2e-3
+global_damping = 0.5
+contact_level = 3
+
+[[part]]
+name = "tool"
+generator = {{ type = "sphere", radius = {radius}, level = 3 }}
+mode = "rigid"
+motion = "kinematic"
+position = [{x}, {y_start}, {z}]
+
+[[action]]
+time = 0.0
+type = "grab"
+part = "tool"
+
+[[action]]
+time = 0.0
+type = "move"
+part = "tool"
+position = [{x}, {y_press}, {z}]
+duration = 0.5
+
+[[action]]
+time = 0.5
+type = "move"
+part = "tool"
+position = [{x}, {y_press}, {z_end}]
+duration = 1.5
+"""
+
+
+def scenes(directory):
+    vertices, faces = read_off(WUSON)
+    lo = [min(p[d] for p in vertices) for d in range(3)]
+    hi = [max(p[d] for p in vertices) for d in range(3)]
+    radius = 0.1 * math.dist(lo, hi)
+    top = max(vertices, key=lambda p: p[1])
+    out = []
+    for level in range(3):
+        v, f = shuffled(vertices, faces, 7)
+        path = os.path.join(directory, f"wuson_x{4 ** level}.obj")
+        write_obj(path, v, f)
+        scene = os.path.join(directory, f"tool_press_x{4 ** level}.toml")
+        with open(scene, "w") as s:
+            s.write(SCENE.format(mesh=path, radius=radius, x=top[0], z=top[2], y_start=top[1] + 1.3 * radius,
+                                 y_press=top[1] + 0.8 * radius, z_end=top[2] + 2.0 * radius))
+        out.append((4 ** level, len(f), scene))
+        vertices, faces = subdivide(vertices, faces)
+    return out
+
+
+def percentile(values, p):
+    values = sorted(values)
+    return values[min(len(values), max(1, math.ceil(p / 100 * len(values)))) - 1]
+
+
+def measure(flexfit, scene, directory):
+    out = os.path.join(directory, "run")
+    if flexfit.endswith("+plain"):  # this binary with coherent_collision = false
+        flexfit = flexfit[: -len("+plain")]
+        with open(scene) as f:
+            text = f.read().replace("[world]\n", "[world]\ncoherent_collision = false\n", 1)
+        scene = os.path.join(directory, "plain.toml")
+        with open(scene, "w") as f:
+            f.write(text)
+    subprocess.run([flexfit, "run", scene, "--out", out, "--no-progress"], check=True, stdout=subprocess.DEVNULL)
+    with open(os.path.join(out, "metrics.csv")) as f:
+        rows = [r for r in csv.DictReader(f) if float(r["contacts"]) > 0]
+    stages = [k for k in rows[0] if k.startswith("us_") and k != "us_world_step"]
+    steps = [float(r["us_world_step"]) if "us_world_step" in r else sum(float(r[k]) for k in stages) for r in rows]
+    narrow = [float(r["us_narrow_phase"]) for r in rows]
+    return {"contact_steps": len(rows), "contacts": statistics.mean(float(r["contacts"]) for r in rows),
+            "us_narrow_phase": statistics.mean(narrow), "us_world_step": statistics.mean(steps),
+            "us_step_p50": percentile(steps, 50), "us_step_p99": percentile(steps, 99)}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--flexfit", action="append", required=True, help="NAME=PATH of a flexfit binary")
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--csv")
+    args = parser.parse_args()
+    binaries = [b.split("=", 1) for b in args.flexfit]
+    if not os.path.exists(WUSON):
+        raise SystemExit(f"{WUSON} is missing: install Debian's assimp-testmodels")
+    with tempfile.TemporaryDirectory() as directory:
+        runs = {}
+        for scale, faces, scene in scenes(directory):
+            for _ in range(args.rounds):
+                for name, path in binaries:
+                    runs.setdefault((scale, faces, name), []).append(measure(path, scene, directory))
+    table = []
+    for (scale, faces, name), results in runs.items():
+        row = {"part": f"wuson x{scale}", "faces": faces, "binary": name}
+        for key in results[0]:
+            row[key] = statistics.median(r[key] for r in results)
+        table.append(row)
+    keys = list(table[0])
+    print("| " + " | ".join(keys) + " |")
+    print("|" + "---|" * len(keys))
+    for row in table:
+        print("| " + " | ".join(f"{row[k]:.1f}" if isinstance(row[k], float) else str(row[k]) for k in keys) + " |")
+    if args.csv:
+        with open(args.csv, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=keys)
+            writer.writeheader()
+            writer.writerows(table)
+
+
+if __name__ == "__main__":
+    main()
