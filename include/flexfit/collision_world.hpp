@@ -11,8 +11,8 @@
 // than the top-down enclosure and the queries then visit more nodes.
 //
 // Narrow phase: per candidate pair, the two face hierarchies traversed together (collision.hpp),
-// or, by default, the pair's candidates from its last traversal while they still cover it
-// (queryPairCoherent: exactly the same contacts). The world keeps one PairCoherence per pair
+// or, by default for two rigid parts, the pair's candidates from its last traversal while they
+// still cover it (queryPairCoherent: exactly the same contacts). The world keeps one PairCoherence per pair
 // that a face query has met, and drops those the broad phase has not paired for a while.
 // Part A of a pair is the pressing one: the rigid part when exactly one is deformable, otherwise
 // the lower id. With ExactTest::SphereTriangle A's faces are spheres and B's triangles.
@@ -30,7 +30,7 @@
 #include "flexfit/distance_field.hpp"
 
 #include <memory>
-#include <unordered_map>
+#include <map>
 
 namespace flexfit {
 
@@ -61,9 +61,10 @@ struct CollisionSettings {
     ExactTest exactTest = ExactTest::TriangleTriangle;
     BroadPhaseUpdate broadPhase = BroadPhaseUpdate::Rebuild;
     RigidDeformableQuery rigidDeformable = RigidDeformableQuery::Faces;
-    // Queries start from what the pair's last query found (queryPairCoherent,
-    // queryPointShellCoherent): the same contacts as full ones, at the cost of what may touch
-    // while the pair moves little.
+    // Queries start from what the pair's last query found (queryPairCoherent for two rigid
+    // parts, queryPointShellCoherent): the same contacts as full ones, at the cost of what may
+    // touch while the pair moves little. Face queries with a deforming part traverse (measured
+    // slower coherent: the part refits every step and outruns the margins).
     bool coherent = true;
 };
 
@@ -147,7 +148,7 @@ private:
         PointShellCoherence pointShell;
         std::uint64_t lastUpdate = 0;  // the update() count when last used
     };
-    std::unordered_map<std::uint64_t, KeptCoherence> coherence_;  // by (a << 32 | b), a presses b
+    std::map<std::uint64_t, KeptCoherence> coherence_;  // by (a << 32 | b), a presses b (ordered: no hash order in a step)
     std::uint64_t updates_ = 0;
     std::uint64_t faceQueries_ = 0, faceTraversals_ = 0;
 };
