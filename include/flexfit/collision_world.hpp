@@ -11,8 +11,8 @@
 // than the top-down enclosure and the queries then visit more nodes.
 //
 // Narrow phase: per candidate pair, the two face hierarchies traversed together (collision.hpp),
-// or, by default for two rigid parts, the pair's candidates from its last traversal while they
-// still cover it (queryPairCoherent: exactly the same contacts). The world keeps one PairCoherence per pair
+// or, by default, the pair's candidates from its last traversal while they still cover it
+// (queryPairCoherent: exactly the same contacts). The world keeps one PairCoherence per pair
 // that a face query has met, and drops those the broad phase has not paired for a while.
 // Part A of a pair is the pressing one: the rigid part when exactly one is deformable, otherwise
 // the lower id. With ExactTest::SphereTriangle A's faces are spheres and B's triangles.
@@ -61,10 +61,10 @@ struct CollisionSettings {
     ExactTest exactTest = ExactTest::TriangleTriangle;
     BroadPhaseUpdate broadPhase = BroadPhaseUpdate::Rebuild;
     RigidDeformableQuery rigidDeformable = RigidDeformableQuery::Faces;
-    // Queries start from what the pair's last query found (queryPairCoherent for two rigid
-    // parts, queryPointShellCoherent): the same contacts as full ones, at the cost of what may
-    // touch while the pair moves little. Face queries with a deforming part traverse (measured
-    // slower coherent: the part refits every step and outruns the margins).
+    // Queries start from what the pair's last query found (queryPairCoherent,
+    // queryPointShellCoherent): the same contacts as full ones, at the cost of what may touch
+    // while the pair moves little. Measured: a ball resting on a deforming mouth 2x faster; a
+    // part deforming fast under a tool 5-16 % slower, with tails up to 1.6x (false: plain).
     bool coherent = true;
 };
 

@@ -61,10 +61,7 @@ void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, Qu
     refitChanged(a);
     refitChanged(b);
     ++faceQueries_;
-    // A deforming part refits every step and moves its leaves faster than a margin pays for:
-    // measured, coherent face queries made such pairs 5-16 % slower on the mean and up to 1.6x
-    // on the tail (tools/tool_press.py, ball_torus.toml), so they traverse.
-    if (!settings_.coherent || parts_[a]->deforms() || parts_[b]->deforms()) {
+    if (!settings_.coherent) {
         ++faceTraversals_;
         return flexfit::queryPair(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, out, stats);
     }
