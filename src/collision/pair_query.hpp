@@ -30,9 +30,9 @@ inline Aabb grown(const Aabb& b, double margin) { return {b.min.array() - margin
 // over several queries); traverse() is one whole traversal.
 using NodePairStack = std::vector<std::pair<std::int32_t, std::int32_t>>;
 
-template <class BA, class BB, class LeafPair, class Prune>
-void traverseFrom(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA,
-                  QueryStats& stats, LeafPair leafPair, Prune prune, double margin) {
+template <bool kGrown, class BA, class BB, class LeafPair, class Prune>
+void traverseFromImpl(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA,
+                      QueryStats& stats, LeafPair& leafPair, Prune& prune, double margin) {
     const auto& na = a.nodes();
     const auto& nb = b.nodes();
     for (std::size_t visited = 0; !stack.empty() && visited < budget; ++visited) {
@@ -41,7 +41,11 @@ void traverseFrom(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a, co
         const auto& x = na[std::size_t(i)];
         const auto& y = nb[std::size_t(j)];
         ++stats.volumeTests;
-        if (!(margin > 0.0 ? overlap(grown(x.volume, margin), y.volume, bInA) : overlap(x.volume, y.volume, bInA))) continue;
+        if constexpr (kGrown) {
+            if (!overlap(grown(x.volume, margin), y.volume, bInA)) continue;
+        } else {
+            if (!overlap(x.volume, y.volume, bInA)) continue;
+        }
         if (x.isLeaf() && !y.isLeaf() && prune(x.item, y.volume)) continue;
         if (x.isLeaf() && y.isLeaf()) {
             ++stats.candidatePairs;
@@ -54,6 +58,15 @@ void traverseFrom(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a, co
             stack.emplace_back(x.left, j);
         }
     }
+}
+
+template <class BA, class BB, class LeafPair, class Prune>
+void traverseFrom(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA,
+                  QueryStats& stats, LeafPair leafPair, Prune prune, double margin) {
+    if (margin > 0.0)
+        traverseFromImpl<true>(stack, budget, a, b, bInA, stats, leafPair, prune, margin);
+    else
+        traverseFromImpl<false>(stack, budget, a, b, bInA, stats, leafPair, prune, margin);
 }
 
 template <class BA, class BB, class LeafPair, class Prune>
