@@ -103,16 +103,15 @@ public:
     // beyond one of them cannot touch the face.
     const std::array<Eigen::Vector4d, 4>& restPlanes(Index face) const { return restPlanes_[face]; }
 
-    // How far the leaves may have grown since the hierarchy was built: every leaf now lies
-    // within its volume of any earlier time t grown by drift() - drift at t (box leaves: by that
-    // much along each axis of the part frame; sphere leaves: in radius), from the vertices'
-    // moves (vertexDrift): a triangle's box grows by at most a vertex's move, a face sphere (or
-    // its box) by three times it. generation() changes when rebuild() starts afresh.
-    double drift() const { return leafDriftPerMove_ * vertexDrift_; }
-    std::uint64_t generation() const { return generation_; }
     // How far the part's vertices may have moved (part frame) since the hierarchy was built:
     // each refit adds the largest move of a changed mass since the refit before.
+    // generation() changes when rebuild() starts afresh.
     double vertexDrift() const { return vertexDrift_; }
+    std::uint64_t generation() const { return generation_; }
+    // How far a leaf can grow while the vertices move by `vertexMove` (box leaves: along each
+    // axis of the part frame; sphere leaves: in radius): a triangle's box by at most that, a
+    // face sphere (or its box) by three times it.
+    double leafGrowth(double vertexMove) const { return leafDriftPerMove_ * vertexMove; }
     // Mean size of the leaf volumes (box diagonal, sphere diameter) when built: the scale of
     // the coherent query's margins.
     double leafScale() const { return leafScale_; }
@@ -169,13 +168,13 @@ struct PairCoherence {
         double separation = 0.0;
     };
     // What a traversal took, and what it assumed: the relative pose it tested at, its margin,
-    // and the colliders' drifts and generations when it began. A traversal may be spread over
+    // and the colliders' vertex drifts and generations when it began. A traversal may be spread over
     // several queries (`stack` holds the node pairs left); it tests every node at `pose`.
     struct Take {
         std::vector<Candidate> candidates;  // sorted by (faceA, faceB) once complete
         RelativePose pose;
         double margin = 0.0;
-        double driftA = 0.0, driftB = 0.0, vertexDriftA = 0.0, vertexDriftB = 0.0;
+        double vertexDriftA = 0.0, vertexDriftB = 0.0;
         std::uint64_t generationA = 0, generationB = 0;
         std::vector<std::pair<std::int32_t, std::int32_t>> stack;
         std::size_t nodes = 0;              // node pairs visited
@@ -187,17 +186,15 @@ struct PairCoherence {
     bool walking = false;
     std::uint64_t queries = 0;             // coherent queries so far
     std::uint32_t queriesSince = 0;        // queries answered from the list
-    std::size_t tested = 0, overlapping = 0;  // at the last query: candidates tested, and whose leaves overlapped
     std::size_t testedAfterTraversal = 0;  // candidates tested by the query that took the list
     std::size_t scanCost = 0;              // candidates tested since beyond that many, summed
     std::uint32_t plainQueriesLeft = 0;    // answered by plain traversals (outrun)
     std::uint64_t traversals = 0;          // lists taken
-    std::uint64_t plainSpells = 0;         // times the motion outran the widest margin
 };
 
 // queryPair()'s contacts, in the same order, from the pair's last candidates while they still
 // cover every leaf pair that can overlap: the relative motion of the parts (B's bounding sphere
-// under the change of relative pose) plus both colliders' drift since the candidates were taken
+// under the change of relative pose) plus the growth of both colliders' leaves since the candidates were taken
 // stays within their margin. A's leaf volumes grown by the margin contain every position its
 // leaves can reach meanwhile, so a leaf pair that overlaps now was a candidate; each candidate
 // is tested as the full query tests a leaf pair (volume overlap now, then the exact test).

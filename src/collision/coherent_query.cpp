@@ -31,10 +31,11 @@ constexpr double kScanBudget = 1.0;
 constexpr std::uint32_t kPlainQueries = 16;
 constexpr std::uint64_t kShortLived = 4;
 
-// B's leaves as a ball metric: a box leaf within its earlier box grown by d along each axis is
-// within sqrt(3) d of it.
-double ballDrift(const PartCollider& collider, double drift) {
-    return collider.kind() == BoundingVolumeKind::Aabb ? std::sqrt(3.0) * drift : drift;
+// B's leaves' growth as a ball metric: a box leaf within its earlier box grown by d along each
+// axis is within sqrt(3) d of it.
+double ballGrowth(const PartCollider& collider, double vertexMove) {
+    const double growth = collider.leafGrowth(vertexMove);
+    return collider.kind() == BoundingVolumeKind::Aabb ? std::sqrt(3.0) * growth : growth;
 }
 
 // How far B's frame has moved in A's since the take's pose (for points of B's bounding sphere),
@@ -63,8 +64,7 @@ Coverage coverageOf(const PartCollider& colliderA, const PartCollider& colliderB
     const double motion = motionSince(colliderA, colliderB, bInA, t);
     if (!std::isfinite(motion)) return {motion, motion};
     const double moveA = colliderA.vertexDrift() - t.vertexDriftA, moveB = colliderB.vertexDrift() - t.vertexDriftB;
-    return {motion + (colliderA.drift() - t.driftA) + ballDrift(colliderB, colliderB.drift() - t.driftB),
-            std::max(motion, motionOfA(bInA, colliderA, t)) + moveA + moveB};
+    return {motion + colliderA.leafGrowth(moveA) + ballGrowth(colliderB, moveB), std::max(motion, motionOfA(bInA, colliderA, t)) + moveA + moveB};
 }
 
 bool scansSpentBudget(const PairCoherence& c) { return double(c.scanCost) > kScanBudget * double(c.list.nodes); }
@@ -93,8 +93,6 @@ void startTake(PairCoherence::Take& t, const PartCollider& colliderA, const Part
     t.nodes = 0;
     t.pose = bInA;
     t.margin = margin;
-    t.driftA = colliderA.drift();
-    t.driftB = colliderB.drift();
     t.vertexDriftA = colliderA.vertexDrift();
     t.vertexDriftB = colliderB.vertexDrift();
     t.generationA = colliderA.generation();
@@ -140,25 +138,24 @@ void useNext(PairCoherence& c) {
 }
 
 // Tests the list's candidates as the full query tests its leaf pairs; those whose separation
-// exceeds `reach` cannot touch and are skipped.
+// exceeds `reach` cannot touch and are skipped. The tests beyond those of the list's first
+// query are what the motion since added (scanCost).
 template <class BA, class BB>
 void scanCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const RelativePose& bInA, double reach, LeafPairTester& tester,
                     PairCoherence& c, QueryStats& stats) {
-    c.tested = 0;
-    c.overlapping = 0;
+    std::size_t tested = 0;
     for (const PairCoherence::Candidate& k : c.list.candidates) {
         if (k.separation > reach) continue;
-        ++c.tested;
+        ++tested;
         if (!overlap(bvhA.leafVolume(k.faceA), bvhB.leafVolume(k.faceB), bInA)) continue;
-        ++c.overlapping;
+        ++stats.candidatePairs;
         tester(k.faceA, k.faceB);
     }
-    stats.volumeTests += c.tested;
-    stats.candidatePairs += c.overlapping;
+    stats.volumeTests += tested;
     if (c.queriesSince == 0)
-        c.testedAfterTraversal = c.tested;
+        c.testedAfterTraversal = tested;
     else
-        c.scanCost += c.tested - std::min(c.tested, c.testedAfterTraversal);
+        c.scanCost += tested - std::min(tested, c.testedAfterTraversal);
 }
 
 // The next list's walk: started at kWalkStart of the margin, 1 / kWalkShare of the last
@@ -191,12 +188,12 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
     if (outrun && c.valid && c.queries - c.list.startQuery <= kShortLived && c.list.margin >= maxMargin(colliderA, colliderB)) {
         c.valid = c.walking = false;  // the motion outruns the widest margin: plain traversals for a while
         c.plainQueriesLeft = kPlainQueries;
-        ++c.plainSpells;
         return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
     }
     dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) {
         // The next list: finished now when the current one no longer covers (if it covers, else
-        // taken afresh) or its tests spent their budget; else walked a slice, from 0.4 margin.
+        // taken afresh) or its tests spent their budget; else walked a slice, from kWalkStart of
+        // the margin.
         const bool atOnce = outrun || scansSpentBudget(c);
         if (atOnce && c.walking && !(coverageOf(colliderA, colliderB, bInA, c.next).slack() <= c.next.margin)) c.walking = false;
         if (!c.walking && (atOnce || now.slack() > kWalkStart * c.list.margin)) {

@@ -100,14 +100,13 @@ void PartCollider::updateDisplacementBound(const Part& part) {
 void PartCollider::refit(const Part& part, std::span<const Index> changedMasses) {
     const PartModel& model = part.model();
     double moved = 0.0;
+    changedFaces_.clear();
     for (Index m : changedMasses) {
         moved = std::max(moved, (part.state().positions[m] - seenPositions_[m]).norm());
         seenPositions_[m] = part.state().positions[m];
+        for (Index f : model.topology.facesOf(m)) changedFaces_.insert(f);
     }
     vertexDrift_ += moved;
-    changedFaces_.clear();
-    for (Index m : changedMasses)
-        for (Index f : model.topology.facesOf(m)) changedFaces_.insert(f);
     const std::span<const Vec3> positions = part.state().positions;
     std::visit(
         [&](auto& bvh) {

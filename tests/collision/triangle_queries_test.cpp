@@ -54,6 +54,15 @@ bool referenceIntersects(const Triangle& x, const Triangle& y) {
 
 Triangle shifted(const Triangle& t, const Vec3& d) { return {t.a + d, t.b + d, t.c + d}; }
 
+// Corners uniform in [-1, 1]^3 (drawn in order: a, then b, then c; x, y, z each).
+Triangle randomTriangle(std::mt19937& rng) {
+    std::uniform_real_distribution<double> u(-1, 1);
+    Triangle t;
+    for (Vec3* corner : {&t.a, &t.b, &t.c})
+        for (int d = 0; d < 3; ++d) (*corner)[d] = u(rng);
+    return t;
+}
+
 }  // namespace
 
 TEST(ClosestPoint, MatchesDenseSamplingInEveryRegion) {
@@ -103,11 +112,9 @@ TEST(SphereTriangle, ContactPointNormalDepth) {
 
 TEST(TriangleTriangle, AgreesWithEdgeTestsOnRandomPairs) {
     std::mt19937 rng(2);
-    std::uniform_real_distribution<double> u(-1, 1);
     int hits = 0;
     for (int k = 0; k < 20000; ++k) {
-        const Triangle x{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
-        const Triangle y{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+        const Triangle x = randomTriangle(rng), y = randomTriangle(rng);
         const bool reference = referenceIntersects(x, y);
         const auto contact = intersectTriangles(x, y);
         ASSERT_EQ(contact.has_value(), reference) << "pair " << k;
@@ -139,8 +146,7 @@ TEST(TriangleGap, ALowerBoundOnTheDistanceThatKeepsPairsApart) {
     std::uniform_real_distribution<double> u(-1, 1);
     int apart = 0;
     for (int k = 0; k < 3000; ++k) {
-        const Triangle x{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
-        const Triangle y{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+        const Triangle x = randomTriangle(rng), y = randomTriangle(rng);
         const double gap = triangleGap(x, y);
         ASSERT_GE(gap, 0.0);
         if (intersectTriangles(x, y)) {
