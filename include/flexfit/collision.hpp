@@ -261,4 +261,52 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
                              const Bvh<Aabb>& restPointsB, const Sphere& restSphereB, PointShellCoherence& coherence,
                              std::vector<Contact>& contacts, QueryStats& stats);
 
+// --- The point shell's sharp features (sharp_features.cpp) ---
+// The point shell sees only B's masses, so a rigid edge or corner narrower than the gaps
+// between them can pass through B's surface unseen. The faces of the rigid part where its
+// surface turns sharply at B's scale are therefore also tested as faces against B's faces
+// (querySharpFeatures), which closes that hole; the point shell answers the rest.
+//
+// With B's rest resolution rho (every point of a B triangle lies within rho of one of its
+// corners: rho = longest rest edge / sqrt(3)), a crossing of B's (locally flat) surface that
+// covers a disc of radius rho of it holds a mass, which the point shell finds. A vertex v of
+// the rigid part is smooth at scale rho when, with n its normal, its faces lie within `angle`
+// of n (the pressing direction, in v's normal cone, is then close to n), the faces within
+// twice that disc's radius of v turn less than 60 degrees from n (a height field over n's
+// plane, covering the disc of radius rho / cos(angle) around v), and the surface over it lies at most
+// rho tan(angle) behind v along n. Then if v were the deepest point of a crossing deeper than
+// that, the crossing would cover the disc: smooth surface hides at most rho tan(angle) past
+// B's (0.21 of B's longest rest edge at the default 20 degrees; a sphere of radius R hides
+// about rho^2 / 2R, and spheres of radius >= 2.2 rho are smooth). Every other vertex is sharp, and
+// the faces around sharp vertices are the sharp faces. Known limits: heights are taken along
+// n, not the pressing direction (they differ by at most `angle`); B's triangles stretched
+// beyond their rest length widen the gaps by as much; a neighbourhood of more than 512
+// vertices counts as sharp (a rigid part far finer than B), which keeps the bound at a cost.
+inline constexpr double kSharpFeatureAngle = 0.3490658503988659;  // 20 degrees
+
+struct SharpFeatures {
+    std::vector<Index> faces;  // ascending faces of the rigid part
+    Bvh<Aabb> tree;            // their leaf boxes (for `test`) in the part's frame; leaf k is faces[k]
+    double radius = 0.0, angle = 0.0;
+    ExactTest test = ExactTest::TriangleTriangle;
+    bool empty() const { return faces.empty(); }
+};
+
+// The sharp faces of `rigid` (its rest mesh) at scale `radius` (>= 0, finite), with leaves
+// for the exact test the queries will use.
+SharpFeatures findSharpFeatures(const Part& rigid, double radius, ExactTest test = ExactTest::TriangleTriangle,
+                                double angle = kSharpFeatureAngle);
+
+// B's rest resolution: the largest distance from a point of one of its triangles to the
+// nearest corner of that triangle is at most this (its longest rest edge / sqrt(3)).
+double restResolution(const Part& part);
+
+// The face contacts of A's sharp faces (A rigid, the part `features` were found for) against
+// B's faces, in (faceA, faceB) order, appended after whatever `contacts` holds: queryPair()
+// restricted to those faces of A. colliderB must be refitted to B's shape; the features must
+// have been found for `test`.
+void querySharpFeatures(std::uint32_t idA, const Part& a, const PartCollider& colliderA, const SharpFeatures& features,
+                        std::uint32_t idB, const Part& b, const PartCollider& colliderB, ExactTest test,
+                        std::vector<Contact>& contacts, QueryStats& stats);
+
 }  // namespace flexfit

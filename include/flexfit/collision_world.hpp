@@ -30,6 +30,7 @@
 #include "flexfit/distance_field.hpp"
 
 #include <memory>
+#include <limits>
 #include <map>
 
 namespace flexfit {
@@ -48,12 +49,17 @@ template <> inline constexpr std::span<const EnumName<BroadPhaseUpdate>> kEnumNa
 // not stall at the first contact); it needs a closed rigid mesh (open ones keep the face
 // query) and sees only the masses, so the deformable part should be the finer of the two. Its
 // cost follows the masses near the rigid surface, which is what lets a ball press a
-// 7,300-mass rim at haptic rates.
-enum class RigidDeformableQuery { Faces, PointShell };
+// 7,300-mass rim at haptic rates. The rigid part's sharp faces at the deformable part's scale
+// are tested as faces too (querySharpFeatures), so no edge or corner slips between masses.
+// Auto: the point shell for a pair whose rigid part is closed and whose deformable part is the
+// finer (mean rest edge no longer than the rigid part's), the face query otherwise; fields are
+// built only for rigid parts some deformable part is finer than.
+enum class RigidDeformableQuery { Faces, PointShell, Auto };
 // Its names (names.hpp).
 inline constexpr EnumName<RigidDeformableQuery> kRigidDeformableQueryNames[] = {
     {RigidDeformableQuery::Faces, "faces", "face hierarchies"},
     {RigidDeformableQuery::PointShell, "point-shell", "point shell"},
+    {RigidDeformableQuery::Auto, "auto", "point shell where the deformable part is finer, else faces"},
 };
 template <> inline constexpr std::span<const EnumName<RigidDeformableQuery>> kEnumNames<RigidDeformableQuery> = kRigidDeformableQueryNames;
 
@@ -124,6 +130,11 @@ public:
 
 private:
     bool pressesFirst(BodyId a, BodyId b) const;
+    // Whether the pair (a presses b) is answered by the point shell.
+    bool usesPointShell(BodyId a, BodyId b) const;
+    // The point shell's contacts of the pair (a rigid with a field, b deforming), with those of
+    // a's sharp faces.
+    void queryPointShellPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats);
     // Contacts of the pair (a presses b) appended to `out`, by the query the settings choose.
     void queryPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats);
     // Forgets the coherence of pairs no query has used lately (broad_phase.cpp).
@@ -134,7 +145,12 @@ private:
     CollisionSettings settings_;
     std::vector<const Part*> parts_;                                  // (nbody)
     std::vector<PartCollider> colliders_;                             // (nbody)
-    std::vector<std::shared_ptr<const SignedDistanceField>> fields_;  // (nbody) rigid closed parts, PointShell; else null
+    std::vector<std::shared_ptr<const SignedDistanceField>> fields_;  // (nbody) rigid closed parts the point shell may serve; else null
+    std::vector<std::shared_ptr<const SharpFeatures>> features_;      // (nbody) beside each field, at featureRadius_
+    std::vector<double> meanEdge_;                                    // (nbody) mean rest edge length
+    std::vector<bool> fieldTried_;                                    // (nbody) a field was built, or the mesh has no inside
+    double featureRadius_ = 0.0;  // the largest rest resolution of the deformable parts
+    double finestDeformableEdge_ = std::numeric_limits<double>::infinity();  // their smallest mean rest edge
     std::vector<Sphere> partSpheres_;                                 // (nbody) world frame
     Bvh<Sphere> broadPhase_;
     std::vector<std::pair<BodyId, BodyId>> pairs_;

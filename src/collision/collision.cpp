@@ -140,7 +140,7 @@ RestPlaneFilter::Scratch& restPlaneScratch() {
 }
 }  // namespace detail
 
-namespace {
+namespace detail {
 
 // Contacts in (faceA, faceB) order: the same whatever order a traversal met them in.
 // Sorts (face pair, position) keys, then moves each contact once: a contact is 80 bytes.
@@ -160,7 +160,7 @@ void sortContacts(std::vector<Contact>& contacts, std::size_t first) {
     std::copy(sorted.begin(), sorted.end(), contacts.begin() + std::ptrdiff_t(first));
 }
 
-}  // namespace
+}  // namespace detail
 
 void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
                const PartCollider& colliderB, ExactTest test, std::vector<Contact>& contacts, QueryStats& stats,

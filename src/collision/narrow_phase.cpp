@@ -50,14 +50,7 @@ const std::vector<Contact>& CollisionWorld::contactsOf(BodyId id, bool rigidPart
 }
 
 void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats) {
-    // A field exists only for a rigid part under the point-shell setting.
-    if (const SignedDistanceField* field = fields_[a].get(); field != nullptr && parts_[b]->deforms()) {
-        if (!settings_.coherent) return queryPointShell(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(), out, stats);
-        KeptCoherence& kept = coherence_[std::uint64_t(a) << 32 | b];
-        kept.lastUpdate = updates_;
-        return queryPointShellCoherent(a, *parts_[a], *field, b, *parts_[b], colliders_[b].restPointTree(), colliders_[b].localSphere(),
-                                       kept.pointShell, out, stats);
-    }
+    if (usesPointShell(a, b)) return queryPointShellPair(a, b, out, stats);
     refitChanged(a);
     refitChanged(b);
     ++faceQueries_;
@@ -70,6 +63,22 @@ void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, Qu
     const std::uint64_t traversals = kept.coherence.traversals;
     queryPairCoherent(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, kept.coherence, out, stats);
     faceTraversals_ += kept.coherence.traversals - traversals;
+}
+
+void CollisionWorld::queryPointShellPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats) {
+    const SignedDistanceField& field = *fields_[a];
+    if (!settings_.coherent) {
+        queryPointShell(a, *parts_[a], field, b, *parts_[b], colliders_[b].restPointTree(), out, stats);
+    } else {
+        KeptCoherence& kept = coherence_[std::uint64_t(a) << 32 | b];
+        kept.lastUpdate = updates_;
+        queryPointShellCoherent(a, *parts_[a], field, b, *parts_[b], colliders_[b].restPointTree(), colliders_[b].localSphere(),
+                                kept.pointShell, out, stats);
+    }
+    // The sharp faces, against B's faces as they are now.
+    if (features_[a]->empty()) return;
+    refitChanged(b);
+    querySharpFeatures(a, *parts_[a], colliders_[a], *features_[a], b, *parts_[b], colliders_[b], settings_.exactTest, out, stats);
 }
 
 void CollisionWorld::refitChanged(BodyId id) {

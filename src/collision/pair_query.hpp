@@ -206,6 +206,9 @@ inline RelativePose relativePose(const Part& a, const Part& b) {
 // This thread's scratch of the rest-plane filter (collision.cpp).
 RestPlaneFilter::Scratch& restPlaneScratch();
 
+// Sorts contacts[first..] into (faceA, faceB) order (collision.cpp).
+void sortContacts(std::vector<Contact>& contacts, std::size_t first);
+
 // The exact test of one leaf pair (face of A, face of B) at the parts' current shapes and poses,
 // shared by the full and the coherent query.
 class LeafPairTester {

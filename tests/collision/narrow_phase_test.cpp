@@ -114,13 +114,14 @@ TEST(NarrowPhase, HierarchiesRefitWhenAQueryNeedsThemAndNotWhenRead) {
 }
 
 TEST(NarrowPhase, PointShellPairsNeedNoRefit) {
-    // Under the point-shell query a deformable part met only by a closed rigid part is tested
-    // mass by mass: its face hierarchy is never refitted.
+    // Under the point-shell query a deformable part met only by a closed rigid part, smooth at
+    // its scale (no sharp faces), is tested mass by mass: its face hierarchy is never refitted.
     CollisionSettings settings;
     settings.rigidDeformable = RigidDeformableQuery::PointShell;
     Part ball(buildPartModel(makeIcoSphere(3.0, 2)), rigidPart());
     ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(12.0, 0.5, 0.0)});
-    Part torus(buildPartModel(makeTorus1()));
+    Part torus(buildPartModel(makeTorus2()));
+    ASSERT_TRUE(findSharpFeatures(ball, restResolution(torus)).empty());
     CollisionWorld world(settings);
     world.add(0, ball);
     world.add(1, torus);

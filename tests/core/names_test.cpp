@@ -42,7 +42,7 @@ TEST(Names, EveryEnumHasOneNamePerValue) {
     expectOneNamePerValue<ExactTest>(2);
     expectOneNamePerValue<BoundingVolumeKind>(2);
     expectOneNamePerValue<BroadPhaseUpdate>(2);
-    expectOneNamePerValue<RigidDeformableQuery>(2);
+    expectOneNamePerValue<RigidDeformableQuery>(3);
     expectOneNamePerValue<SnapTechnique>(4);
     expectOneNamePerValue<AssemblyArea::Shape>(3);
     expectOneNamePerValue<SceneAction::Kind>(6);

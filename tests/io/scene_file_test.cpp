@@ -136,7 +136,7 @@ TEST(SceneFile, ContactQueryIsAChoice) {
     const std::string text = withLine("duration = 2.5", "rigid_deformable_query = \"point-shell\"");
     EXPECT_EQ(parseScene(text, "scene.toml", ".").world.collision.rigidDeformable, RigidDeformableQuery::PointShell);
     const std::string e = errorOf(withLine("duration = 2.5", "rigid_deformable_query = \"voxels\""));
-    EXPECT_NE(e.find(":6: scene.world, key 'rigid_deformable_query': unknown value 'voxels' (expected one of 'faces', 'point-shell')"),
+    EXPECT_NE(e.find(":6: scene.world, key 'rigid_deformable_query': unknown value 'voxels' (expected one of 'faces', 'point-shell', 'auto')"),
               std::string::npos)
         << e;
 }

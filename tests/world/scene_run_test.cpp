@@ -160,9 +160,16 @@ TEST_P(SceneRunWithQuery, StiffMouthStopsTheBallUnderGravity) {
     EXPECT_GT(run.world().body(1).linearVelocity.y(), -0.01);  // not sinking (the anchors push back up)
 }
 
-INSTANTIATE_TEST_SUITE_P(BothQueries, SceneRunWithQuery,
-                         ::testing::Values(RigidDeformableQuery::Faces, RigidDeformableQuery::PointShell),
-                         [](const auto& param) { return param.param == RigidDeformableQuery::Faces ? "Faces" : "PointShell"; });
+INSTANTIATE_TEST_SUITE_P(EveryQuery, SceneRunWithQuery,
+                         ::testing::Values(RigidDeformableQuery::Faces, RigidDeformableQuery::PointShell, RigidDeformableQuery::Auto),
+                         [](const auto& param) {
+                             switch (param.param) {
+                                 case RigidDeformableQuery::Faces: return "Faces";
+                                 case RigidDeformableQuery::PointShell: return "PointShell";
+                                 case RigidDeformableQuery::Auto: break;
+                             }
+                             return "Auto";
+                         });
 
 // --- The contact solver's example scenes, against Coulomb's law. ---
 
