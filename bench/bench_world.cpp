@@ -72,7 +72,9 @@ void BM_HapticMouthResting(benchmark::State& s) { stepInContact(s, "ball_torus_h
 void BM_HapticMouthRestingFaceQuery(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", false, 500, true); }
 // The same at the container-mouth resolution (64 x 24 = 1,536 masses).
 void BM_MouthPushed(benchmark::State& s) { stepInContact(s, "ball_torus.toml", true, 20); }
+void BM_MouthPushedFaceQuery(benchmark::State& s) { stepInContact(s, "ball_torus.toml", true, 20, true); }
 void BM_MouthResting(benchmark::State& s) { stepInContact(s, "ball_torus.toml", false, 500); }
+void BM_MouthRestingFaceQuery(benchmark::State& s) { stepInContact(s, "ball_torus.toml", false, 500, true); }
 // A rigid mouth: the ball rests on it, projected by the rigid contact dynamics.
 void BM_RigidMouthResting(benchmark::State& s) { stepInContact(s, "ball_torus_rigid.toml", false, 500); }
 
@@ -83,7 +85,9 @@ BENCHMARK(BM_HapticMouthPushedFaceQuery)->UseManualTime()->Unit(benchmark::kMill
 BENCHMARK(BM_HapticMouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_HapticMouthRestingFaceQuery)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_MouthPushed)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_MouthPushedFaceQuery)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_MouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_MouthRestingFaceQuery)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_RigidMouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 
 BENCHMARK_MAIN();

@@ -51,6 +51,7 @@ void run(const ContactOptions& opt) {
     settings.timeStep = 1e-3;
     settings.gravity = Vec3::Zero();
     settings.collision.exactTest = enumOption<ExactTest>(opt.test, "option --test");
+    settings.collision.rigidDeformable = RigidDeformableQuery::Faces;  // the thesis's face pairs, which --test chooses among
     World world(settings);
     const double start = 2 * (kMajor + kMinor) + 0.5;  // 0.5 apart
     BodySettings yellowBody;

@@ -66,7 +66,7 @@ template <> inline constexpr std::span<const EnumName<RigidDeformableQuery>> kEn
 struct CollisionSettings {
     ExactTest exactTest = ExactTest::TriangleTriangle;
     BroadPhaseUpdate broadPhase = BroadPhaseUpdate::Rebuild;
-    RigidDeformableQuery rigidDeformable = RigidDeformableQuery::Faces;
+    RigidDeformableQuery rigidDeformable = RigidDeformableQuery::Auto;
     // Queries start from what the pair's last query found (queryPairCoherent,
     // queryPointShellCoherent): the same contacts as full ones, at the cost of what may touch
     // while the pair moves little. Measured: a ball resting on a deforming mouth 2x faster; a

@@ -64,7 +64,7 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     }
     for (std::size_t r = 0; r < n && query != RigidDeformableQuery::Faces; ++r) {
         if (parts[r]->deforms() || tried[r]) continue;
-        if (query == RigidDeformableQuery::Auto && !(finestEdge <= meanEdge[r])) continue;  // no deformable part is finer
+        if (query == RigidDeformableQuery::Auto && !(finestEdge < meanEdge[r])) continue;  // no deformable part is finer
         fields[r] = buildDistanceField(*parts[r]);
         tried[r] = true;
     }
@@ -116,7 +116,7 @@ bool CollisionWorld::pressesFirst(BodyId a, BodyId b) const {
 
 bool CollisionWorld::usesPointShell(BodyId a, BodyId b) const {
     if (!fields_[a] || !parts_[b]->deforms()) return false;
-    return settings_.rigidDeformable == RigidDeformableQuery::PointShell || meanEdge_[b] <= meanEdge_[a];
+    return settings_.rigidDeformable == RigidDeformableQuery::PointShell || meanEdge_[b] < meanEdge_[a];
 }
 
 }  // namespace flexfit

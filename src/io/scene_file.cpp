@@ -416,7 +416,7 @@ void readWorld(Table& root, Scene& scene) {
     if (s.contactSlop > 1.0) w.fail(*w.node("contact_slop"), "contact_slop", "must be in (0, 1]");
     s.contactDamping = w.nonNegative("contact_damping", s.contactDamping);
     s.collision.exactTest = w.choice("exact_test", ExactTest::TriangleTriangle);
-    s.collision.rigidDeformable = w.choice("rigid_deformable_query", RigidDeformableQuery::Faces);
+    s.collision.rigidDeformable = w.choice("rigid_deformable_query", RigidDeformableQuery::Auto);
     s.collision.coherent = w.flag("coherent_collision", s.collision.coherent);
     w.finish();
     try {

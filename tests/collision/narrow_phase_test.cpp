@@ -24,9 +24,17 @@ std::set<ContactKey> keysOf(const std::vector<Contact>& contacts) {
 }
 
 // Unit spheres scattered in a small box, registered in order; isRigid(i) picks each mode.
+// The face query for every pair (the default would answer rigid-deformable pairs of these
+// equal spheres by the point shell).
+CollisionSettings facesEverywhere() {
+    CollisionSettings settings;
+    settings.rigidDeformable = RigidDeformableQuery::Faces;
+    return settings;
+}
+
 struct Heap {
     std::vector<std::unique_ptr<Part>> parts;
-    CollisionWorld world;
+    CollisionWorld world{facesEverywhere()};
 
     Heap(BodyId count, unsigned seed, bool (*isRigid)(BodyId)) {
         std::mt19937 rng(seed);
@@ -86,7 +94,7 @@ TEST(NarrowPhase, HierarchiesRefitWhenAQueryNeedsThemAndNotWhenRead) {
     Part torus(torusModel);
     Part probe(buildPartModel(makeIcoSphere(3.0, 3)), rigidPart());
     probe.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(12.0, 0.5, 0.0)});
-    CollisionWorld world;
+    CollisionWorld world{facesEverywhere()};
     world.add(0, probe);
     world.add(1, torus);
     for (int i = 0; i < 300; ++i) {

@@ -132,7 +132,7 @@ TEST(SceneFile, UnknownChoiceListsTheOptions) {
 }
 
 TEST(SceneFile, ContactQueryIsAChoice) {
-    EXPECT_EQ(parseScene(kBall, "scene.toml", ".").world.collision.rigidDeformable, RigidDeformableQuery::Faces);  // default
+    EXPECT_EQ(parseScene(kBall, "scene.toml", ".").world.collision.rigidDeformable, RigidDeformableQuery::Auto);  // default
     const std::string text = withLine("duration = 2.5", "rigid_deformable_query = \"point-shell\"");
     EXPECT_EQ(parseScene(text, "scene.toml", ".").world.collision.rigidDeformable, RigidDeformableQuery::PointShell);
     const std::string e = errorOf(withLine("duration = 2.5", "rigid_deformable_query = \"voxels\""));
