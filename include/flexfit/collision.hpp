@@ -19,6 +19,7 @@
 #include "flexfit/names.hpp"
 
 #include <array>
+#include <cmath>
 #include <limits>
 #include <span>
 
@@ -270,19 +271,27 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
 // With B's rest resolution rho (every point of a B triangle lies within rho of one of its
 // corners: rho = longest rest edge / sqrt(3)), a crossing of B's (locally flat) surface that
 // covers a disc of radius rho of it holds a mass, which the point shell finds. A vertex v of
-// the rigid part is smooth at scale rho when, with n its normal, its faces lie within `angle`
-// of n (the pressing direction, in v's normal cone, is then close to n), the faces within
-// twice that disc's radius of v turn less than 60 degrees from n (a height field over n's
-// plane, covering the disc of radius rho / cos(angle) around v), and the surface over it lies at most
-// rho tan(angle) behind v along n. Then if v were the deepest point of a crossing deeper than
-// that, the crossing would cover the disc: smooth surface hides at most rho tan(angle) past
-// B's (0.21 of B's longest rest edge at the default 20 degrees; a sphere of radius R hides
-// about rho^2 / 2R, and spheres of radius >= 2.2 rho are smooth). Every other vertex is sharp, and
-// the faces around sharp vertices are the sharp faces. Known limits: heights are taken along
-// n, not the pressing direction (they differ by at most `angle`); B's triangles stretched
-// beyond their rest length widen the gaps by as much; a neighbourhood of more than 512
-// vertices counts as sharp (a rigid part far finer than B), which keeps the bound at a cost.
+// the rigid part, with normal n, is smooth at scale rho when its faces lie within `angle`
+// (theta) of n (the pressing direction, in v's normal cone, is then within theta of n), and the
+// faces over the disc of radius R = rho cos(theta) / cos(2 theta) around v in n's plane
+// (connected to v through such faces) turn less than 60 degrees from n (a height field) and lie
+// at most rho tan(theta) behind v along n. Were v the deepest point of a crossing deeper than
+// rho (tan(theta) + tan(2 theta) / 2), the crossing would cover a disc of radius rho of B's
+// surface (sharp_features.cpp gives the steps): smooth surface hides at most that much past
+// B's (0.78 rho, 0.45 of B's longest rest edge, at the default 20 degrees; a sphere of radius R
+// hides about rho^2 / 2R; a true sphere is smooth from a radius of 2.25 rho, finely faceted
+// ones from 2.5 rho, level-2 icospheres from 2.8 rho). Every other vertex is
+// sharp, and the faces around sharp vertices are the sharp faces. Known limits: B's triangles
+// stretched beyond their rest length widen the gaps by as much; a disc over more than 512
+// vertices counts as sharp (a rigid part far finer than B), which keeps the bound at a
+// cost; the bound assumes B locally flat over the disc.
 inline constexpr double kSharpFeatureAngle = 0.3490658503988659;  // 20 degrees
+
+// How deep smooth surface can cross B's unseen at B's rest resolution `radius`: the bound
+// above, radius (tan(angle) + tan(2 angle) / 2).
+inline double sharpFeatureBound(double radius, double angle = kSharpFeatureAngle) {
+    return radius * (std::tan(angle) + 0.5 * std::tan(2.0 * angle));
+}
 
 struct SharpFeatures {
     std::vector<Index> faces;  // ascending faces of the rigid part
@@ -292,8 +301,8 @@ struct SharpFeatures {
     bool empty() const { return faces.empty(); }
 };
 
-// The sharp faces of `rigid` (its rest mesh) at scale `radius` (>= 0, finite), with leaves
-// for the exact test the queries will use.
+// The sharp faces of `rigid` (its rest mesh) at scale `radius` (>= 0, finite; `angle` in
+// (0, pi/4)), with leaves for the exact test the queries will use.
 SharpFeatures findSharpFeatures(const Part& rigid, double radius, ExactTest test = ExactTest::TriangleTriangle,
                                 double angle = kSharpFeatureAngle);
 

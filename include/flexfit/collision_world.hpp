@@ -52,8 +52,9 @@ template <> inline constexpr std::span<const EnumName<BroadPhaseUpdate>> kEnumNa
 // 7,300-mass rim at haptic rates. The rigid part's sharp faces at the deformable part's scale
 // are tested as faces too (querySharpFeatures), so no edge or corner slips between masses.
 // Auto: the point shell for a pair whose rigid part is closed and whose deformable part is the
-// finer (mean rest edge no longer than the rigid part's), the face query otherwise; fields are
-// built only for rigid parts some deformable part is finer than.
+// finer (mean rest edge strictly shorter than the rigid part's), the face query otherwise;
+// fields are built only for rigid parts some deformable part is finer than, and a rigid part's
+// sharp features are found at the scale of the coarsest deformable part its point shell serves.
 enum class RigidDeformableQuery { Faces, PointShell, Auto };
 // Its names (names.hpp).
 inline constexpr EnumName<RigidDeformableQuery> kRigidDeformableQueryNames[] = {
@@ -130,6 +131,9 @@ public:
 
 private:
     bool pressesFirst(BodyId a, BodyId b) const;
+    // Whether the settings let the point shell answer a rigid part against a deformable part,
+    // given their mean rest edges (Auto: the deformable part strictly finer).
+    bool pointShellServes(std::size_t rigid, std::size_t deformable, std::span<const double> meanEdge) const;
     // Whether the pair (a presses b) is answered by the point shell.
     bool usesPointShell(BodyId a, BodyId b) const;
     // The point shell's contacts of the pair (a rigid with a field, b deforming), with those of
@@ -148,9 +152,9 @@ private:
     std::vector<std::shared_ptr<const SignedDistanceField>> fields_;  // (nbody) rigid closed parts the point shell may serve; else null
     std::vector<std::shared_ptr<const SharpFeatures>> features_;      // (nbody) beside each field, at featureRadius_
     std::vector<double> meanEdge_;                                    // (nbody) mean rest edge length
-    std::vector<bool> fieldTried_;                                    // (nbody) a field was built, or the mesh has no inside
-    double featureRadius_ = 0.0;  // the largest rest resolution of the deformable parts
-    double finestDeformableEdge_ = std::numeric_limits<double>::infinity();  // their smallest mean rest edge
+    std::vector<double> restResolution_;  // (nbody) of deformable parts the point shell may serve (restResolution), else 0
+    std::vector<double> featureRadius_;   // (nbody) of rigid parts: the largest rest resolution of the parts their point shell serves
+    std::vector<bool> fieldTried_;        // (nbody) a field was built, or the mesh has no inside
     std::vector<Sphere> partSpheres_;                                 // (nbody) world frame
     Bvh<Sphere> broadPhase_;
     std::vector<std::pair<BodyId, BodyId>> pairs_;

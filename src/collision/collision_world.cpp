@@ -45,35 +45,48 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     // rather than at the first contact, where they would stall a haptic loop.
     PartCollider collider(part, kind, settings_.exactTest);
     const RigidDeformableQuery query = settings_.rigidDeformable;
-    const double edge = meanRestEdge(part);
-    // Which rigid parts (this one included, as index parts_.size()) may meet the point shell.
-    const std::size_t n = parts_.size() + 1;
-    std::vector<std::shared_ptr<const SignedDistanceField>> fields = fields_;
-    std::vector<bool> tried = fieldTried_;
-    std::vector<double> meanEdge = meanEdge_;
-    fields.push_back(nullptr);
-    tried.push_back(false);
-    meanEdge.push_back(edge);
+    const bool shellable = query != RigidDeformableQuery::Faces && part.deforms();
+    if (shellable) collider.buildRestPointTree(part);
+    // The registry with this part in it (index self), in copies until nothing can throw.
+    const std::size_t self = parts_.size(), n = self + 1;
     std::vector<const Part*> parts = parts_;
     parts.push_back(&part);
-    double radius = featureRadius_, finestEdge = finestDeformableEdge_;
-    if (query != RigidDeformableQuery::Faces && part.deforms()) {
-        collider.buildRestPointTree(part);
-        radius = std::max(radius, restResolution(part));
-        finestEdge = std::min(finestEdge, edge);
+    std::vector<double> meanEdge = meanEdge_, resolution = restResolution_, radius = featureRadius_;
+    meanEdge.push_back(meanRestEdge(part));
+    resolution.push_back(shellable ? restResolution(part) : 0.0);
+    radius.push_back(0.0);
+    // A rigid part's features are found at the scale of the coarsest deformable part its point
+    // shell may serve: the new part's, where it deforms; all of those it may serve, where it is
+    // the rigid one.
+    auto serves = [&](std::size_t r, std::size_t b) {
+        return !parts[r]->deforms() && parts[b]->deforms() && pointShellServes(r, b, meanEdge);
+    };
+    std::vector<bool> servesNew(n, false);  // rigid parts the new part makes the point shell serve
+    for (std::size_t r = 0; r < self; ++r) {
+        if (serves(r, self)) {
+            servesNew[r] = true;
+            radius[r] = std::max(radius[r], resolution[self]);
+        }
+        if (serves(self, r)) {
+            servesNew[self] = true;
+            radius[self] = std::max(radius[self], resolution[r]);
+        }
     }
+    // Fields for the rigid parts the point shell may serve (under PointShell all of them).
+    std::vector<std::shared_ptr<const SignedDistanceField>> fields = fields_;
+    std::vector<bool> tried = fieldTried_;
+    fields.push_back(nullptr);
+    tried.push_back(false);
     for (std::size_t r = 0; r < n && query != RigidDeformableQuery::Faces; ++r) {
-        if (parts[r]->deforms() || tried[r]) continue;
-        if (query == RigidDeformableQuery::Auto && !(finestEdge < meanEdge[r])) continue;  // no deformable part is finer
+        if (parts[r]->deforms() || tried[r] || (query == RigidDeformableQuery::Auto && !servesNew[r])) continue;
         fields[r] = buildDistanceField(*parts[r]);
         tried[r] = true;
     }
-    // Sharp features beside every field, at the coarsest deformable part's scale.
     std::vector<std::shared_ptr<const SharpFeatures>> features = features_;
     features.push_back(nullptr);
     for (std::size_t r = 0; r < n; ++r)
-        if (fields[r] && (!features[r] || features[r]->radius != radius))
-            features[r] = std::make_shared<const SharpFeatures>(findSharpFeatures(*parts[r], radius, settings_.exactTest));
+        if (fields[r] && (!features[r] || features[r]->radius != radius[r]))
+            features[r] = std::make_shared<const SharpFeatures>(findSharpFeatures(*parts[r], radius[r], settings_.exactTest));
     std::vector<Sphere> spheres = partSpheres_;
     spheres.push_back(collider.worldSphere(part));
     Bvh<Sphere> tree;
@@ -86,9 +99,9 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     fields_ = std::move(fields);
     features_ = std::move(features);
     meanEdge_ = std::move(meanEdge);
+    restResolution_ = std::move(resolution);
+    featureRadius_ = std::move(radius);
     fieldTried_ = std::move(tried);
-    featureRadius_ = radius;
-    finestDeformableEdge_ = finestEdge;
     partSpheres_ = std::move(spheres);
     broadPhase_ = std::move(tree);
 }
@@ -101,7 +114,7 @@ void CollisionWorld::setExactTest(ExactTest test) {
         PartCollider rebuilt(*parts_[i], colliders_[i].kind(), test);
         if (!colliders_[i].restPointTree().empty()) rebuilt.buildRestPointTree(*parts_[i]);
         colliders.push_back(std::move(rebuilt));
-        if (features_[i]) features[i] = std::make_shared<const SharpFeatures>(findSharpFeatures(*parts_[i], featureRadius_, test));
+        if (features_[i]) features[i] = std::make_shared<const SharpFeatures>(findSharpFeatures(*parts_[i], features_[i]->radius, test));
     }
     settings_.exactTest = test;
     colliders_ = std::move(colliders);
@@ -114,9 +127,17 @@ bool CollisionWorld::pressesFirst(BodyId a, BodyId b) const {
     return da == db ? a < b : !da;
 }
 
+bool CollisionWorld::pointShellServes(std::size_t rigid, std::size_t deformable, std::span<const double> meanEdge) const {
+    switch (settings_.rigidDeformable) {
+        case RigidDeformableQuery::Faces: return false;
+        case RigidDeformableQuery::PointShell: return true;
+        case RigidDeformableQuery::Auto: return meanEdge[deformable] < meanEdge[rigid];
+    }
+    return false;
+}
+
 bool CollisionWorld::usesPointShell(BodyId a, BodyId b) const {
-    if (!fields_[a] || !parts_[b]->deforms()) return false;
-    return settings_.rigidDeformable == RigidDeformableQuery::PointShell || meanEdge_[b] < meanEdge_[a];
+    return fields_[a] && parts_[b]->deforms() && pointShellServes(a, b, meanEdge_);
 }
 
 }  // namespace flexfit

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace flexfit {
@@ -32,18 +33,22 @@ Vec3 vertexNormal(const TriMesh& mesh, const Topology& topology, Index v) {
     return sum.normalized();
 }
 
-// Whether A's surface near vertex v could cross a plane (B's surface) by more than
-// `tolerance` while covering no disc of radius `radius` of it. v would be the deepest point, so
-// the pressing direction lies in v's normal cone: v's faces must lie within `angle` of its
-// normal n, or v is sharp. Around v, the faces within twice the disc's radius (reached over
-// edges) must turn less than 60 degrees from n, so the surface is a height field over n's plane
-// there, covering the disc of radius radius / cos(angle) (the disc of B's plane seen along n). The height of a
-// surface point behind v, along n, over that disc must stay within `tolerance`: a crossing
-// deeper than that covers the disc, which holds a mass. Otherwise v is sharp.
+// Whether A's surface near vertex v could cross a plane (B's surface) deeper than the bound
+// of collision.hpp while covering no disc of radius rho (`radius`) of it. v would be the
+// deepest point along the pressing direction d, so d lies in v's normal cone: v's faces must
+// lie within `angle` (theta) of its normal n, which keeps d within theta of n, or v is sharp.
+// The faces over the disc of radius R = rho cos(theta) / cos(2 theta) around v in n's plane,
+// connected to v through such faces, must turn less than 60 degrees from n (a height field over
+// the disc) and lie at most rho tan(theta) behind v along n there; otherwise v is sharp. Then a surface point
+// over that disc lies at most rho tan(theta) + R sin(theta) behind v along d: a crossing deeper
+// than that is crossing all over it. Seen along d, the patch's rim lies at least
+// R cos(theta) - R tan(theta) sin(theta) = rho from v (its height in front of v is at most
+// R tan(theta), or v would not be deepest), so the patch covers the disc of radius rho of B's
+// plane, which holds a mass.
 class SharpnessProbe {
 public:
     SharpnessProbe(const TriMesh& mesh, const Topology& topology, const std::vector<Vec3>& normals, double radius, double angle)
-        : mesh_(mesh), topology_(topology), normals_(normals), disc_(radius / std::cos(angle)), reach2_(4.0 * disc_ * disc_),
+        : mesh_(mesh), topology_(topology), normals_(normals), disc_(radius * std::cos(angle) / std::cos(2.0 * angle)),
           tolerance_(radius * std::tan(angle)), cosAngle_(std::cos(angle)), seen_(mesh.vertices.size(), kNoMass) {}
 
     bool sharp(Index v) {
@@ -56,24 +61,34 @@ public:
         for (std::size_t k = 0; k < queue_.size(); ++k) {
             const Index u = queue_[k];
             for (Index f : topology_.facesOf(u)) {
+                const std::optional<double> height = heightOverDisc(v, n, mesh_.faces[f]);
+                if (!height) continue;
                 if (!(normals_[f].dot(n) >= 0.5)) return true;  // steeper than 60 degrees: no height field
-                if (heightOverDisc(v, n, mesh_.faces[f]) > tolerance_) return true;
-            }
-            for (Index w : topology_.neighborsOf(u)) {
-                if (seen_[w] == v || (mesh_.vertices[w] - mesh_.vertices[v]).squaredNorm() > reach2_) continue;
-                if (queue_.size() == kMaxNeighbourhood) return true;  // far finer than the scale: counted sharp
-                seen_[w] = v;
-                queue_.push_back(w);
+                if (*height > tolerance_) return true;
+                // A face over the disc leads on to its corners, however far they are (a long
+                // thin face can cross the disc with every corner far outside it).
+                for (Index w : mesh_.faces[f])
+                    if (!visit(v, w)) return true;
             }
         }
         return false;
     }
 
 private:
+    // Queues w for v's probe unless it was already; false when the neighbourhood outgrows the
+    // cap (far finer than the scale: counted sharp).
+    bool visit(Index v, Index w) {
+        if (seen_[w] == v) return true;
+        if (queue_.size() == kMaxNeighbourhood) return false;
+        seen_[w] = v;
+        queue_.push_back(w);
+        return true;
+    }
+
     // How far behind v (along n) the face reaches over the disc around v in n's plane: at most
     // its deepest corner, and at most its plane's height at v plus its slope times the disc's
-    // radius. 0 for a face whose projection misses the disc.
-    double heightOverDisc(Index v, const Vec3& n, const Face& face) const {
+    // radius. Nothing for a face whose projection misses the disc.
+    std::optional<double> heightOverDisc(Index v, const Vec3& n, const Face& face) const {
         std::array<Vec3, 3> lateral;
         std::array<double, 3> height;
         for (int i = 0; i < 3; ++i) {
@@ -82,7 +97,7 @@ private:
             lateral[i] = d + height[i] * n;
         }
         const Vec3 closest = closestPointOnTriangle(Vec3::Zero(), {lateral[0], lateral[1], lateral[2]});
-        if (closest.norm() > disc_) return 0.0;
+        if (closest.norm() > disc_) return std::nullopt;
         double bound = std::max({height[0], height[1], height[2]});
         // The plane's height as a linear function of the lateral position.
         const Vec3 e1 = lateral[1] - lateral[0], e2 = lateral[2] - lateral[0];
@@ -101,7 +116,7 @@ private:
     const TriMesh& mesh_;
     const Topology& topology_;
     const std::vector<Vec3>& normals_;
-    double disc_, reach2_, tolerance_, cosAngle_;
+    double disc_, tolerance_, cosAngle_;
     std::vector<Index> seen_;  // the vertex whose probe last reached each
     std::vector<Index> queue_;
 };
@@ -109,8 +124,8 @@ private:
 }  // namespace
 
 SharpFeatures findSharpFeatures(const Part& rigid, double radius, ExactTest test, double angle) {
-    if (!(radius >= 0.0) || !std::isfinite(radius) || !(angle > 0.0) || !(angle < M_PI))
-        throw std::invalid_argument("findSharpFeatures: radius must be finite and >= 0, angle in (0, pi)");
+    if (!(radius >= 0.0) || !std::isfinite(radius) || !(angle > 0.0) || !(angle < M_PI / 4.0))
+        throw std::invalid_argument("findSharpFeatures: radius must be finite and >= 0, angle in (0, pi/4)");
     const TriMesh& mesh = rigid.model().mesh;
     const Topology& topology = rigid.model().topology;
     const std::vector<Vec3> normals = unitFaceNormals(mesh);

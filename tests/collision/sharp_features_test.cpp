@@ -47,7 +47,7 @@ std::set<std::pair<Index, Index>> pairsOf(const std::vector<Contact>& contacts) 
 
 TEST(SharpFeatures, ABoxIsSharpAtItsEdgesOnly) {
     // A finely divided cube at a scale below its cells: exactly the faces touching a vertex on
-    // one of its edges (two coordinates at +-1) are sharp. At a scale reaching past a cell the
+    // one of its edges (two coordinates at +-1) are sharp. At a scale whose disc reaches past a cell the
     // band widens; at any scale a coarse cube is sharp everywhere.
     Part fine(buildPartModel(makeBox(Vec3(1, 1, 1), 8)), rigidPart());
     auto onEdge = [&](Index v) {
@@ -62,7 +62,7 @@ TEST(SharpFeatures, ABoxIsSharpAtItsEdgesOnly) {
     const SharpFeatures narrow = findSharpFeatures(fine, 0.1);
     EXPECT_EQ(narrow.faces, expected);
     EXPECT_LT(narrow.faces.size(), fine.model().faceCount());
-    const SharpFeatures wide = findSharpFeatures(fine, 0.2);
+    const SharpFeatures wide = findSharpFeatures(fine, 0.25);  // its disc (0.31) reaches past a cell (0.25)
     EXPECT_GT(wide.faces.size(), narrow.faces.size());
     for (Index f : narrow.faces) EXPECT_TRUE(std::binary_search(wide.faces.begin(), wide.faces.end(), f));
 
@@ -71,10 +71,16 @@ TEST(SharpFeatures, ABoxIsSharpAtItsEdgesOnly) {
 }
 
 TEST(SharpFeatures, ASphereIsSmoothWhenLargeAgainstTheScale) {
-    // The bound's sphere: smooth at radius >= 2.2 rho, sharp well below (each face lies within
-    // 20 degrees of its corners' normals, so only the turn within the reach tells).
+    // A true sphere of radius k rho stands within rho tan(theta) behind a point over the disc of
+    // radius rho cos(theta) / cos(2 theta) when k >= 2.25 (theta = 20 degrees): a finely
+    // faceted ball is smooth a little above that and sharp everywhere below it (each face lies
+    // within 20 degrees of its corners' normals, so only the height over the disc tells).
     Part ball(buildPartModel(makeIcoSphere(10.0, 4)), rigidPart());
-    EXPECT_TRUE(findSharpFeatures(ball, 10.0 / 2.5).empty());
+    const double t = std::tan(kSharpFeatureAngle), c = std::cos(kSharpFeatureAngle) / std::cos(2.0 * kSharpFeatureAngle);
+    const double threshold = (c * c + t * t) / (2.0 * t);
+    ASSERT_NEAR(threshold, 2.25, 0.01);
+    EXPECT_TRUE(findSharpFeatures(ball, 10.0 / (1.12 * threshold)).empty());
+    EXPECT_EQ(findSharpFeatures(ball, 10.0 / (0.93 * threshold)).faces.size(), ball.model().faceCount());
     Part coarse(buildPartModel(makeIcoSphere(10.0, 2)), rigidPart());  // 162 vertices: fewer than the probe's cap
     EXPECT_TRUE(findSharpFeatures(coarse, 10.0 / 3.0).empty());  // its facets turn ~10 degrees more
     EXPECT_EQ(findSharpFeatures(coarse, 10.0 / 1.2).faces.size(), coarse.model().faceCount());
@@ -119,9 +125,9 @@ namespace {
 
 // Lowers a rigid part into a coarse slab (top at y = 1, masses 4 apart) at random places,
 // turns and depths, queried by the point shell and the part's sharp faces at the slab's
-// scale. Whenever neither reports a contact, the part (crossing the top) reaches at most rho tan(20 degrees)
-// below the top, plus the field's rounding (sqrt(3) cells). Returns the crossings unseen and
-// seen.
+// scale. Whenever neither reports a contact, the part (crossing the top) reaches at most
+// sharpFeatureBound(rho) below the top, plus the field's rounding (sqrt(3) cells). Returns the
+// crossings unseen and seen.
 std::pair<int, int> lowerIntoSlab(const TriMesh& mesh, int trials, unsigned seed) {
     const auto model = buildPartModel(mesh);
     const SignedDistanceField field(model->mesh, model->topology);
@@ -131,7 +137,7 @@ std::pair<int, int> lowerIntoSlab(const TriMesh& mesh, int trials, unsigned seed
     slabCollider.buildRestPointTree(slab);
     const double rho = restResolution(slab);
     const SharpFeatures features = findSharpFeatures(tool, rho);
-    const double bound = rho * std::tan(kSharpFeatureAngle) + std::sqrt(3.0) * field.cellSize();
+    const double bound = sharpFeatureBound(rho) + std::sqrt(3.0) * field.cellSize();
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> across(-3.0, 3.0), depth(0.0, 2.0), turn(-M_PI, M_PI);
     int unseen = 0, seen = 0;
@@ -166,13 +172,17 @@ std::pair<int, int> lowerIntoSlab(const TriMesh& mesh, int trials, unsigned seed
 TEST(SharpFeatures, NoCrossingDeeperThanTheBoundGoesUnseen) {
     // Smooth balls (no sharp faces at the slab's scale), faceted ones near and below the
     // threshold (some or all faces sharp), a smooth needle (sharp at that scale: it turns
-    // within the reach), a blade and a needle-thin box (all sharp): some
-    // shallow crossings go unseen (the bound is not empty), none deeper than it.
+    // over the disc), a faceted lens whose cap corners are smooth (pressed at random tilts
+    // to their normals), a blade and a needle-thin box (all sharp): some shallow crossings go
+    // unseen (the bound is not empty), none deeper than it.
     int unseen = 0, seen = 0;
     TriMesh needle = makeUvSphere(0.08, 16, 96);  // smooth, 0.16 wide, 2.4 long; its tip turns < 20 degrees a ring
     needle.name = "needle";
     for (Vec3& p : needle.vertices) p.y() *= 15.0;
-    const TriMesh tools[] = {needle, makeIcoSphere(10.0, 4), makeIcoSphere(6.0, 3), makeIcoSphere(4.0, 2), makeIcoSphere(3.0, 1),
+    TriMesh lens = makeIcoSphere(10.0, 2);  // flat faceted caps: corners smooth at the scale, pressed tilted
+    lens.name = "lens";
+    for (Vec3& p : lens.vertices) p.y() *= 0.2;
+    const TriMesh tools[] = {needle, lens, makeIcoSphere(10.0, 4), makeIcoSphere(6.0, 3), makeIcoSphere(4.0, 2), makeIcoSphere(3.0, 1),
                              makeUvSphere(2.0, 12, 6), makeBox(Vec3(1.5, 0.6, 0.02), 1), makeBox(Vec3(2.0, 0.03, 0.03), 4)};
     unsigned seed = 11;
     for (const TriMesh& mesh : tools) {
@@ -186,15 +196,32 @@ TEST(SharpFeatures, NoCrossingDeeperThanTheBoundGoesUnseen) {
     EXPECT_TRUE(findSharpFeatures(smooth, restResolution(Part(buildPartModel(makeBox(Vec3(6.0, 1.0, 6.0), 3))))).empty());
 }
 
+namespace {
+
+// A thin rigid blade standing in a coarse deformable slab, in a collision world under the point
+// shell.
+struct BladeInSlab {
+    Part blade{buildPartModel(makeBox(Vec3(1.0, 0.5, 0.01), 1)), rigidPart()};
+    Part slab{buildPartModel(makeBox(Vec3(3.0, 0.5, 3.0), 1))};
+    CollisionWorld world{[] {
+        CollisionSettings settings;
+        settings.rigidDeformable = RigidDeformableQuery::PointShell;
+        return settings;
+    }()};
+    BladeInSlab() {
+        blade.setPose(at(Vec3(0.2, 0.7, 0.1)));
+        world.add(0, blade);
+        world.add(1, slab);
+    }
+};
+
+}  // namespace
+
 TEST(SharpFeatures, TheCollisionWorldFindsTheBladeUnderThePointShell) {
-    CollisionSettings settings;
-    settings.rigidDeformable = RigidDeformableQuery::PointShell;
-    Part blade(buildPartModel(makeBox(Vec3(1.0, 0.5, 0.01), 1)), rigidPart());
-    Part slab(buildPartModel(makeBox(Vec3(3.0, 0.5, 3.0), 1)));
-    blade.setPose(at(Vec3(0.2, 0.7, 0.1)));
-    CollisionWorld world(settings);
-    world.add(0, blade);
-    world.add(1, slab);
+    BladeInSlab scene;
+    Part& blade = scene.blade;
+    const Part& slab = scene.slab;
+    CollisionWorld& world = scene.world;
     const std::vector<Contact> contacts = world.findContacts();
     ASSERT_FALSE(contacts.empty());
     for (const Contact& c : contacts) EXPECT_EQ(c.massB, kNoMass);  // through the blade's faces
@@ -229,4 +256,108 @@ TEST(SharpFeatures, AutoChoosesThePointShellWhereTheDeformablePartIsFiner) {
     ASSERT_FALSE(fineBall.empty());
     for (const Contact& c : fineBall) EXPECT_EQ(c.massB, kNoMass);
     EXPECT_EQ(pairsOf(fineBall), pairsOf(contactsWith(RigidDeformableQuery::Faces, 3.0, 4, makeTorus1())));
+}
+
+TEST(SharpFeatures, AFaceOverTheDiscLeadsOnToItsFarCorners) {
+    // A small flat fan around v, then one long flat face (v's neighbour h to two corners 3 away)
+    // and, hanging from that face's far edge 0.72 from v, a vertical wall: a fold within the
+    // disc that only the long face's far corners lead to. The fan's faces are sharp.
+    TriMesh mesh;
+    mesh.name = "fan and wall";
+    mesh.vertices.push_back(Vec3::Zero());  // v
+    for (int k = 0; k < 6; ++k) {
+        const double a = (30.0 + 60.0 * k) * M_PI / 180.0;
+        mesh.vertices.push_back(Vec3(0.05 * std::cos(a), 0.0, 0.05 * std::sin(a)));
+    }
+    for (Index k = 0; k < 6; ++k) mesh.faces.push_back({0, 1 + (k + 1) % 6, 1 + k});  // normal +y
+    const Index h = 2;                                                                  // at 90 degrees: (0, 0, 0.05)
+    const Index a = Index(mesh.vertices.size()), b = a + 1, c = a + 2;
+    mesh.vertices.push_back(Vec3(-3.0, 0.0, 0.72));
+    mesh.vertices.push_back(Vec3(3.0, 0.0, 0.72));
+    mesh.vertices.push_back(Vec3(0.0, -1.5, 0.74));
+    mesh.faces.push_back({h, a, b});
+    mesh.faces.push_back({a, c, b});
+    Part part(buildPartModel(mesh), rigidPart());
+    const double rho = 0.6;  // disc radius 0.74: the wall's corners lie far outside it
+    ASSERT_GT((mesh.vertices[a] - mesh.vertices[0]).norm(), 4.0 * rho);
+    const SharpFeatures features = findSharpFeatures(part, rho);
+    for (Index f = 0; f < 6; ++f) EXPECT_TRUE(std::binary_search(features.faces.begin(), features.faces.end(), f)) << "fan face " << f;
+    // Without the wall the same fan is smooth.
+    mesh.faces.pop_back();
+    mesh.vertices.pop_back();
+    const SharpFeatures flat = findSharpFeatures(Part(buildPartModel(mesh), rigidPart()), rho);
+    for (Index f = 0; f < 6; ++f) EXPECT_FALSE(std::binary_search(flat.faces.begin(), flat.faces.end(), f)) << "fan face " << f;
+}
+
+namespace {
+
+// The contacts of a ball (rigid, level-2, radius 6) on torus2 (deformable, finer) under Auto,
+// with the parts added in `order`, and optionally a coarse deformable slab far away.
+std::vector<Contact> ballOnTorus2(bool torusFirst, bool withCoarseSlab) {
+    CollisionSettings settings;
+    Part ball(buildPartModel(makeIcoSphere(6.0, 2)), rigidPart());
+    ball.setPose(at(Vec3(12.0, 8.0, 0.0)));
+    Part torus(buildPartModel(makeTorus2()));
+    Part slab(buildPartModel(makeBox(Vec3(8.0, 1.0, 8.0), 1)));  // mean edge above the ball's
+    slab.setPose(at(Vec3(0.0, -50.0, 0.0)));
+    CollisionWorld world(settings);
+    BodyId next = 0;
+    if (torusFirst) world.add(next++, torus);
+    world.add(next++, ball);
+    if (!torusFirst) world.add(next++, torus);
+    if (withCoarseSlab) world.add(next++, slab);
+    std::vector<Contact> contacts = world.findContacts();
+    for (Contact& c : contacts) c.partA = c.partB = 0;  // the ids differ with the order
+    return contacts;
+}
+
+}  // namespace
+
+TEST(SharpFeatures, AutoChoosesWhicheverPartComesFirst) {
+    // The torus added before the ball gets the same point-shell contacts as after it.
+    const std::vector<Contact> after = ballOnTorus2(false, false);
+    ASSERT_FALSE(after.empty());
+    for (const Contact& c : after) EXPECT_NE(c.massB, kNoMass);
+    const std::vector<Contact> before = ballOnTorus2(true, false);
+    ASSERT_EQ(before.size(), after.size());
+    for (std::size_t i = 0; i < after.size(); ++i) {
+        EXPECT_EQ(before[i].massB, after[i].massB);
+        EXPECT_EQ(before[i].depth, after[i].depth);
+    }
+}
+
+TEST(SharpFeatures, ACoarserDeformablePartLeavesTheBallsScaleAlone) {
+    // A slab coarser than the ball is served by faces, so the ball's features stay at the
+    // torus's scale (none): its contacts with the torus are still the point shell's alone. At
+    // the slab's scale the ball would be sharp all over.
+    Part slab(buildPartModel(makeBox(Vec3(8.0, 1.0, 8.0), 1)));
+    Part ball(buildPartModel(makeIcoSphere(6.0, 2)), rigidPart());
+    ASSERT_EQ(findSharpFeatures(ball, restResolution(slab)).faces.size(), ball.model().faceCount());
+    const std::vector<Contact> alone = ballOnTorus2(false, false), withSlab = ballOnTorus2(false, true);
+    ASSERT_EQ(withSlab.size(), alone.size());
+    for (std::size_t i = 0; i < alone.size(); ++i) {
+        EXPECT_NE(withSlab[i].massB, kNoMass);
+        EXPECT_EQ(withSlab[i].massB, alone[i].massB);
+        EXPECT_EQ(withSlab[i].depth, alone[i].depth);
+    }
+}
+
+TEST(SharpFeatures, ChangingTheExactTestKeepsTheSharpFaces) {
+    // The blade under the point shell: switched to sphere-triangle its faces still meet the
+    // slab (through the face spheres, a superset of the triangles' pairs), and switched back
+    // the contacts are those of the start.
+    BladeInSlab scene;
+    CollisionWorld& world = scene.world;
+    const std::vector<Contact> start = world.findContacts();
+    ASSERT_FALSE(start.empty());
+    world.setExactTest(ExactTest::SphereTriangle);
+    const std::vector<Contact> spheres = world.findContacts();
+    const auto spherePairs = pairsOf(spheres);
+    for (const Contact& c : spheres) EXPECT_EQ(c.massB, kNoMass);
+    for (const auto& pair : pairsOf(start)) EXPECT_TRUE(spherePairs.count(pair)) << pair.first << "," << pair.second;
+    world.setExactTest(ExactTest::TriangleTriangle);
+    const std::vector<Contact> back = world.findContacts();
+    EXPECT_EQ(pairsOf(back), pairsOf(start));
+    ASSERT_EQ(back.size(), start.size());
+    for (std::size_t i = 0; i < back.size(); ++i) EXPECT_EQ(back[i].depth, start[i].depth);
 }
