@@ -3,15 +3,17 @@
 
 The part is Wuson (Debian's assimp-testmodels, a third-party mesh of 3,732 faces, open, 51
 pieces), its vertices shuffled (seeded), at 1x, 4x and 16x its faces (midpoint subdivision). A
-kinematic level-3 icosphere of radius 4 % of the part's box diagonal comes down onto its
+kinematic level-3 icosphere of radius 10 % of the part's box diagonal comes down onto its
 highest vertex, presses 20 % of its radius in, and slides along it while the part deforms
-(face query, rigid-deformable part). For each binary and size: the in-contact steps' mean
+(rigid-deformable part, face query: `rigid_deformable_query = "faces"`). For each binary and size: the in-contact steps' mean
 narrow phase and World::step, and the step's p50 / p99 (nearest rank), from metrics.csv. Runs
 alternate between binaries, `--rounds` times; the medians are reported.
 
   tools/tool_press.py --flexfit new=build/release/apps/flexfit/flexfit \
       --flexfit old=/tmp/base/build/apps/flexfit/flexfit --csv bench/results/tool_press.csv
-A path ending in "+plain" runs that binary with coherent_collision = false.
+A path ending in "+plain" runs that binary with coherent_collision = false; "+auto" with
+rigid_deformable_query = "auto" (the point shell where the part is finer than the tool; the
+contacts are then masses, not face pairs). Suffixes combine.
 """
 import argparse
 import csv
@@ -81,6 +83,7 @@ def write_obj(path, vertices, faces):
 
 
 SCENE = """[world]
+rigid_deformable_query = "{query}"
 time_step = 0.001
 gravity = [0, 0, 0]
 duration = 2.0
@@ -136,7 +139,7 @@ def scenes(directory):
         write_obj(path, v, f)
         scene = os.path.join(directory, f"tool_press_x{4 ** level}.toml")
         with open(scene, "w") as s:
-            s.write(SCENE.format(mesh=path, radius=radius, x=top[0], z=top[2], y_start=top[1] + 1.3 * radius,
+            s.write(SCENE.format(query="faces", mesh=path, radius=radius, x=top[0], z=top[2], y_start=top[1] + 1.3 * radius,
                                  y_press=top[1] + 0.8 * radius, z_end=top[2] + 2.0 * radius))
         out.append((4 ** level, len(f), scene))
         vertices, faces = subdivide(vertices, faces)
@@ -148,15 +151,24 @@ def percentile(values, p):
     return values[min(len(values), max(1, math.ceil(p / 100 * len(values)))) - 1]
 
 
+# A binary path's suffixes, each rewriting the scene for that run.
+VARIANTS = {
+    "+plain": ("[world]\n", "[world]\ncoherent_collision = false\n"),
+    "+auto": ('rigid_deformable_query = "faces"', 'rigid_deformable_query = "auto"'),
+}
+
+
 def measure(flexfit, scene, directory):
     out = os.path.join(directory, "run")
-    if flexfit.endswith("+plain"):  # this binary with coherent_collision = false
-        flexfit = flexfit[: -len("+plain")]
-        with open(scene) as f:
-            text = f.read().replace("[world]\n", "[world]\ncoherent_collision = false\n", 1)
-        scene = os.path.join(directory, "plain.toml")
-        with open(scene, "w") as f:
-            f.write(text)
+    with open(scene) as f:
+        text = f.read()
+    while any(flexfit.endswith(suffix) for suffix in VARIANTS):
+        suffix = next(s for s in VARIANTS if flexfit.endswith(s))
+        flexfit = flexfit[: -len(suffix)]
+        text = text.replace(*VARIANTS[suffix], 1)
+    scene = os.path.join(directory, "variant.toml")
+    with open(scene, "w") as f:
+        f.write(text)
     subprocess.run([flexfit, "run", scene, "--out", out, "--no-progress"], check=True, stdout=subprocess.DEVNULL)
     with open(os.path.join(out, "metrics.csv")) as f:
         rows = [r for r in csv.DictReader(f) if float(r["contacts"]) > 0]
