@@ -39,9 +39,9 @@ Vec3 vertexNormal(const TriMesh& mesh, const Topology& topology, Index v) {
 // lie within `angle` (theta) of its normal n, which keeps d within theta of n, or v is sharp.
 // The faces over the disc of radius R = rho cos(theta) / cos(2 theta) around v in n's plane,
 // connected to v through such faces, must turn less than 60 degrees from n (a height field over
-// the disc) and lie at most rho tan(theta) behind v along n there; otherwise v is sharp. Then a surface point
-// over that disc lies at most rho tan(theta) + R sin(theta) behind v along d: a crossing deeper
-// than that is crossing all over it. Seen along d, the patch's rim lies at least
+// the disc) and lie at most rho tan(theta) behind v along n there; otherwise v is sharp. Then
+// a surface point over that disc lies at most rho tan(theta) + R sin(theta) behind v along d:
+// a crossing deeper than that is crossing all over it. Seen along d, the patch's rim lies at least
 // R cos(theta) - R tan(theta) sin(theta) = rho from v (its height in front of v is at most
 // R tan(theta), or v would not be deepest), so the patch covers the disc of radius rho of B's
 // plane, which holds a mass.
