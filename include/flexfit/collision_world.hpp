@@ -125,7 +125,8 @@ public:
     // part's changed masses: those parts' lists can be cleared (Part::clearChangedMasses).
     std::span<const BodyId> refittedBodies() const { return refitted_.members(); }
     // Face queries answered so far, and how many of them needed a traversal (coherent
-    // queries reuse the pair's candidates otherwise).
+    // queries reuse the pair's candidates otherwise). A point-shell pair's sharp faces count
+    // as one face query, always traversed.
     std::uint64_t faceQueries() const { return faceQueries_; }
     std::uint64_t faceTraversals() const { return faceTraversals_; }
 

@@ -75,9 +75,11 @@ void CollisionWorld::queryPointShellPair(BodyId a, BodyId b, std::vector<Contact
         queryPointShellCoherent(a, *parts_[a], field, b, *parts_[b], colliders_[b].restPointTree(), colliders_[b].localSphere(),
                                 kept.pointShell, out, stats);
     }
-    // The sharp faces, against B's faces as they are now.
+    // The sharp faces, against B's faces as they are now: a face query, traversed every time.
     if (features_[a]->empty()) return;
     refitChanged(b);
+    ++faceQueries_;
+    ++faceTraversals_;
     querySharpFeatures(a, *parts_[a], colliders_[a], *features_[a], b, *parts_[b], colliders_[b], settings_.exactTest, out, stats);
 }
 

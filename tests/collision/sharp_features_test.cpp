@@ -231,6 +231,12 @@ TEST(SharpFeatures, TheCollisionWorldFindsTheBladeUnderThePointShell) {
         return f;
     }();
     EXPECT_EQ(pairsOf(contacts), bruteForcePairs(blade, all, slab));
+    // The sharp faces' query is counted as a face query, traversed each time.
+    EXPECT_EQ(world.faceQueries(), 1u);
+    EXPECT_EQ(world.faceTraversals(), 1u);
+    world.findContacts();
+    EXPECT_EQ(world.faceQueries(), 2u);
+    EXPECT_EQ(world.faceTraversals(), 2u);
 }
 
 TEST(SharpFeatures, AutoChoosesThePointShellWhereTheDeformablePartIsFiner) {
