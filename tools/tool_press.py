@@ -5,9 +5,10 @@ The part is Wuson (Debian's assimp-testmodels, a third-party mesh of 3,732 faces
 pieces), its vertices shuffled (seeded), at 1x, 4x and 16x its faces (midpoint subdivision). A
 kinematic level-3 icosphere of radius 10 % of the part's box diagonal comes down onto its
 highest vertex, presses 20 % of its radius in, and slides along it while the part deforms
-(rigid-deformable part, face query: `rigid_deformable_query = "faces"`). For each binary and size: the in-contact steps' mean
-narrow phase and World::step, and the step's p50 / p99 (nearest rank), from metrics.csv. Runs
-alternate between binaries, `--rounds` times; the medians are reported.
+(rigid-deformable part, face query: `rigid_deformable_query = "faces"`). For each binary and
+size: the in-contact steps' mean narrow phase and World::step, and the step's p50 / p99
+(nearest rank), from metrics.csv. Runs alternate between binaries, `--rounds` times; the
+medians are reported.
 
   tools/tool_press.py --flexfit new=build/release/apps/flexfit/flexfit \
       --flexfit old=/tmp/base/build/apps/flexfit/flexfit --csv bench/results/tool_press.csv

@@ -30,7 +30,6 @@
 #include "flexfit/distance_field.hpp"
 
 #include <memory>
-#include <limits>
 #include <map>
 
 namespace flexfit {
@@ -151,10 +150,9 @@ private:
     std::vector<const Part*> parts_;                                  // (nbody)
     std::vector<PartCollider> colliders_;                             // (nbody)
     std::vector<std::shared_ptr<const SignedDistanceField>> fields_;  // (nbody) rigid closed parts the point shell may serve; else null
-    std::vector<std::shared_ptr<const SharpFeatures>> features_;      // (nbody) beside each field, at featureRadius_
+    std::vector<std::shared_ptr<const SharpFeatures>> features_;      // (nbody) beside each field, at the scale of the parts it serves
     std::vector<double> meanEdge_;                                    // (nbody) mean rest edge length
     std::vector<double> restResolution_;  // (nbody) of deformable parts the point shell may serve (restResolution), else 0
-    std::vector<double> featureRadius_;   // (nbody) of rigid parts: the largest rest resolution of the parts their point shell serves
     std::vector<bool> fieldTried_;        // (nbody) a field was built, or the mesh has no inside
     std::vector<Sphere> partSpheres_;                                 // (nbody) world frame
     Bvh<Sphere> broadPhase_;

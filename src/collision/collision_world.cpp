@@ -51,13 +51,14 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     const std::size_t self = parts_.size(), n = self + 1;
     std::vector<const Part*> parts = parts_;
     parts.push_back(&part);
-    std::vector<double> meanEdge = meanEdge_, resolution = restResolution_, radius = featureRadius_;
+    std::vector<double> meanEdge = meanEdge_, resolution = restResolution_;
     meanEdge.push_back(meanRestEdge(part));
     resolution.push_back(shellable ? restResolution(part) : 0.0);
-    radius.push_back(0.0);
     // A rigid part's features are found at the scale of the coarsest deformable part its point
-    // shell may serve: the new part's, where it deforms; all of those it may serve, where it is
-    // the rigid one.
+    // shell may serve: the scale they have, grown to the new part's where it deforms; all of
+    // those it may serve, where it is the rigid one.
+    std::vector<double> radius(n, 0.0);
+    for (std::size_t r = 0; r < self; ++r) radius[r] = features_[r] ? features_[r]->radius : 0.0;
     auto serves = [&](std::size_t r, std::size_t b) {
         return !parts[r]->deforms() && parts[b]->deforms() && pointShellServes(r, b, meanEdge);
     };
@@ -100,7 +101,6 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     features_ = std::move(features);
     meanEdge_ = std::move(meanEdge);
     restResolution_ = std::move(resolution);
-    featureRadius_ = std::move(radius);
     fieldTried_ = std::move(tried);
     partSpheres_ = std::move(spheres);
     broadPhase_ = std::move(tree);

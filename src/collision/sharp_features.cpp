@@ -49,7 +49,8 @@ class SharpnessProbe {
 public:
     SharpnessProbe(const TriMesh& mesh, const Topology& topology, const std::vector<Vec3>& normals, double radius, double angle)
         : mesh_(mesh), topology_(topology), normals_(normals), disc_(radius * std::cos(angle) / std::cos(2.0 * angle)),
-          tolerance_(radius * std::tan(angle)), cosAngle_(std::cos(angle)), seen_(mesh.vertices.size(), kNoMass) {}
+          tolerance_(radius * std::tan(angle)), cosAngle_(std::cos(angle)), seen_(mesh.vertices.size(), kNoMass),
+          faceSeen_(mesh.faces.size(), kNoMass) {}
 
     bool sharp(Index v) {
         const Vec3 n = vertexNormal(mesh_, topology_, v);
@@ -61,6 +62,8 @@ public:
         for (std::size_t k = 0; k < queue_.size(); ++k) {
             const Index u = queue_[k];
             for (Index f : topology_.facesOf(u)) {
+                if (faceSeen_[f] == v) continue;  // met through another of its corners
+                faceSeen_[f] = v;
                 const std::optional<double> height = heightOverDisc(v, n, mesh_.faces[f]);
                 if (!height) continue;
                 if (!(normals_[f].dot(n) >= 0.5)) return true;  // steeper than 60 degrees: no height field
@@ -117,7 +120,8 @@ private:
     const Topology& topology_;
     const std::vector<Vec3>& normals_;
     double disc_, tolerance_, cosAngle_;
-    std::vector<Index> seen_;  // the vertex whose probe last reached each
+    std::vector<Index> seen_;      // the vertex whose probe last reached each
+    std::vector<Index> faceSeen_;  // the vertex whose probe last tested each face
     std::vector<Index> queue_;
 };
 
