@@ -12,6 +12,8 @@ namespace flexfit::detail {
 
 // True when every coordinate is finite. No early exit: one vectorised pass over the array.
 bool allFinite(std::span<const Vec3> values);
+// True when every coordinate of the masses' positions, velocities and pending forces is finite.
+bool allFinite(const PartState& state, std::span<const Index> masses);
 
 // "velocity of mass 17 is not finite (nan, nan, nan)" when the mass's position, velocity or
 // pending force (tested in that order) is not finite; nothing when all are.

@@ -36,6 +36,25 @@ TEST(Divergence, AllFiniteFindsABadValueAnywhere) {
     }
 }
 
+TEST(Divergence, AllFiniteOverMassesAgreesWithTheMassByMassTest) {
+    const auto model = buildPartModel(makeTorus1());
+    PartState state = PartState::atRest(*model);
+    const std::vector<Index> listed{3, 17, 40, 41, 200};
+    EXPECT_TRUE(detail::allFinite(state, listed));
+    EXPECT_TRUE(detail::allFinite(state, {}));
+    for (Index m : {Index(17), Index(18)})  // listed, and not
+        for (int what = 0; what < 3; ++what)
+            for (int c = 0; c < 3; ++c)
+                for (double bad : {kInf, -kInf, kNaN, -kNaN}) {
+                    PartState copy = state;
+                    (what == 0 ? copy.positions : what == 1 ? copy.velocities : copy.forces)[m][c] = bad;
+                    bool reference = true;  // the mass-by-mass test over the listed masses
+                    for (Index k : listed) reference = reference && !detail::nonFiniteMass(copy, k);
+                    EXPECT_EQ(detail::allFinite(copy, listed), reference) << m << " " << what << " " << c << " " << bad;
+                    EXPECT_EQ(reference, m != 17);
+                }
+}
+
 TEST(Divergence, NamesTheMassAndWhatOfItIsNotFinite) {
     const auto model = buildPartModel(makeTorus1());
     PartState state = PartState::atRest(*model);
