@@ -73,8 +73,24 @@ ZoneRequest parseZone(const std::string& text, const std::string& option) {
     return {face ? ZoneSeed::face(Index(index)) : ZoneSeed::mass(Index(index)), int(level)};
 }
 
-MeshReadResult loadMesh(const std::filesystem::path& path, double weldTolerance) {
-    MeshReadResult result = readMesh(path, MeshReadOptions{weldTolerance});
+MeshReadOptions MeshOptions::read() const {
+    MeshReadOptions options;
+    if (weldOption != nullptr && weldOption->count() > 0) options.weldTolerance = weld;
+    options.repair = !strict;
+    return options;
+}
+
+void addMeshOptions(CLI::App* cmd, MeshOptions& options, bool weld) {
+    if (weld)
+        options.weldOption = cmd->add_option("--weld", options.weld, "Weld vertices closer than this distance (default: near-duplicates, 1e-6 of the diagonal)")
+                                 ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--strict", options.strict,
+                  "Refuse meshes with geometric defects (degenerate or duplicate faces, near-duplicate or unused vertices, "
+                  "inconsistent windings) instead of repairing them");
+}
+
+MeshReadResult loadMesh(const std::filesystem::path& path, const MeshReadOptions& options) {
+    MeshReadResult result = readMesh(path, options);
     for (const std::string& warning : result.diagnostics.warnings) fmt::print(stderr, "warning: {}: {}\n", path.string(), warning);
     return result;
 }

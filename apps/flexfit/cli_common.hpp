@@ -4,6 +4,8 @@
 
 #include "flexfit/flexfit.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -41,8 +43,18 @@ std::vector<std::string> enumChoices() {
     return allNames<Enum>(true);
 }
 
-// Reads any supported mesh and prints its warnings to stderr.
-MeshReadResult loadMesh(const std::filesystem::path& path, double weldTolerance = 0.0);
+// How a command reads mesh files: --weld TOLERANCE (asked-for welding) and --strict (refuse
+// geometric defects instead of repairing them, mesh_repair.hpp).
+struct MeshOptions {
+    double weld = 0.0;
+    bool strict = false;
+    CLI::Option* weldOption = nullptr;
+    MeshReadOptions read() const;
+};
+void addMeshOptions(CLI::App* cmd, MeshOptions& options, bool weld = true);
+
+// Reads any supported mesh and prints its warnings (repairs first) to stderr.
+MeshReadResult loadMesh(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
 // Writes `text` to `path`; throws InputError when it cannot.
 void writeTextFile(const std::filesystem::path& path, const std::string& text);

@@ -15,6 +15,7 @@ struct CollideOptions {
     std::string bv = "aabb", test = "triangle";
     bool json = false;
     int maxPrint = 20;
+    MeshOptions mesh;
 };
 
 // "x,y,z" translation and optional "ax,ay,az,degrees" rotation (about the origin, then moved).
@@ -37,7 +38,7 @@ void run(const CollideOptions& opt) {
     const ExactTest test = enumOption<ExactTest>(opt.test, "option --test");
     PartSettings rigid;
     rigid.mode = PartMode::Rigid;
-    Part a(buildPartModel(loadMesh(opt.a).mesh), rigid), b(buildPartModel(loadMesh(opt.b).mesh), rigid);
+    Part a(buildPartModel(loadMesh(opt.a, opt.mesh.read()).mesh), rigid), b(buildPartModel(loadMesh(opt.b, opt.mesh.read()).mesh), rigid);
     a.setPose(parsePose(opt.translateA, opt.rotateA, "a"));
     b.setPose(parsePose(opt.translateB, opt.rotateB, "b"));
     const auto buildStart = std::chrono::steady_clock::now();
@@ -85,6 +86,7 @@ void registerCollide(CLI::App& app) {
     auto opt = std::make_shared<CollideOptions>();
     cmd->add_option("a", opt->a, "First mesh (the pressing part: its faces are spheres with --test sphere)")->required();
     cmd->add_option("b", opt->b, "Second mesh")->required();
+    addMeshOptions(cmd, opt->mesh);
     cmd->add_option("--pose-a", opt->translateA, "Translation x,y,z of A")->capture_default_str();
     cmd->add_option("--rotate-a", opt->rotateA, "Rotation of A: axis and degrees ax,ay,az,deg");
     cmd->add_option("--pose-b", opt->translateB, "Translation x,y,z of B")->capture_default_str();

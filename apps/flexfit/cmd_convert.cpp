@@ -7,23 +7,24 @@
 namespace flexfit::cli {
 
 void registerConvert(CLI::App& app) {
-    auto* cmd = app.add_subcommand("convert", "Convert a mesh to .tri or .obj (validated, vertices welded)");
+    auto* cmd = app.add_subcommand("convert", "Convert a mesh to .tri or .obj (validated and repaired, vertices welded)");
     struct Options {
         std::string in, out, name;
-        double weld = 0.0;
+        MeshOptions mesh;
     };
     auto opt = std::make_shared<Options>();
     cmd->add_option("input", opt->in, "Input mesh")->required();
     cmd->add_option("output", opt->out, "Output mesh (.tri or .obj)")->required();
-    cmd->add_option("--weld", opt->weld, "Weld vertices closer than this distance")->check(CLI::NonNegativeNumber);
+    addMeshOptions(cmd, opt->mesh);
     cmd->add_option("--name", opt->name, "Model name to write (default: the input's)");
     cmd->callback([opt] {
-        MeshReadResult read = loadMesh(opt->in, opt->weld);
+        MeshReadResult read = loadMesh(opt->in, opt->mesh.read());
         if (!opt->name.empty()) read.mesh.name = opt->name;
         writeMesh(read.mesh, opt->out);
         fmt::print("{} -> {}: {} vertices, {} faces, {} springs", opt->in, opt->out, read.mesh.vertices.size(),
                    read.mesh.faces.size(), read.diagnostics.edgeCount);
         if (read.weldedVertices > 0) fmt::print(" ({} vertices welded)", read.weldedVertices);
+        if (read.repairs.any()) fmt::print(" (repaired: see the warnings)");
         fmt::print("\n");
     });
 }

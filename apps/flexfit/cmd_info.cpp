@@ -94,14 +94,14 @@ void registerInfo(CLI::App& app) {
     struct Options {
         std::string file;
         bool json = false;
-        double weld = 0.0;
+        MeshOptions mesh;
     };
     auto opt = std::make_shared<Options>();
     cmd->add_option("file", opt->file, "Mesh file (.tri, .obj, .stl, .ply, .off, .gltf, .glb)")->required();
     cmd->add_flag("--json", opt->json, "Print one JSON object");
-    cmd->add_option("--weld", opt->weld, "Weld vertices closer than this distance")->check(CLI::NonNegativeNumber);
+    addMeshOptions(cmd, opt->mesh);
     cmd->callback([opt] {
-        const MeshReadResult read = loadMesh(opt->file, opt->weld);
+        const MeshReadResult read = loadMesh(opt->file, opt->mesh.read());
         const MeshInfo info = describe(read);
         if (opt->json)
             printJson(opt->file, read.mesh.name, info, read.diagnostics.warnings);

@@ -13,14 +13,16 @@ void registerRun(CLI::App& app) {
         std::string scene, out;
         double duration = 0.0;
         bool noProgress = false;
+        bool strict = false;
     };
     auto opt = std::make_shared<Options>();
     cmd->add_option("scene", opt->scene, "Scene file (.toml)")->required();
     cmd->add_option("--duration", opt->duration, "Simulated seconds (default: the scene's [world] duration)")->check(CLI::PositiveNumber);
     cmd->add_option("--out", opt->out, "Directory for metrics.csv, summary.json and OBJ frames");
     cmd->add_flag("--no-progress", opt->noProgress, "No progress bar");
+    cmd->add_flag("--strict", opt->strict, "Refuse mesh files with geometric defects instead of repairing them (every part)");
     cmd->callback([opt] {
-        const Scene scene = loadScene(opt->scene);
+        const Scene scene = loadScene(opt->scene, SceneReadOptions{opt->strict});
         printWarnings(scene);
         RunOptions options;
         if (opt->duration > 0.0) options.duration = opt->duration;

@@ -15,6 +15,7 @@ namespace {
 
 struct SimulateOptions {
     std::string file;
+    MeshOptions mesh;
     SimulationOptions sim;
     std::vector<std::string> forces;
     double forceDuration = 0.5, duration = 10.0;
@@ -62,7 +63,7 @@ private:
 };
 
 void run(const SimulateOptions& opt) {
-    const MeshReadResult read = loadMesh(opt.file);
+    const MeshReadResult read = loadMesh(opt.file, opt.mesh.read());
     PerturbationConfig config;
     config.model = buildPartModel(read.mesh, opt.sim.modelSettings());
     config.part.simulation = opt.sim.simulationSettings(*config.model);
@@ -133,6 +134,7 @@ void registerSimulate(CLI::App& app) {
     auto* cmd = app.add_subcommand("simulate", "Simulate a full-deformable part under point loads");
     auto opt = std::make_shared<SimulateOptions>();
     cmd->add_option("file", opt->file, "Mesh file")->required();
+    addMeshOptions(cmd, opt->mesh);
     cmd->footer("In --mode rigid-deformable, a force on a mass no zone covers opens a zone there at --level; zones retire once\n"
                 "their springs are inactive at the first --threshold and their masses at rest.");
     opt->sim.addTo(*cmd);

@@ -16,6 +16,7 @@
 #include "flexfit/mass_properties.hpp"
 #include "flexfit/mesh.hpp"
 #include "flexfit/mesh_io.hpp"
+#include "flexfit/mesh_repair.hpp"
 #include "flexfit/names.hpp"
 #include "flexfit/part.hpp"
 #include "flexfit/part_model.hpp"

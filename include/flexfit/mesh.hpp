@@ -8,6 +8,7 @@
 
 #include "flexfit/core.hpp"
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,8 @@ MeshDiagnostics validateMesh(const TriMesh& mesh, const std::string& source,
 // of each cluster in input order, so the result is deterministic. Faces that collapse are
 // removed; the count is returned. Used for formats that split vertices per face (STL).
 std::size_t weldVertices(TriMesh& mesh, double tolerance);
+// The vertex each vertex would be welded into (itself when none): always an earlier one.
+std::vector<Index> weldTargets(std::span<const Vec3> vertices, double tolerance);
 
 // Axis-aligned bounds of the vertices.
 Eigen::AlignedBox3d boundingBox(const TriMesh& mesh);

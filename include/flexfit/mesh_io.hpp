@@ -3,36 +3,47 @@
 // `.tri` is the thesis's text format, as SPEC.md defines it: line 1 the model's name; then the
 // vertex count V and the face count F (on one line or two); then V lines `x y z`; then F lines
 // `a b c` of 0-based indices. Blank lines are ignored. Everything else (OBJ, STL, PLY, OFF,
-// glTF/GLB) goes through assimp. Every reader validates before returning: it returns a whole,
-// valid mesh or throws InputError naming the file, the line where there is one, and the
-// problem.
+// glTF/GLB) goes through assimp. Every reader returns a whole, valid mesh or throws InputError
+// naming the file, the line where there is one, and the problem.
+//
+// Corrupt files are errors: counts that do not match, indices out of range, NaN or infinite
+// coordinates, truncation, an empty mesh. Geometric defects a user cannot fix by hand are
+// repaired by default (mesh_repair.hpp: near-duplicate vertices welded, degenerate and duplicate
+// faces dropped, windings made consistent, unreferenced vertices removed), each kind counted
+// in a warning; with `repair = false` they are errors instead, naming the first one's line.
 #pragma once
 
 #include "flexfit/mesh.hpp"
+#include "flexfit/mesh_repair.hpp"
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
 namespace flexfit {
 
 struct MeshReadOptions {
-    // Vertices closer than this are welded (0: only identical positions). Formats that store
-    // one vertex per face corner (STL, and OBJ with split normals) need welding so springs
-    // connect the surface.
-    double weldTolerance = 0.0;
+    // Vertices closer than this are welded, asked for (0: only identical positions). Formats
+    // that store one vertex per face corner (STL, and OBJ with split normals) always weld
+    // identical positions so springs connect the surface. Unset: the repair welds
+    // near-duplicates (nearDuplicateTolerance()); the strict reading refuses them.
+    std::optional<double> weldTolerance;
+    // Repair geometric defects with warnings (true), or refuse them (false: strict).
+    bool repair = true;
 };
 
 struct MeshReadResult {
     TriMesh mesh;
-    MeshDiagnostics diagnostics;
-    std::size_t weldedVertices = 0;  // vertices removed by welding
-    std::size_t collapsedFaces = 0;  // faces removed because welding collapsed them
+    MeshDiagnostics diagnostics;     // its warnings list the repairs first
+    std::size_t weldedVertices = 0;  // vertices removed by the asked-for or the format's welding
+    std::size_t collapsedFaces = 0;  // faces removed because that welding collapsed them
+    MeshRepairs repairs;             // what the repair changed (nothing when strict)
 };
 
 // Parses `.tri` text; `source` names it in errors.
-MeshReadResult parseTri(std::string_view text, const std::string& source);
-MeshReadResult readTri(const std::filesystem::path& path);
+MeshReadResult parseTri(std::string_view text, const std::string& source, const MeshReadOptions& options = {});
+MeshReadResult readTri(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
 // Any supported format, chosen by extension (.tri natively, the rest through assimp).
 MeshReadResult readMesh(const std::filesystem::path& path, const MeshReadOptions& options = {});

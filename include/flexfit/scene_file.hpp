@@ -16,9 +16,18 @@
 
 namespace flexfit {
 
-// Throws InputError naming the file, the line and the key for every problem.
-Scene loadScene(const std::filesystem::path& file);
+struct SceneReadOptions {
+    // Refuse mesh files with geometric defects (mesh_repair.hpp) instead of repairing them, for
+    // every part (a part's own `repair = false` does it for that part alone).
+    bool strictMeshes = false;
+};
+
+// Throws InputError naming the file, the line and the key for every problem. A part's mesh
+// file is repaired unless the part says `repair = false`; what was repaired is in the
+// scene's warnings, at the line of the part's `mesh` key.
+Scene loadScene(const std::filesystem::path& file, const SceneReadOptions& options = {});
 // The same from text; mesh paths are resolved against `baseDirectory`.
-Scene parseScene(std::string_view text, const std::string& source, const std::filesystem::path& baseDirectory);
+Scene parseScene(std::string_view text, const std::string& source, const std::filesystem::path& baseDirectory,
+                 const SceneReadOptions& options = {});
 
 }  // namespace flexfit

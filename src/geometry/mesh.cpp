@@ -1,58 +1,73 @@
 #include "flexfit/mesh.hpp"
+#include "geometry/mesh_checks.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 namespace flexfit {
-namespace {
 
-std::size_t lineOf(const std::vector<std::size_t>& lines, std::size_t i) {
-    return i < lines.size() ? lines[i] : 0;
-}
+namespace detail {
+
+std::size_t lineOf(const std::vector<std::size_t>& lines, std::size_t i) { return i < lines.size() ? lines[i] : 0; }
 
 std::string faceText(std::size_t f, const Face& face) {
-    return "face " + std::to_string(f) + " (" + std::to_string(face[0]) + " " + std::to_string(face[1]) +
-           " " + std::to_string(face[2]) + ")";
+    return "face " + std::to_string(f) + " (" + std::to_string(face[0]) + " " + std::to_string(face[1]) + " " + std::to_string(face[2]) + ")";
 }
 
-void checkVertices(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
-    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+void requireWellFormed(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
+    if (mesh.vertices.empty()) throw InputError(source, 0, "empty mesh: no vertices");
+    if (mesh.faces.empty()) throw InputError(source, 0, "empty mesh: no faces");
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
         if (!mesh.vertices[v].allFinite())
-            throw InputError(source, lineOf(lines.vertexLine, v),
-                             "vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
-    }
-}
-
-void checkFaceIndices(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
+            throw InputError(source, lineOf(lines.vertexLine, v), "vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
     const std::size_t n = mesh.vertices.size();
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-        const Face& face = mesh.faces[f];
-        for (Index idx : face)
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+        for (Index idx : mesh.faces[f])
             if (idx >= n)
                 throw InputError(source, lineOf(lines.faceLine, f),
-                                 faceText(f, face) + ": index " + std::to_string(idx) +
-                                     " out of range (the mesh has " + std::to_string(n) + " vertices)");
+                                 faceText(f, mesh.faces[f]) + ": index " + std::to_string(idx) + " out of range (the mesh has " +
+                                     std::to_string(n) + " vertices)");
+}
+
+double areaScale(const TriMesh& mesh) {
+    const double diagonal = boundingBox(mesh).diagonal().stableNorm();  // no over/underflow
+    return diagonal > 0.0 ? 1.0 / diagonal : 1.0;
+}
+
+bool hasZeroArea(const TriMesh& mesh, const Face& face, double scale) {
+    // Edges are scaled by the bounding-box diagonal first, so the test is relative and neither
+    // underflows for tiny meshes nor overflows for huge ones.
+    const Vec3& a = mesh.vertices[face[0]];
+    const Vec3 ab = (mesh.vertices[face[1]] - a) * scale, ac = (mesh.vertices[face[2]] - a) * scale;
+    return !(ab.cross(ac).norm() > 2e-12);
+}
+
+}  // namespace detail
+
+using detail::faceText;
+using detail::lineOf;
+
+namespace {
+
+void checkFaceIndices(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        const Face& face = mesh.faces[f];
         if (face[0] == face[1] || face[1] == face[2] || face[0] == face[2])
             throw InputError(source, lineOf(lines.faceLine, f), faceText(f, face) + " is degenerate: repeated vertex");
     }
 }
 
 void checkFaceAreas(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
-    // Edges are scaled by the bounding-box diagonal first, so the test is relative and neither
-    // underflows for tiny meshes nor overflows for huge ones.
-    const double diagonal = boundingBox(mesh).diagonal().stableNorm();  // no over/underflow
-    const double scale = diagonal > 0.0 ? 1.0 / diagonal : 1.0;
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-        const Face& face = mesh.faces[f];
-        const Vec3& a = mesh.vertices[face[0]];
-        const Vec3 ab = (mesh.vertices[face[1]] - a) * scale, ac = (mesh.vertices[face[2]] - a) * scale;
-        const double relativeDoubleArea = ab.cross(ac).norm();
-        if (!(relativeDoubleArea > 2e-12))
-            throw InputError(source, lineOf(lines.faceLine, f), faceText(f, face) + " is degenerate: zero area");
-    }
+    const double scale = detail::areaScale(mesh);
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+        if (detail::hasZeroArea(mesh, mesh.faces[f], scale))
+            throw InputError(source, lineOf(lines.faceLine, f), faceText(f, mesh.faces[f]) + " is degenerate: zero area");
 }
 
 void checkDuplicateFaces(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
@@ -102,9 +117,7 @@ Eigen::AlignedBox3d boundingBox(const TriMesh& mesh) {
 }
 
 MeshDiagnostics validateMesh(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
-    if (mesh.vertices.empty()) throw InputError(source, 0, "empty mesh: no vertices");
-    if (mesh.faces.empty()) throw InputError(source, 0, "empty mesh: no faces");
-    checkVertices(mesh, source, lines);
+    detail::requireWellFormed(mesh, source, lines);
     checkFaceIndices(mesh, source, lines);
     checkFaceAreas(mesh, source, lines);
     checkDuplicateFaces(mesh, source, lines);
@@ -128,11 +141,31 @@ MeshDiagnostics validateMesh(const TriMesh& mesh, const std::string& source, con
     return diagnostics;
 }
 
-std::size_t weldVertices(TriMesh& mesh, double tolerance) {
-    // Hash grid with cells of the tolerance's size; each vertex is compared with the kept
-    // vertices in the 27 surrounding cells and joins the first one found within the tolerance.
-    // Exact mode compares coordinates with == (so 0.0 and -0.0 are the same position).
-    const double cell = tolerance > 0 ? tolerance : 1.0;
+namespace {
+
+// Exact mode: vertices whose coordinates are equal (0.0 and -0.0 alike; NaN equal to nothing),
+// found by sorting their bit patterns. Each joins the first of its group in input order.
+std::vector<Index> identicalPositions(std::span<const Vec3> vertices) {
+    using Key = std::array<std::uint64_t, 3>;
+    auto keyOf = [](const Vec3& p) {
+        return Key{std::bit_cast<std::uint64_t>(p.x() + 0.0), std::bit_cast<std::uint64_t>(p.y() + 0.0), std::bit_cast<std::uint64_t>(p.z() + 0.0)};
+    };
+    std::vector<std::pair<Key, Index>> order(vertices.size());
+    for (std::size_t v = 0; v < vertices.size(); ++v) order[v] = {keyOf(vertices[v]), Index(v)};
+    std::sort(order.begin(), order.end());  // by position, then index: a group's first is the earliest
+    std::vector<Index> first(vertices.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        const Index v = order[i].second;
+        const bool joins = i > 0 && order[i].first == order[i - 1].first && !vertices[v].hasNaN();
+        first[v] = joins ? first[order[i - 1].second] : v;
+    }
+    return first;
+}
+
+// Tolerance mode: a hash grid with cells of the tolerance's size; each vertex is compared with
+// the kept vertices in the 27 surrounding cells (each cell's in the order they were kept) and
+// joins the first one found within the tolerance.
+std::vector<Index> positionsWithin(std::span<const Vec3> vertices, double tolerance) {
     struct CellHash {
         std::size_t operator()(const std::array<std::int64_t, 3>& c) const {
             // Unsigned arithmetic: wraps instead of overflowing for far-away cells.
@@ -140,38 +173,67 @@ std::size_t weldVertices(TriMesh& mesh, double tolerance) {
                    std::size_t(std::uint64_t(c[2]) * 83492791u);
         }
     };
-    std::unordered_map<std::array<std::int64_t, 3>, std::vector<Index>, CellHash> grid;
-    std::vector<Index> remap(mesh.vertices.size());
-    std::vector<Vec3> kept;
-    kept.reserve(mesh.vertices.size());
+    constexpr Index kNone = Index(-1);
+    // A cell's kept vertices as a list threaded through `next`: no allocation per cell.
+    std::unordered_map<std::array<std::int64_t, 3>, std::pair<Index, Index>, CellHash> cells;  // first, last
+    cells.reserve(vertices.size());
+    std::vector<Index> next(vertices.size(), kNone), first(vertices.size());
     auto cellOf = [&](const Vec3& p) {
         // Clamped so that huge or non-finite coordinates never overflow the integer cast.
         auto axis = [&](double x) {
-            const double c = std::floor(x / cell);
+            const double c = std::floor(x / tolerance);
             return std::int64_t(std::isfinite(c) ? std::clamp(c, -1e15, 1e15) : 0.0);
         };
         return std::array<std::int64_t, 3>{axis(p.x()), axis(p.y()), axis(p.z())};
     };
-    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
-        const Vec3& p = mesh.vertices[v];
+    for (std::size_t v = 0; v < vertices.size(); ++v) {
+        const Vec3& p = vertices[v];
         const auto c = cellOf(p);
-        Index match = Index(-1);
-        for (int dx = -1; dx <= 1 && match == Index(-1); ++dx)
-            for (int dy = -1; dy <= 1 && match == Index(-1); ++dy)
-                for (int dz = -1; dz <= 1 && match == Index(-1); ++dz) {
-                    auto it = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
-                    if (it == grid.end()) continue;
-                    for (Index k : it->second) {
-                        const bool same = tolerance > 0 ? (kept[k] - p).norm() <= tolerance : kept[k] == p;
-                        if (same) { match = k; break; }
-                    }
+        Index match = kNone;
+        for (int dx = -1; dx <= 1 && match == kNone; ++dx)
+            for (int dy = -1; dy <= 1 && match == kNone; ++dy)
+                for (int dz = -1; dz <= 1 && match == kNone; ++dz) {
+                    const auto it = cells.find({c[0] + dx, c[1] + dy, c[2] + dz});
+                    if (it == cells.end()) continue;
+                    for (Index k = it->second.first; k != kNone; k = next[k])
+                        if ((vertices[k] - p).norm() <= tolerance) {
+                            match = k;
+                            break;
+                        }
                 }
-        if (match == Index(-1)) {
-            match = Index(kept.size());
-            kept.push_back(p);
-            grid[c].push_back(match);
+        if (match != kNone) {
+            first[v] = match;
+            continue;
         }
-        remap[v] = match;
+        first[v] = Index(v);
+        const auto [it, inserted] = cells.try_emplace(c, Index(v), Index(v));
+        if (!inserted) {
+            next[it->second.second] = Index(v);
+            it->second.second = Index(v);
+        }
+    }
+    return first;
+}
+
+}  // namespace
+
+std::vector<Index> weldTargets(std::span<const Vec3> vertices, double tolerance) {
+    return tolerance > 0 ? positionsWithin(vertices, tolerance) : identicalPositions(vertices);
+}
+
+std::size_t weldVertices(TriMesh& mesh, double tolerance) {
+    const std::vector<Index> target = weldTargets(mesh.vertices, tolerance);
+    // Kept vertices in input order; every vertex maps to its target's new index.
+    std::vector<Index> remap(mesh.vertices.size());
+    std::vector<Vec3> kept;
+    kept.reserve(mesh.vertices.size());
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+        if (target[v] == Index(v)) {
+            remap[v] = Index(kept.size());
+            kept.push_back(mesh.vertices[v]);
+        } else {
+            remap[v] = remap[target[v]];
+        }
     }
     std::vector<Face> faces;
     faces.reserve(mesh.faces.size());

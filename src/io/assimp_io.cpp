@@ -94,16 +94,7 @@ MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadO
         if (!mesh.vertices[v].allFinite())
             throw InputError(file, lineOfNonFiniteToken(path), "a vertex has a NaN or infinite coordinate");
 
-    MeshReadResult result;
-    const std::size_t before = mesh.vertices.size();
-    result.collapsedFaces = weldVertices(mesh, options.weldTolerance);
-    result.weldedVertices = before - mesh.vertices.size();
-    result.diagnostics = validateMesh(mesh, file);
-    if (result.collapsedFaces > 0)
-        result.diagnostics.warnings.push_back(std::to_string(result.collapsedFaces) +
-                                              " faces collapsed by welding and were removed");
-    result.mesh = std::move(mesh);
-    return result;
+    return finishRead(std::move(mesh), file, {}, options, true);  // one vertex per corner in STL: weld identical ones
 }
 
 }  // namespace flexfit

@@ -1,6 +1,7 @@
 // Format dispatch and the OBJ writer.
 #include "flexfit/mesh_io.hpp"
 #include "io_internal.hpp"
+#include "geometry/mesh_checks.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -19,22 +20,57 @@ std::string lowerExtension(const std::filesystem::path& path) {
 
 }  // namespace
 
+namespace {
+
+// Strict reading: a face the welding would collapse (two corners at one position) is refused,
+// not dropped.
+void requireNoCollapse(const TriMesh& mesh, double tolerance, const std::string& source, const MeshSourceLines& lines) {
+    const std::vector<Index> target = weldTargets(mesh.vertices, tolerance);
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        const Face& face = mesh.faces[f];
+        for (int k = 0; k < 3; ++k) {
+            const Index u = face[k], v = face[(k + 1) % 3];
+            if (target[u] == target[v])
+                throw InputError(source, detail::lineOf(lines.faceLine, f),
+                                 detail::faceText(f, face) + " is degenerate: its corners " + std::to_string(u) + " and " + std::to_string(v) +
+                                     (tolerance > 0.0 ? " are within the weld tolerance" : " are at the same position"));
+        }
+    }
+}
+
+}  // namespace
+
+MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSourceLines& lines, const MeshReadOptions& options,
+                          bool formatWelds) {
+    detail::requireWellFormed(mesh, source, lines);
+    MeshReadResult result;
+    const bool welds = formatWelds || options.weldTolerance.has_value();
+    if (welds && !options.repair) requireNoCollapse(mesh, options.weldTolerance.value_or(0.0), source, lines);
+    if (welds) {  // indices change: the lines no longer match the faces
+        const std::size_t before = mesh.vertices.size();
+        result.collapsedFaces = weldVertices(mesh, options.weldTolerance.value_or(0.0));
+        result.weldedVertices = before - mesh.vertices.size();
+    }
+    const MeshSourceLines& where = welds ? MeshSourceLines{} : lines;
+    const double tolerance = options.weldTolerance.value_or(-1.0);  // < 0: near-duplicates
+    if (options.repair)
+        result.repairs = repairMesh(mesh, tolerance, source, where);
+    else
+        requireNoDefects(mesh, tolerance, source, where);
+    result.diagnostics = validateMesh(mesh, source);
+    std::vector<std::string> warnings = result.repairs.warnings();
+    if (result.collapsedFaces > 0) warnings.push_back(std::to_string(result.collapsedFaces) + " faces collapsed by welding and were removed");
+    warnings.insert(warnings.end(), result.diagnostics.warnings.begin(), result.diagnostics.warnings.end());
+    result.diagnostics.warnings = std::move(warnings);
+    result.mesh = std::move(mesh);
+    return result;
+}
+
 MeshReadResult readMesh(const std::filesystem::path& path, const MeshReadOptions& options) {
-    if (!(options.weldTolerance >= 0.0) || !std::isfinite(options.weldTolerance))
+    if (options.weldTolerance && !(*options.weldTolerance >= 0.0 && std::isfinite(*options.weldTolerance)))
         throw InputError(path.string(), 0, "weld tolerance must be a finite number >= 0");
     if (lowerExtension(path) != ".tri") return readWithAssimp(path, options);
-    MeshReadResult result = readTri(path);
-    if (options.weldTolerance > 0.0) {
-        // .tri vertices are shared by construction; weld only when asked, then re-validate.
-        const std::size_t before = result.mesh.vertices.size();
-        result.collapsedFaces = weldVertices(result.mesh, options.weldTolerance);
-        result.weldedVertices = before - result.mesh.vertices.size();
-        result.diagnostics = validateMesh(result.mesh, path.string());
-        if (result.collapsedFaces > 0)
-            result.diagnostics.warnings.push_back(std::to_string(result.collapsedFaces) +
-                                                  " faces collapsed by welding and were removed");
-    }
-    return result;
+    return readTri(path, options);
 }
 
 void writeObj(const TriMesh& mesh, const std::filesystem::path& path) {

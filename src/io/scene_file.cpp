@@ -171,13 +171,19 @@ std::vector<const toml::table*> tables(Table& root, const std::string& key) {
 }
 
 // Mesh input errors stay as they are (they name the mesh file and its line); the scene's
-// line is added so the user knows which part asked for the file.
-TriMesh readPartMesh(Table& t, const std::filesystem::path& base) {
+// line is added so the user knows which part asked for the file. What the repair changed
+// becomes the scene's warnings, at the mesh key's line: nothing is changed silently.
+TriMesh readPartMesh(Table& t, const std::filesystem::path& base, const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
     const std::string file = t.text("mesh", "");
     const std::filesystem::path path = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : base / file;
     const std::size_t line = t.line("mesh");
+    MeshReadOptions read;
+    read.repair = t.flag("repair", true) && !options.strictMeshes;
     try {
-        return readMesh(path).mesh;
+        MeshReadResult result = readMesh(path, read);
+        for (const std::string& repair : result.repairs.warnings())
+            warnings.push_back({line, t.what() + ", key 'mesh': " + path.string() + ": " + repair});
+        return std::move(result.mesh);
     } catch (const InputError& e) {
         throw InputError(t.file(), line, t.what() + ", key 'mesh': " + e.what());
     }
@@ -237,11 +243,12 @@ Material readMaterial(Table& t) {
     return material;
 }
 
-ScenePart readPart(Table& t, const std::filesystem::path& base) {
+ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
     ScenePart p;
     p.name = t.requiredText("name");
     if (t.has("mesh") == t.has("generator")) t.fail("needs exactly one of 'mesh' and 'generator'");
-    TriMesh mesh = t.has("mesh") ? readPartMesh(t, base) : generatePartMesh(t);
+    if (t.has("repair") && !t.has("mesh")) t.fail(*t.node("repair"), "repair", "applies only to a part read from a 'mesh' file");
+    TriMesh mesh = t.has("mesh") ? readPartMesh(t, base, options, warnings) : generatePartMesh(t);
     mesh.name = p.name;
     PartModelSettings model;
     model.material = readMaterial(t);
@@ -428,7 +435,8 @@ void readWorld(Table& root, Scene& scene) {
 
 }  // namespace
 
-Scene parseScene(std::string_view text, const std::string& source, const std::filesystem::path& baseDirectory) {
+Scene parseScene(std::string_view text, const std::string& source, const std::filesystem::path& baseDirectory,
+                 const SceneReadOptions& options) {
     toml::table document;
     try {
         document = toml::parse(text, source);
@@ -441,7 +449,7 @@ Scene parseScene(std::string_view text, const std::string& source, const std::fi
     readWorld(root, scene);
     for (const toml::table* t : tables(root, "part")) {
         Table part(*t, "part " + std::to_string(scene.parts.size() + 1), scene.source, scene.warnings);
-        ScenePart p = readPart(part, baseDirectory);
+        ScenePart p = readPart(part, baseDirectory, options, scene.warnings);
         if (scene.find(p.name)) part.fail(*t->get("name"), "name", "duplicate part name '" + p.name + "'");
         scene.parts.push_back(std::move(p));
     }
@@ -465,12 +473,12 @@ Scene parseScene(std::string_view text, const std::string& source, const std::fi
     return scene;
 }
 
-Scene loadScene(const std::filesystem::path& file) {
+Scene loadScene(const std::filesystem::path& file, const SceneReadOptions& options) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file.string(), 0, "cannot open the scene file");
     std::ostringstream text;
     text << in.rdbuf();
-    return parseScene(text.str(), file.string(), file.parent_path());
+    return parseScene(text.str(), file.string(), file.parent_path(), options);
 }
 
 }  // namespace flexfit

@@ -1,5 +1,6 @@
 // The `.tri` reader and writer (format in mesh_io.hpp).
 #include "flexfit/mesh_io.hpp"
+#include "io_internal.hpp"
 
 #include <charconv>
 #include <cstdio>
@@ -160,7 +161,7 @@ std::string trimmed(std::string_view s) {
 
 }  // namespace
 
-MeshReadResult parseTri(std::string_view text, const std::string& source) {
+MeshReadResult parseTri(std::string_view text, const std::string& source, const MeshReadOptions& options) {
     if (text.find_first_not_of(" \t\r\n\v\f") == std::string_view::npos) throw InputError(source, 0, "empty file");
     LineCursor cursor(text);
     TriMesh mesh;
@@ -182,13 +183,10 @@ MeshReadResult parseTri(std::string_view text, const std::string& source) {
         throw InputError(source, extra.number, "unexpected data after the last face: the header's counts (" +
                                                    std::to_string(vertexCount) + " vertices, " + std::to_string(faceCount) +
                                                    " faces) do not match the file");
-    MeshReadResult result;
-    result.diagnostics = validateMesh(mesh, source, lines);
-    result.mesh = std::move(mesh);
-    return result;
+    return finishRead(std::move(mesh), source, lines, options, false);  // .tri shares vertices: no format welding
 }
 
-MeshReadResult readTri(const std::filesystem::path& path) {
+MeshReadResult readTri(const std::filesystem::path& path, const MeshReadOptions& options) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))
         throw InputError(path.string(), 0, std::filesystem::exists(path, ec) ? "not a regular file"
@@ -197,7 +195,7 @@ MeshReadResult readTri(const std::filesystem::path& path) {
     if (!file) throw InputError(path.string(), 0, "cannot open the file for reading");
     std::ostringstream buffer;
     buffer << file.rdbuf();
-    return parseTri(buffer.str(), path.string());
+    return parseTri(buffer.str(), path.string(), options);
 }
 
 std::string formatTri(const TriMesh& mesh) {

@@ -429,14 +429,19 @@ TEST(AssimpIo, TruncatedAsciiStlIsRejected) {
     expectReadError(dir.write("garbage.stl", "solid x\n  facet normal 0 0 0\n    outer loop\n      vertex 0 0\n"));
 }
 
-TEST(AssimpIo, DegenerateAndDuplicateFacesAreRejected) {
+TEST(AssimpIo, DegenerateAndDuplicateFacesAreRepairedOrRefused) {
     TempDir dir;
-    // Zero-area face.
-    EXPECT_TRUE(contains(expectReadError(dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n")).problem(),
-                         "zero area"));
+    const MeshReadOptions strict{.weldTolerance = std::nullopt, .repair = false};
+    // Zero-area face: refused when strict; the repair drops it, and then nothing is left.
+    const fs::path flat = dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+    EXPECT_TRUE(contains(expectReadError(flat, strict).problem(), "zero area"));
+    EXPECT_TRUE(contains(expectReadError(flat).problem(), "no face is left"));
     // Duplicate faces (the same triangle twice, opposite winding).
-    EXPECT_TRUE(contains(expectReadError(dir.write("dup.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 3 2 1\n")).problem(),
-                         "duplicates"));
+    const fs::path dup = dir.write("dup.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 3 2 1\n");
+    EXPECT_TRUE(contains(expectReadError(dup, strict).problem(), "duplicates"));
+    const MeshReadResult r = readMesh(dup);
+    EXPECT_EQ(r.mesh.faces.size(), 1u);
+    EXPECT_EQ(r.repairs.duplicateFaces, 1u);
 }
 
 TEST(AssimpIo, NegativeOrNaNWeldToleranceIsRejected) {

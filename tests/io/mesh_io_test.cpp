@@ -113,17 +113,35 @@ const std::string kSplitTet =
     "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1e-9 0 0\n"
     "0 2 1\n4 1 3\n0 3 2\n1 2 3\n";
 
-TEST(MeshIo, ReadMeshTriDoesNotWeldByDefault) {
+TEST(MeshIo, ReadMeshTriRepairsANearDuplicateByDefault) {
     TempDir dir;
-    const MeshReadResult r = readMesh(dir.write("split.tri", kSplitTet));
+    const fs::path file = dir.write("split.tri", kSplitTet);
+    // Vertex 4 lies 1e-9 from vertex 0, within 1e-6 of the diagonal: a crack, welded and reported.
+    const MeshReadResult r = readMesh(file);
     EXPECT_EQ(r.mesh.name, "split tet");
-    EXPECT_EQ(r.mesh.vertices.size(), 5u);
-    EXPECT_EQ(r.weldedVertices, 0u);
-    EXPECT_EQ(r.collapsedFaces, 0u);
-    EXPECT_EQ(r.diagnostics.edgeCount, 8u);  // 6 + the split edges 4-1, 4-3
-    EXPECT_EQ(r.diagnostics.boundaryEdges, 4u);
-    EXPECT_FALSE(r.diagnostics.closed());
-    EXPECT_FALSE(r.diagnostics.warnings.empty());
+    EXPECT_EQ(r.mesh.vertices.size(), 4u);
+    EXPECT_EQ(r.weldedVertices, 0u);  // none asked for
+    EXPECT_EQ(r.repairs.weldedVertices, 1u);
+    EXPECT_DOUBLE_EQ(r.repairs.weldTolerance, 1e-6 * std::sqrt(3.0));
+    EXPECT_TRUE(r.diagnostics.closed());
+    ASSERT_EQ(r.diagnostics.warnings.size(), 1u);
+    EXPECT_TRUE(contains(r.diagnostics.warnings[0], "1 vertex welded")) << r.diagnostics.warnings[0];
+    // Strict: refused, naming both vertices and the line of the later one.
+    try {
+        readMesh(file, MeshReadOptions{.weldTolerance = std::nullopt, .repair = false});
+        ADD_FAILURE() << "accepted a near-duplicate vertex";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.line(), 7u);
+        EXPECT_TRUE(contains(e.problem(), "vertex 4 (line 7) is within")) << e.problem();
+        EXPECT_TRUE(contains(e.problem(), "of vertex 0 (line 3)")) << e.problem();
+    }
+    // Welding asked for at 0 (identical positions only) keeps the split, as the file says.
+    const MeshReadResult exact = readMesh(file, MeshReadOptions{0.0});
+    EXPECT_EQ(exact.mesh.vertices.size(), 5u);
+    EXPECT_EQ(exact.weldedVertices, 0u);
+    EXPECT_EQ(exact.diagnostics.edgeCount, 8u);  // 6 + the split edges 4-1, 4-3
+    EXPECT_EQ(exact.diagnostics.boundaryEdges, 4u);
+    EXPECT_FALSE(exact.diagnostics.closed());
 }
 
 TEST(MeshIo, ReadMeshTriWeldsWithinTolerance) {
@@ -162,14 +180,18 @@ TEST(MeshIo, ReadMeshTriWeldingCollapsesFaces) {
     EXPECT_TRUE(r.diagnostics.closed());
 }
 
-TEST(MeshIo, ReadMeshTriWeldingThatBreaksTheMeshThrows) {
+TEST(MeshIo, ReadMeshTriWeldingThatMakesDuplicatesIsRepairedOrRefused) {
     TempDir dir;
     // Welding at 0.6 merges vertex 3 into vertex 0 (and into no other): the two faces become duplicates.
     const std::string text = "dup\n4 2\n0 0 0\n1 0 0\n0 1 0\n0 0 0.5\n0 1 2\n3 1 2\n";
     const fs::path file = dir.write("dup.tri", text);
-    EXPECT_NO_THROW(readMesh(file));
+    EXPECT_EQ(readMesh(file).mesh.faces.size(), 2u);
+    const MeshReadResult r = readMesh(file, MeshReadOptions{0.6});
+    EXPECT_EQ(r.weldedVertices, 1u);
+    EXPECT_EQ(r.repairs.duplicateFaces, 1u);
+    EXPECT_EQ(r.mesh.faces.size(), 1u);
     try {
-        readMesh(file, MeshReadOptions{0.6});
+        readMesh(file, MeshReadOptions{.weldTolerance = 0.6, .repair = false});
         ADD_FAILURE() << "accepted duplicate faces after welding";
     } catch (const InputError& e) {
         EXPECT_EQ(e.source(), file.string());

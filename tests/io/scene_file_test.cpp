@@ -2,6 +2,7 @@
 // a valid scene gives exactly the values it states (checked key by key against the text),
 // contact materials, the contact solver's settings and the box and plate generators included.
 #include "flexfit/scene_file.hpp"
+#include "temp_dir.hpp"
 
 #include <gtest/gtest.h>
 
@@ -371,4 +372,34 @@ TEST(SceneFile, CoherentCollisionIsAFlag) {
     EXPECT_FALSE(parseScene(withLine("duration = 2.5", "coherent_collision = false"), "scene.toml", ".").world.collision.coherent);
     const std::string e = errorOf(withLine("duration = 2.5", "coherent_collision = \"no\""));
     EXPECT_NE(e.find(":6: scene.world, key 'coherent_collision': expected true or false"), std::string::npos) << e;
+}
+
+// A part's mesh file with a duplicate face: repaired with a warning at the mesh key's line,
+// refused with the mesh file's line by `repair = false` or SceneReadOptions::strictMeshes.
+TEST(SceneFile, MeshDefectsAreRepairedWithAWarningOrRefused) {
+    flexfit::testing::TempDir dir;
+    // A tetrahedron and a copy of its face 0 (line 7) on line 11.
+    dir.write("tet.tri", "tet\n4 5\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 2 1\n0 1 3\n0 3 2\n1 2 3\n1 0 2\n");
+    const std::string part = "[[part]]\nname = \"tet\"\nmesh = \"tet.tri\"\n";
+    const Scene repaired = parseScene(part, "scene.toml", dir.path());
+    ASSERT_EQ(repaired.warnings.size(), 1u);
+    EXPECT_EQ(repaired.warnings[0].line, 3u);
+    EXPECT_NE(repaired.warnings[0].message.find("part 1, key 'mesh': "), std::string::npos) << repaired.warnings[0].message;
+    EXPECT_NE(repaired.warnings[0].message.find("1 duplicate face"), std::string::npos) << repaired.warnings[0].message;
+    EXPECT_EQ(repaired.parts[0].model->faceCount(), 4u);
+
+    for (const auto& [text, options] : {std::pair{part + "repair = false\n", SceneReadOptions{}}, std::pair{part, SceneReadOptions{true}}}) {
+        try {
+            parseScene(text, "scene.toml", dir.path(), options);
+            ADD_FAILURE() << "accepted a duplicate face: " << text;
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.line(), 3u);
+            EXPECT_NE(std::string(e.what()).find("tet.tri:11: face 4 (1 0 2) duplicates face 0 (line 7)"), std::string::npos) << e.what();
+        }
+    }
+}
+
+TEST(SceneFile, RepairAppliesOnlyToMeshFiles) {
+    const std::string e = errorOf(withLine("name = \"ball\"", "repair = false"));
+    EXPECT_NE(e.find("key 'repair': applies only to a part read from a 'mesh' file"), std::string::npos) << e;
 }

@@ -76,9 +76,9 @@ void expectTetrahedron(const MeshReadResult& r) {
 }
 
 // parseTri must throw InputError naming the source, at `line`, with `phrase` in the problem.
-void expectParseError(const std::string& text, std::size_t line, const std::string& phrase) {
+void expectParseError(const std::string& text, std::size_t line, const std::string& phrase, const MeshReadOptions& options = {}) {
     try {
-        parseTri(text, "bad.tri");
+        parseTri(text, "bad.tri", options);
         ADD_FAILURE() << "accepted:\n" << text;
     } catch (const InputError& e) {
         EXPECT_EQ(e.source(), "bad.tri");
@@ -301,16 +301,31 @@ TEST(TriIoErrors, IndexOutOfRange) {
     expectParseError(tetWithLine(7, "0 4294967296 1"), 7, "out of range");
 }
 
-TEST(TriIoErrors, DegenerateFaceRepeatedIndex) { expectParseError(tetWithLine(8, "0 1 1"), 8, "repeated vertex"); }
+// Geometric defects: refused with their line when strict, repaired with a warning otherwise.
+const MeshReadOptions kStrict{.weldTolerance = std::nullopt, .repair = false};
+
+void expectRepaired(const std::string& text, std::size_t faces, const std::string& warning) {
+    const MeshReadResult r = parseTri(text, "defect.tri");
+    EXPECT_EQ(r.mesh.faces.size(), faces);
+    ASSERT_FALSE(r.diagnostics.warnings.empty());
+    EXPECT_TRUE(contains(r.diagnostics.warnings[0], warning)) << r.diagnostics.warnings[0];
+}
+
+TEST(TriIoErrors, DegenerateFaceRepeatedIndex) {
+    expectParseError(tetWithLine(8, "0 1 1"), 8, "repeated vertex", kStrict);
+    expectRepaired(tetWithLine(8, "0 1 1"), 3, "1 degenerate face");
+}
 
 TEST(TriIoErrors, ZeroAreaFace) {
     // Vertex 3 moved onto the line through 0 and 1: face 1 (0 1 3), line 8, has zero area.
-    expectParseError(tetWithLine(6, "2 0 0"), 8, "zero area");
+    expectParseError(tetWithLine(6, "2 0 0"), 8, "zero area", kStrict);
+    expectRepaired(tetWithLine(6, "2 0 0"), 3, "1 degenerate face");
 }
 
 TEST(TriIoErrors, DuplicateFace) {
     std::string text = tetWithLine(2, "4 5") + "2 1 0\n";  // same vertices as line 7, reversed
-    expectParseError(text, 11, "duplicates face 0 (line 7)");
+    expectParseError(text, 11, "duplicates face 0 (line 7)", kStrict);
+    expectRepaired(text, 4, "1 duplicate face");
 }
 
 TEST(TriIoErrors, TrailingDataAfterFaces) {
