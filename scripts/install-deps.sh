@@ -13,6 +13,7 @@ packages=(
   libgtest-dev libgmock-dev            # tests
   libbenchmark-dev                     # benchmarks
   libtomlplusplus-dev                  # scene files (TOML, with the line of every key)
+  libcgal-dev                          # simulation remeshing (Polygon Mesh Processing)
   libfcl-dev                           # FCL: reference for collision tests and benchmarks
   python3-matplotlib                   # plots of experiment results (/usr/bin/python3)
   libglfw3-dev libimgui-dev            # viewer: window, input, user interface

@@ -25,6 +25,8 @@ import statistics
 import subprocess
 import tempfile
 
+from results_table import report
+
 WUSON = "/usr/share/assimp/models/OFF/Wuson.off"
 
 
@@ -202,16 +204,7 @@ def main():
         for key in results[0]:
             row[key] = statistics.median(r[key] for r in results)
         table.append(row)
-    keys = list(table[0])
-    print("| " + " | ".join(keys) + " |")
-    print("|" + "---|" * len(keys))
-    for row in table:
-        print("| " + " | ".join(f"{row[k]:.1f}" if isinstance(row[k], float) else str(row[k]) for k in keys) + " |")
-    if args.csv:
-        with open(args.csv, "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=keys)
-            writer.writeheader()
-            writer.writerows(table)
+    report(table, args.csv)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 // TOML scene parsing (scene_file.hpp). Every table is read through a Table that remembers
 // which keys were used, so unknown keys (typos) are reported instead of silently ignored.
 #include "flexfit/scene_file.hpp"
+#include "flexfit/remesh.hpp"
 
 #include "flexfit/generators.hpp"
 #include "flexfit/mesh_io.hpp"
@@ -170,6 +171,26 @@ std::vector<const toml::table*> tables(Table& root, const std::string& key) {
     return out;
 }
 
+// `remesh = L` (the target edge) or `remesh = { edge = L, iterations = N, feature_angle = DEG }`.
+std::optional<RemeshOptions> readRemesh(Table& t) {
+    if (!t.has("remesh")) return std::nullopt;
+    const toml::node* n = t.node("remesh");
+    RemeshOptions r;
+    if (n->is_number()) {
+        r.targetEdge = t.positive("remesh", 1.0);
+        return r;
+    }
+    if (!n->is_table()) t.fail(*n, "remesh", "expected a target edge length or {edge, iterations, feature_angle}");
+    Table options = t.sub("remesh");
+    if (!options.has("edge")) options.fail("needs 'edge' (the target edge length)");
+    r.targetEdge = options.positive("edge", 0.0);
+    r.iterations = options.integer("iterations", r.iterations, 1, 100);
+    r.featureAngle = options.positive("feature_angle", r.featureAngle);
+    if (!(r.featureAngle < 180.0)) options.fail(*options.node("feature_angle"), "feature_angle", "must be below 180 degrees");
+    options.finish();
+    return r;
+}
+
 // Mesh input errors stay as they are (they name the mesh file and its line); the scene's
 // line is added so the user knows which part asked for the file. What the repair changed
 // becomes the scene's warnings, at the mesh key's line: nothing is changed silently.
@@ -179,13 +200,20 @@ TriMesh readPartMesh(Table& t, const std::filesystem::path& base, const SceneRea
     const std::size_t line = t.line("mesh");
     MeshReadOptions read;
     read.repair = t.flag("repair", true) && !options.strictMeshes;
+    const std::optional<RemeshOptions> remesh = readRemesh(t);
+    MeshReadResult result;
     try {
-        MeshReadResult result = readMesh(path, read);
-        for (const std::string& repair : result.repairs.warnings())
-            warnings.push_back({line, t.what() + ", key 'mesh': " + path.string() + ": " + repair});
-        return std::move(result.mesh);
+        result = readMesh(path, read);
     } catch (const InputError& e) {
         throw InputError(t.file(), line, t.what() + ", key 'mesh': " + e.what());
+    }
+    for (const std::string& repair : result.repairs.warnings())
+        warnings.push_back({line, t.what() + ", key 'mesh': " + path.string() + ": " + repair});
+    if (!remesh) return std::move(result.mesh);
+    try {
+        return remeshForSimulation(result.mesh, *remesh, path.string()).mesh;
+    } catch (const InputError& e) {
+        throw InputError(t.file(), t.line("remesh"), t.what() + ", key 'remesh': " + e.problem());
     }
 }
 
@@ -247,7 +275,8 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     ScenePart p;
     p.name = t.requiredText("name");
     if (t.has("mesh") == t.has("generator")) t.fail("needs exactly one of 'mesh' and 'generator'");
-    if (t.has("repair") && !t.has("mesh")) t.fail(*t.node("repair"), "repair", "applies only to a part read from a 'mesh' file");
+    for (const char* key : {"repair", "remesh"})
+        if (t.has(key) && !t.has("mesh")) t.fail(*t.node(key), key, "applies only to a part read from a 'mesh' file");
     TriMesh mesh = t.has("mesh") ? readPartMesh(t, base, options, warnings) : generatePartMesh(t);
     mesh.name = p.name;
     PartModelSettings model;

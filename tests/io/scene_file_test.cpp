@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numeric>
 #include <string>
 
 using namespace flexfit;
@@ -402,4 +403,36 @@ TEST(SceneFile, MeshDefectsAreRepairedWithAWarningOrRefused) {
 TEST(SceneFile, RepairAppliesOnlyToMeshFiles) {
     const std::string e = errorOf(withLine("name = \"ball\"", "repair = false"));
     EXPECT_NE(e.find("key 'repair': applies only to a part read from a 'mesh' file"), std::string::npos) << e;
+}
+
+// `remesh` on a part read from a file: the model is the remeshed surface (CGAL, remesh.hpp).
+TEST(SceneFile, RemeshGivesTheModelNearUniformEdges) {
+    flexfit::testing::TempDir dir;
+    dir.write("tet.tri", "tet\n4 4\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 2 1\n0 1 3\n0 3 2\n1 2 3\n");
+    const std::string part = "[[part]]\nname = \"tet\"\nmesh = \"tet.tri\"\n";
+    const Scene plain = parseScene(part, "scene.toml", dir.path());
+    EXPECT_EQ(plain.parts[0].model->faceCount(), 4u);
+    for (const std::string& remesh : {std::string("remesh = 0.1\n"), std::string("remesh = { edge = 0.1, iterations = 3, feature_angle = 30 }\n")}) {
+        const Scene scene = parseScene(part + remesh, "scene.toml", dir.path());
+        const PartModel& model = *scene.parts[0].model;
+        EXPECT_GT(model.faceCount(), 300u) << remesh;
+        const double meanLength = std::accumulate(model.restLength.begin(), model.restLength.end(), 0.0) / double(model.springCount());
+        EXPECT_NEAR(meanLength, 0.1, 0.03) << remesh;
+    }
+    auto error = [&](const std::string& extra) {
+        try {
+            parseScene(part + extra, "scene.toml", dir.path());
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    EXPECT_NE(error("remesh = -0.1\n").find("scene.toml:4: part 1, key 'remesh': must be > 0"), std::string::npos) << error("remesh = -0.1\n");
+    EXPECT_NE(error("remesh = { iterations = 3 }\n").find("needs 'edge'"), std::string::npos) << error("remesh = { iterations = 3 }\n");
+    EXPECT_NE(error("remesh = { edge = 0.1, angle = 3 }\n").find("key 'angle': unknown key"), std::string::npos)
+        << error("remesh = { edge = 0.1, angle = 3 }\n");
+    EXPECT_NE(error("remesh = 1e-6\n").find("key 'remesh': remesh: the target edge length 1e-06 is below 1e-4"), std::string::npos)
+        << error("remesh = 1e-6\n");
+    EXPECT_NE(errorOf(withLine("name = \"ball\"", "remesh = 0.5")).find("key 'remesh': applies only to a part read from a 'mesh' file"),
+              std::string::npos);
 }

@@ -1,0 +1,166 @@
+// Tests remeshForSimulation and measureQuality against analytic shapes: a box made of slivers
+// comes out without them, every vertex on the box (the analytic distance to its surface), the
+// corners and edges kept; an open square keeps its rim; the reported Hausdorff distance is at
+// least a brute-force lower bound (output vertices against the input's triangles) and within
+// the target edge; bad options are errors.
+#include "flexfit/generators.hpp"
+#include "flexfit/remesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace flexfit {
+namespace {
+
+// A box of half extents h whose six sides are fans of slivers: each side's quad (a b c d, two
+// triangles over the diagonal a-c) gets `n` points along that diagonal, fanned from b and
+// from d. The box's own edges are untouched, so the surface stays closed.
+TriMesh sliverBox(const Vec3& h, int n) {
+    const TriMesh box = makeBox(h, 1);
+    TriMesh out;
+    out.name = "slivers";
+    out.vertices = box.vertices;
+    for (std::size_t f = 0; f + 1 < box.faces.size(); f += 2) {
+        const Index a = box.faces[f][0], b = box.faces[f][1], c = box.faces[f][2], d = box.faces[f + 1][2];
+        std::vector<Index> diagonal{a};
+        for (int i = 1; i <= n; ++i) {
+            diagonal.push_back(Index(out.vertices.size()));
+            out.vertices.push_back(box.vertices[a] + (double(i) / double(n + 1)) * (box.vertices[c] - box.vertices[a]));
+        }
+        diagonal.push_back(c);
+        for (std::size_t i = 0; i + 1 < diagonal.size(); ++i) {
+            out.faces.push_back({diagonal[i], b, diagonal[i + 1]});  // within (a b c)
+            out.faces.push_back({diagonal[i], diagonal[i + 1], d});  // within (a c d)
+        }
+    }
+    return out;
+}
+
+double distanceToBoxSurface(const Vec3& p, const Vec3& h) {
+    const Vec3 q = p.cwiseAbs() - h;
+    const double outside = q.cwiseMax(0.0).norm();
+    return outside > 0.0 ? outside : -q.maxCoeff();
+}
+
+Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+    // Brute force over a barycentric grid refined around the best sample: independent of the
+    // library's closest-point code, accurate to ~1e-6 of the triangle.
+    Vec3 best = a;
+    double bestU = 0, bestV = 0, step = 0.05;
+    for (int round = 0; round < 6; ++round) {
+        const double u0 = bestU, v0 = bestV;
+        for (int i = -20; i <= 20; ++i)
+            for (int j = -20; j <= 20; ++j) {
+                const double u = std::clamp(u0 + i * step, 0.0, 1.0), v = std::clamp(v0 + j * step, 0.0, 1.0 - u);
+                const Vec3 x = a + u * (b - a) + v * (c - a);
+                if ((x - p).squaredNorm() < (best - p).squaredNorm()) {
+                    best = x;
+                    bestU = u;
+                    bestV = v;
+                }
+            }
+        step /= 10.0;
+    }
+    return best;
+}
+
+TEST(Remesh, SliversBecomeNearUniformTrianglesOnTheSameBox) {
+    const Vec3 h(1.0, 0.5, 0.75);
+    const TriMesh input = sliverBox(h, 24);
+    ASSERT_NO_THROW(validateMesh(input, "input"));
+    const RemeshResult r = remeshForSimulation(input, {.targetEdge = 0.1, .iterations = 5, .featureAngle = 40.0}, "box");
+    EXPECT_GT(r.before.slivers, 0.9);  // the fans are nearly all slivers
+    EXPECT_LT(r.before.minAngle, 3.0);
+    EXPECT_LT(r.after.slivers, 0.01);
+    EXPECT_GT(r.after.faces, 1000u);
+    EXPECT_LT(r.after.edgeSpread, 0.3);
+    EXPECT_NEAR(r.after.meanEdge, 0.1, 0.03);
+    EXPECT_EQ(r.featureEdges, 12u);  // the box's edges; the diagonals are flat
+    // Every vertex on the box's surface; its 8 corners kept exactly where they were.
+    for (const Vec3& v : r.mesh.vertices) EXPECT_NEAR(distanceToBoxSurface(v, h), 0.0, 1e-9) << v.transpose();
+    for (const Vec3& corner : makeBox(h, 1).vertices) {
+        const bool kept = std::any_of(r.mesh.vertices.begin(), r.mesh.vertices.end(), [&](const Vec3& v) { return (v - corner).norm() < 1e-9; });
+        EXPECT_TRUE(kept) << corner.transpose();
+    }
+    // A box's surface is exact under remeshing with its edges kept: no distance.
+    EXPECT_LT(r.hausdorffShare(), 1e-9);
+    EXPECT_NO_THROW(validateMesh(r.mesh, "output"));
+}
+
+TEST(Remesh, HausdorffDistanceIsAtLeastTheFarthestVertexAndWithinTheEdge) {
+    // A coarse icosphere remeshed finer: the output lies on the input polyhedron (projection),
+    // so the reported distance is small; a brute-force lower bound must not exceed it.
+    const TriMesh input = makeIcoSphere(1.0, 1);
+    const RemeshResult r = remeshForSimulation(input, {.targetEdge = 0.15}, "sphere");
+    double lower = 0.0;
+    for (std::size_t i = 0; i < r.mesh.vertices.size(); i += 7) {
+        const Vec3& p = r.mesh.vertices[i];
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const Face& f : input.faces)
+            nearest = std::min(nearest, (closestOnTriangle(p, input.vertices[f[0]], input.vertices[f[1]], input.vertices[f[2]]) - p).norm());
+        lower = std::max(lower, nearest);
+    }
+    EXPECT_GE(r.hausdorff + 1e-9, lower);  // the samples include the output's vertices
+    EXPECT_LT(r.hausdorff, 0.15);
+    EXPECT_LT(r.after.slivers, 0.01);
+}
+
+TEST(Remesh, AnOpenSurfaceKeepsItsRim) {
+    TriMesh square;
+    square.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+    square.faces = {{0, 2, 1}, {0, 3, 2}};
+    const RemeshResult r = remeshForSimulation(square, {.targetEdge = 0.1}, "square");
+    EXPECT_EQ(r.featureEdges, 4u);  // the border
+    EXPECT_GT(r.after.faces, 150u);
+    std::size_t onRim = 0;
+    for (const Vec3& v : r.mesh.vertices) {
+        EXPECT_NEAR(v.y(), 0.0, 1e-12);
+        EXPECT_GE(v.x(), -1e-12);
+        EXPECT_LE(v.x(), 1 + 1e-12);
+        EXPECT_GE(v.z(), -1e-12);
+        EXPECT_LE(v.z(), 1 + 1e-12);
+        onRim += (std::min({v.x(), 1 - v.x(), v.z(), 1 - v.z()}) < 1e-12) ? 1 : 0;
+    }
+    EXPECT_GE(onRim, 32u);  // the rim split into edges of at most 4/3 of the target: 8 or more a side
+    for (const Vec3& corner : square.vertices) {
+        const bool kept = std::any_of(r.mesh.vertices.begin(), r.mesh.vertices.end(), [&](const Vec3& v) { return (v - corner).norm() < 1e-12; });
+        EXPECT_TRUE(kept) << corner.transpose();
+    }
+}
+
+TEST(Remesh, MeasuredQualityMatchesHandCountedTriangles) {
+    TriMesh mesh;
+    mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {10, 0.5, 0}};
+    mesh.faces = {{0, 1, 2}, {1, 3, 2}};
+    const MeshQuality q = measureQuality(mesh);
+    EXPECT_EQ(q.faces, 2u);
+    EXPECT_DOUBLE_EQ(q.slivers, 0.5);  // the long triangle has an angle of ~5.7 degrees
+    // The long triangle's angle at (10, 0.5, 0), between the directions to (0, 1, 0) and (1, 0, 0).
+    const Vec3 tip(10, 0.5, 0);
+    const double sliverAngle = std::acos((Vec3(0, 1, 0) - tip).normalized().dot((Vec3(1, 0, 0) - tip).normalized())) * 180 / M_PI;
+    EXPECT_NEAR(q.minAngle, sliverAngle, 1e-9);
+    EXPECT_DOUBLE_EQ(q.minEdge, 1.0);
+    EXPECT_DOUBLE_EQ(q.maxEdge, (tip - Vec3(0, 1, 0)).norm());
+}
+
+TEST(Remesh, BadOptionsAreErrors) {
+    const TriMesh mesh = makeIcoSphere(1.0, 1);
+    for (double edge : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), 1e-5}) {
+        try {
+            remeshForSimulation(mesh, {.targetEdge = edge}, "part.obj");
+            ADD_FAILURE() << "accepted edge " << edge;
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.source(), "part.obj");
+            EXPECT_NE(e.problem().find("target edge"), std::string::npos) << e.problem();
+        }
+    }
+    EXPECT_THROW(remeshForSimulation(mesh, {.targetEdge = 0.1, .iterations = 0}, "part.obj"), InputError);
+    EXPECT_THROW(remeshForSimulation(mesh, {.targetEdge = 0.1, .featureAngle = 180.0}, "part.obj"), InputError);
+}
+
+}  // namespace
+}  // namespace flexfit
