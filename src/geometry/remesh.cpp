@@ -142,7 +142,25 @@ MeshQuality measureQuality(const TriMesh& mesh) {
     return q;
 }
 
+namespace {
+
+RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, const std::string& source);
+
+}  // namespace
+
 RemeshResult remeshForSimulation(const TriMesh& mesh, const RemeshOptions& options, const std::string& source) {
+    // CGAL reports a violated precondition by throwing (CGAL::Failure_exception): it becomes the
+    // user's error, naming the file, never an abort.
+    try {
+        return remeshChecked(mesh, options, source);
+    } catch (const CGAL::Failure_exception& e) {
+        throw InputError(source, 0, "remesh: CGAL could not remesh this surface (" + e.message() + ")");
+    }
+}
+
+namespace {
+
+RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, const std::string& source) {
     RemeshResult r;
     r.diagonal = boundingBox(mesh).diagonal().norm();
     if (!(options.targetEdge > 0.0) || !std::isfinite(options.targetEdge))
@@ -180,5 +198,7 @@ RemeshResult remeshForSimulation(const TriMesh& mesh, const RemeshOptions& optio
     validateMesh(r.mesh, source);
     return r;
 }
+
+}  // namespace
 
 }  // namespace flexfit

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <random>
 
@@ -161,6 +162,42 @@ TEST(MeshRepair, DegenerateDuplicateAndUnreferencedAloneAndMixed) {
                                   (expected.flippedFaces > 0) + (expected.unreferencedVertices > 0);
         EXPECT_EQ(r.warnings().size(), kinds)
             << mask;
+    }
+}
+
+// Random soups over a few vertices (many repeated, duplicate, degenerate and non-manifold
+// faces): the repair either leaves a mesh validateMesh accepts, wound consistently wherever two
+// faces share an edge and nothing else does, or says that no face is left. Never anything else.
+TEST(MeshRepair, RandomSoupsComeOutValidOrRefused) {
+    std::mt19937 random(11);
+    std::uniform_int_distribution<Index> pick(0, 11);
+    std::uniform_int_distribution<int> coordinate(-2, 2);
+    for (int trial = 0; trial < 300; ++trial) {
+        TriMesh mesh;
+        for (int v = 0; v < 12; ++v) mesh.vertices.push_back(Vec3(coordinate(random), coordinate(random), coordinate(random)));
+        const int faces = 1 + trial % 30;
+        for (int f = 0; f < faces; ++f) mesh.faces.push_back({pick(random), pick(random), pick(random)});
+        const std::size_t before = mesh.faces.size();
+        try {
+            const MeshRepairs r = repairMesh(mesh, -1.0, "soup");
+            EXPECT_NO_THROW(validateMesh(mesh, "repaired")) << trial;
+            EXPECT_EQ(mesh.faces.size() + r.degenerateFaces + r.duplicateFaces, before) << trial;
+            if (r.nonOrientablePieces == 0) {
+                // Every edge two faces share is run once each way (edges of three or more faces excepted).
+                std::map<std::pair<Index, Index>, int> runs;
+                for (const Face& f : mesh.faces)
+                    for (int k = 0; k < 3; ++k) ++runs[{f[k], f[(k + 1) % 3]}];
+                for (const auto& [edge, count] : runs) {
+                    const auto back = runs.find({edge.second, edge.first});
+                    const int shared = count + (back == runs.end() ? 0 : back->second);
+                    if (shared == 2) {
+                        EXPECT_EQ(count, 1) << trial;
+                    }
+                }
+            }
+        } catch (const InputError& e) {
+            EXPECT_NE(e.problem().find("no face is left"), std::string::npos) << trial << ": " << e.problem();
+        }
     }
 }
 

@@ -147,6 +147,18 @@ TEST(Remesh, MeasuredQualityMatchesHandCountedTriangles) {
     EXPECT_DOUBLE_EQ(q.maxEdge, (tip - Vec3(0, 1, 0)).norm());
 }
 
+TEST(Remesh, ANonManifoldInputIsSplitIntoASurfaceFirst) {
+    // Two tetrahedra sharing one edge (0 1): an edge of four faces. CGAL's soup orientation
+    // duplicates the shared vertices, and each tetrahedron is remeshed on its own.
+    TriMesh mesh;
+    mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, 0.3, 1}, {0.5, -1, 0}, {0.5, -0.3, -1}};
+    mesh.faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}, {0, 1, 4}, {0, 5, 1}, {0, 4, 5}, {1, 5, 4}};
+    const RemeshResult r = remeshForSimulation(mesh, {.targetEdge = 0.1}, "bowtie");
+    EXPECT_GT(r.after.faces, 200u);
+    EXPECT_NO_THROW(validateMesh(r.mesh, "output"));
+    EXPECT_LT(r.hausdorffShare(), 0.05);
+}
+
 TEST(Remesh, BadOptionsAreErrors) {
     const TriMesh mesh = makeIcoSphere(1.0, 1);
     for (double edge : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), 1e-5}) {
