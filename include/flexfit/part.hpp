@@ -63,6 +63,9 @@ struct ZoneSettings {
     double restSpeed = 1e-3;         // masses slower than this are at rest
     int retireCheckInterval = 16;    // steps between retirement checks of an unloaded zone
     bool fullSweepWhenComplete = true;  // step a region covering every mass with stepFullModel
+    // Step a region with stepFullModel, its other masses held at rest, whenever that costs less
+    // (fullStepCostsLess): a part never costs much more than its whole model.
+    bool fullStepWhenCheaper = true;
 };
 
 struct PartSettings {
@@ -191,6 +194,7 @@ private:
     IndexSet changed_;                        // (V) masses changed since clearChangedMasses()
     // Every mass changed (a step moved them all): O(1) instead of marking each.
     bool allChanged_ = false;
+    bool fullModelStepped_ = false;  // the last advance() ran the full model's step (which checked every mass)
     std::vector<Index> allMasses_;  // 0 .. V-1, built the first time every mass moves
 };
 

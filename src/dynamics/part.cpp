@@ -223,10 +223,9 @@ void Part::applyForce(Index mass, const Vec3& worldForce) {
 
 void Part::step(StepCounters* counters) {
     const double start = state_.time;
-    // The full step checks every mass itself (stepFullModel); the region step's are checked here.
-    const bool fullStep = region_.coversEveryMass() && settings_.zones.fullSweepWhenComplete;
     advance({settings_.simulation.timeStep, settings_.simulation.gravity}, counters);
-    if (!fullStep) detail::checkMassesFinite(*model_, settings_.simulation, state_, movingMasses(), std::nullopt, start);
+    // The full step checks every mass itself (stepFullModel); the region step's are checked here.
+    if (!fullModelStepped_) detail::checkMassesFinite(*model_, settings_.simulation, state_, movingMasses(), std::nullopt, start);
     retireRestingZones();
 }
 
@@ -239,10 +238,15 @@ void Part::advance(const StepContext& context, StepCounters* counters) {
     SimulationSettings s = settings_.simulation;
     s.timeStep = context.timeStep;
     s.gravity = pose_.rotateInverse(context.gravity);  // world gravity seen in the part frame
+    fullModelStepped_ = true;
     if (region_.coversEveryMass() && settings_.zones.fullSweepWhenComplete)
         stepFullModel(*model_, s, {}, state_, counters);
-    else
+    else if (settings_.zones.fullStepWhenCheaper && fullStepCostsLess(*model_, region_.springs().size(), region_.masses().size()))
+        stepRegionByFullModel(*model_, s, region_, state_, counters);
+    else {
+        fullModelStepped_ = false;
         stepActiveRegion(*model_, s, region_, state_, counters);
+    }
     if (region_.coversEveryMass())
         markAllChanged();
     else

@@ -210,6 +210,32 @@ TEST(Part, WholeMeshZoneMatchesFullDeformableModel) {
     EXPECT_NE(a.state().positions, model->restPositions);
 }
 
+TEST(Part, ALargeRegionTakesTheCheaperFullStepWithTheSameTrajectory) {
+    // Zones over most of the heart: the full step (spring blocks) with the other masses held
+    // costs less than the region step, and gives its trajectory up to the summation order.
+    const auto model = buildPartModel(makeHeart());
+    PartSettings region = zoneSettings(), cheaper = zoneSettings();
+    region.zones.fullStepWhenCheaper = false;
+    Part a(model, region), b(model, cheaper);
+    for (Part* p : {&a, &b})
+        for (Index m : {Index(0), Index(3000), Index(6000)}) p->openZone(ZoneSeed::mass(m), 22);
+    ASSERT_FALSE(b.region().coversEveryMass());
+    ASSERT_TRUE(fullStepCostsLess(*model, b.computedSprings().size(), b.movingMasses().size()));
+    StepCounters first;
+    b.step(&first);
+    a.step();
+    EXPECT_EQ(first.springsEvaluated, model->springCount());  // the whole model's step
+    for (int i = 0; i < 300; ++i) {  // zones that are not loaded retire: the choice follows
+        if (i < 100)
+            for (Part* p : {&a, &b}) p->applyForce(3000, Vec3(0.5, 0.2, 0));
+        a.step();
+        b.step();
+    }
+    EXPECT_LT(maxRelativeDifference(a.state().positions, b.state().positions), 1e-12);
+    EXPECT_LT(maxRelativeDifference(a.state().velocities, b.state().velocities), 1e-9);
+    EXPECT_NE(a.state().positions, model->restPositions);
+}
+
 TEST(Part, PartialRegionMatchesFullModelWithPinnedMasses) {
     // Independent reference: the full model in which every mass outside the region is pinned
     // by an enormous mass. Region masses must follow the same trajectory.

@@ -1,0 +1,66 @@
+// Zones at every coverage against the whole model (issue 16: a rigid-deformable part never
+// costs more than its whole model), side by side in one run, on torus2 and the heart (spring
+// blocks) and the heart with its vertices shuffled (the per-mass sweep). Six zones at mass
+// seeds spread over the mesh, at levels from 2 to 24; each step loads one mass. With the
+// cheaper path (the default) a large region is stepped by the full step with the other masses
+// held; without it, always by the region step. The counter `coverage` is the share of the
+// model's springs the region computes.
+#include "flexfit/flexfit.hpp"
+#include "shuffled_mesh.hpp"
+
+#include <benchmark/benchmark.h>
+
+namespace {
+
+using namespace flexfit;
+
+// 0: torus2, 1: heart, 2: the heart shuffled.
+const std::shared_ptr<const PartModel>& model(int which) {
+    static const std::shared_ptr<const PartModel> models[3] = {buildPartModel(makeTorus2()), buildPartModel(makeHeart()),
+                                                               buildPartModel(flexfit::testing::shuffledVertices(makeHeart(), 3))};
+    return models[which];
+}
+const char* kNames[3] = {"torus2", "heart", "heart shuffled"};
+
+PartSettings settings(PartMode mode, bool cheaper) {
+    PartSettings s;
+    s.mode = mode;
+    s.simulation.timeStep = 1e-3;
+    s.zones.retireCheckInterval = 1 << 30;  // the zones stay: the coverage is what is measured
+    s.zones.fullStepWhenCheaper = cheaper;
+    return s;
+}
+
+void step(benchmark::State& state, Part& part) {
+    for (auto _ : state) {
+        part.applyForce(0, Vec3(0, 0.05, 0));
+        part.step();
+    }
+    state.SetLabel(kNames[state.range(0)]);
+    state.counters["coverage"] = double(part.computedSprings().size()) / double(part.model().springCount());
+}
+
+void BM_Whole(benchmark::State& state) {
+    Part part(model(int(state.range(0))), settings(PartMode::FullDeformable, true));
+    step(state, part);
+}
+
+void BM_Zones(benchmark::State& state) {
+    const auto& m = model(int(state.range(0)));
+    Part part(m, settings(PartMode::RigidDeformable, state.range(2) != 0));
+    for (Index seed = 0; seed < m->massCount(); seed += Index(m->massCount() / 6)) part.openZone(ZoneSeed::mass(seed), int(state.range(1)));
+    step(state, part);
+}
+
+void Coverages(benchmark::internal::Benchmark* b) {
+    for (int mesh : {0, 1, 2})
+        for (int level : {2, 4, 8, 12, 16, 24})
+            for (int cheaper : {1, 0}) b->Args({mesh, level, cheaper});
+}
+
+BENCHMARK(BM_Whole)->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK(BM_Zones)->Apply(Coverages);
+
+}  // namespace
+
+BENCHMARK_MAIN();
