@@ -50,11 +50,11 @@ Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& 
     // Brute force over a barycentric grid refined around the best sample: independent of the
     // library's closest-point code, accurate to ~1e-6 of the triangle.
     Vec3 best = a;
-    double bestU = 0, bestV = 0, step = 0.05;
+    double bestU = 0, bestV = 0, step = 0.1;
     for (int round = 0; round < 6; ++round) {
         const double u0 = bestU, v0 = bestV;
-        for (int i = -20; i <= 20; ++i)
-            for (int j = -20; j <= 20; ++j) {
+        for (int i = -10; i <= 10; ++i)
+            for (int j = -10; j <= 10; ++j) {
                 const double u = std::clamp(u0 + i * step, 0.0, 1.0), v = std::clamp(v0 + j * step, 0.0, 1.0 - u);
                 const Vec3 x = a + u * (b - a) + v * (c - a);
                 if ((x - p).squaredNorm() < (best - p).squaredNorm()) {
@@ -70,15 +70,15 @@ Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& 
 
 TEST(Remesh, SliversBecomeNearUniformTrianglesOnTheSameBox) {
     const Vec3 h(1.0, 0.5, 0.75);
-    const TriMesh input = sliverBox(h, 24);
+    const TriMesh input = sliverBox(h, 12);
     ASSERT_NO_THROW(validateMesh(input, "input"));
-    const RemeshResult r = remeshForSimulation(input, {.targetEdge = 0.1, .iterations = 5, .featureAngle = 40.0}, "box");
+    const RemeshResult r = remeshForSimulation(input, {.targetEdge = 0.15, .iterations = 5, .featureAngle = 40.0}, "box");
     EXPECT_GT(r.before.slivers, 0.9);  // the fans are nearly all slivers
     EXPECT_LT(r.before.minAngle, 3.0);
     EXPECT_LT(r.after.slivers, 0.01);
-    EXPECT_GT(r.after.faces, 1000u);
+    EXPECT_GT(r.after.faces, 500u);
     EXPECT_LT(r.after.edgeSpread, 0.3);
-    EXPECT_NEAR(r.after.meanEdge, 0.1, 0.03);
+    EXPECT_NEAR(r.after.meanEdge, 0.15, 0.045);
     EXPECT_EQ(r.featureEdges, 12u);  // the box's edges; the diagonals are flat
     // Every vertex on the box's surface; its 8 corners kept exactly where they were.
     for (const Vec3& v : r.mesh.vertices) EXPECT_NEAR(distanceToBoxSurface(v, h), 0.0, 1e-9) << v.transpose();
@@ -97,7 +97,7 @@ TEST(Remesh, HausdorffDistanceIsAtLeastTheFarthestVertexAndWithinTheEdge) {
     const TriMesh input = makeIcoSphere(1.0, 1);
     const RemeshResult r = remeshForSimulation(input, {.targetEdge = 0.15}, "sphere");
     double lower = 0.0;
-    for (std::size_t i = 0; i < r.mesh.vertices.size(); i += 7) {
+    for (std::size_t i = 0; i < r.mesh.vertices.size(); i += 25) {
         const Vec3& p = r.mesh.vertices[i];
         double nearest = std::numeric_limits<double>::infinity();
         for (const Face& f : input.faces)
