@@ -144,22 +144,6 @@ MeshQuality measureQuality(const TriMesh& mesh) {
 
 namespace {
 
-RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, const std::string& source);
-
-}  // namespace
-
-RemeshResult remeshForSimulation(const TriMesh& mesh, const RemeshOptions& options, const std::string& source) {
-    // CGAL reports a violated precondition by throwing (CGAL::Failure_exception): it becomes the
-    // user's error, naming the file, never an abort.
-    try {
-        return remeshChecked(mesh, options, source);
-    } catch (const CGAL::Failure_exception& e) {
-        throw InputError(source, 0, "remesh: CGAL could not remesh this surface (" + e.message() + ")");
-    }
-}
-
-namespace {
-
 RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, const std::string& source) {
     RemeshResult r;
     r.diagonal = boundingBox(mesh).diagonal().norm();
@@ -200,5 +184,15 @@ RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, co
 }
 
 }  // namespace
+
+RemeshResult remeshForSimulation(const TriMesh& mesh, const RemeshOptions& options, const std::string& source) {
+    // CGAL reports a violated precondition by throwing (CGAL::Failure_exception): it becomes the
+    // user's error, naming the file, never an abort.
+    try {
+        return remeshChecked(mesh, options, source);
+    } catch (const CGAL::Failure_exception& e) {
+        throw InputError(source, 0, "remesh: CGAL could not remesh this surface (" + e.message() + ")");
+    }
+}
 
 }  // namespace flexfit

@@ -51,7 +51,8 @@ MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSou
         result.collapsedFaces = weldVertices(mesh, options.weldTolerance.value_or(0.0));
         result.weldedVertices = before - mesh.vertices.size();
     }
-    const MeshSourceLines& where = welds ? MeshSourceLines{} : lines;
+    const MeshSourceLines none;
+    const MeshSourceLines& where = welds ? none : lines;
     const double tolerance = options.weldTolerance.value_or(-1.0);  // < 0: near-duplicates
     if (options.repair)
         result.repairs = repairMesh(mesh, tolerance, source, where);
