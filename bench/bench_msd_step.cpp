@@ -38,7 +38,7 @@ void setCounters(benchmark::State& state, std::size_t springs) {
 void BM_FlexfitFullStep(benchmark::State& state) {
     const TriMesh& mesh = meshByIndex(int(state.range(0)));
     state.SetLabel(mesh.name);
-    const auto model = flexfit::buildPartModel(mesh, {flexfit::Material::elastic(), 1.0, {}, {}});
+    const auto model = flexfit::buildPartModel(mesh, {flexfit::Material::elastic(), 1.0, {}, {}, {}});
     const flexfit::SimulationSettings settings = benchSettings();
     flexfit::PartState partState = flexfit::PartState::atRest(*model);
     for (auto _ : state) {
@@ -69,7 +69,7 @@ void runDetailStep(benchmark::State& state, bool sweep, flexfit::detail::BlockKe
         state.SkipWithError("kernel not supported by this CPU");
         return;
     }
-    const auto model = flexfit::buildPartModel(mesh, {flexfit::Material::elastic(), 1.0, {}, {}});
+    const auto model = flexfit::buildPartModel(mesh, {flexfit::Material::elastic(), 1.0, {}, {}, {}});
     const auto update = flexfit::detail::MassUpdate::from(benchSettings());
     flexfit::PartState partState = flexfit::PartState::atRest(*model);
     const flexfit::detail::FlushDenormals flush;  // as stepFullModel

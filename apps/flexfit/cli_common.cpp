@@ -109,9 +109,9 @@ void writePartsObj(const std::filesystem::path& path, const std::string& header,
     std::vector<Vec3> world;
     for (const NamedPart& named : parts) {
         obj << "o " << named.name << "\n";
-        named.part->worldPositions(world);
+        named.part->drawnWorldPositions(world);
         for (const Vec3& v : world) obj << fmt::format("v {:.9g} {:.9g} {:.9g}\n", v.x(), v.y(), v.z());
-        for (const Face& f : named.part->model().mesh.faces) obj << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
+        for (const Face& f : named.part->model().drawnMesh().faces) obj << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
         base += world.size();
     }
     writeTextFile(path, obj.str());

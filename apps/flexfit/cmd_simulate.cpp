@@ -40,8 +40,8 @@ public:
     }
     void observe(const Part& part) {
         while (next_ < times_.size() && part.time() + 1e-12 >= times_[next_]) {
-            TriMesh mesh = model_.mesh;
-            part.worldPositions(mesh.vertices);
+            TriMesh mesh = model_.drawnMesh();
+            part.drawnWorldPositions(mesh.vertices);
             const std::string path = fmt::format("{}_{:.4f}.obj", prefix_, times_[next_]);
             writeObj(mesh, files_.add(path));
             written_.push_back(fmt::format("wrote {} (t = {:.4f} s)", path, part.time()));

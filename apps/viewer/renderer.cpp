@@ -167,7 +167,7 @@ std::size_t Renderer::addPart(const Part& part) {
         glVertexAttribPointer(k, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
     }
     std::vector<unsigned> indices;
-    for (const Face& f : part.model().mesh.faces) indices.insert(indices.end(), {f[0], f[1], f[2]});
+    for (const Face& f : part.model().drawnMesh().faces) indices.insert(indices.end(), {f[0], f[1], f[2]});
     glGenBuffers(1, &m.indices);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m.indices);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(unsigned)), indices.data(), GL_STATIC_DRAW);
@@ -177,9 +177,9 @@ std::size_t Renderer::addPart(const Part& part) {
     return meshes_.size() - 1;
 }
 
-void Renderer::upload(std::size_t mesh, const Part& part, const std::vector<Vec3>& normals, const std::vector<Vec3>& colours) {
+void Renderer::upload(std::size_t mesh, const ShownSurface& surface) {
     const Mesh& m = meshes_[mesh];
-    const std::vector<Vec3>* sources[] = {&part.state().positions, &normals, &colours};
+    const std::vector<Vec3>* sources[] = {&surface.positions, &surface.normals, &surface.colours};
     const GLuint buffers[] = {m.positions, m.normals, m.colours};
     for (int k = 0; k < 3; ++k) {
         const std::vector<float> data = packed(*sources[k]);

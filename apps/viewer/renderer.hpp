@@ -34,7 +34,7 @@ public:
     // drops them all (a new scene); indices restart at 0.
     std::size_t addPart(const Part& part);
     void clearParts();
-    void upload(std::size_t mesh, const Part& part, const std::vector<Vec3>& normals, const std::vector<Vec3>& colours);
+    void upload(std::size_t mesh, const ShownSurface& surface);
 
     void begin(const Camera& camera, const Vec3& background);
     void drawPart(std::size_t mesh, const Pose& pose);

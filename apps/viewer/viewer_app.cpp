@@ -207,6 +207,7 @@ void App::drawScene() {
     renderer_->begin(camera_, kBackground);
     std::vector<int> depths;
     std::vector<Vec3> colours;
+    ShownSurface shown;
     for (BodyId id = 0; id < w.bodyCount(); ++id) {
         const Part& part = w.part(id);
         const bool changed = normals_[id].update(part);
@@ -223,7 +224,8 @@ void App::drawScene() {
             for (std::size_t m = 0; m < depths.size(); ++m)
                 if (depths[m] >= 0) colours[m] = zoneColour(depths[m], deepest);
         }
-        renderer_->upload(id, part, normals_[id].normals(), colours);
+        showPart(part, normals_[id].normals(), colours, shown);
+        renderer_->upload(id, shown);
         dirty_[id] = false;  // while masses move (and the frame after), update() reports the change
         renderer_->drawPart(id, part.pose());
     }

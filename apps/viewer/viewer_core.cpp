@@ -1,5 +1,7 @@
 #include "viewer_core.hpp"
 
+#include "flexfit/surface_embedding.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -154,15 +156,32 @@ namespace {
 Vec3 faceNormalTimesTwoArea(std::span<const Vec3> x, const Face& f) { return (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]); }
 }  // namespace
 
-std::vector<Vec3> SurfaceNormals::computeAll(const Part& part) {
-    const auto& x = part.state().positions;
+std::vector<Vec3> vertexNormals(std::span<const Face> faces, std::span<const Vec3> x) {
     std::vector<Vec3> n(x.size(), Vec3::Zero());
-    for (const Face& f : part.model().mesh.faces) {
+    for (const Face& f : faces) {
         const Vec3 fn = faceNormalTimesTwoArea(x, f);
         for (Index v : f) n[v] += fn;
     }
     for (Vec3& v : n) v = v.norm() > 0.0 ? Vec3(v.normalized()) : Vec3(Vec3::UnitY());
     return n;
+}
+
+std::vector<Vec3> SurfaceNormals::computeAll(const Part& part) {
+    return vertexNormals(part.model().mesh.faces, part.state().positions);
+}
+
+void showPart(const Part& part, const std::vector<Vec3>& massNormals, const std::vector<Vec3>& massColours, ShownSurface& out) {
+    const auto& drawn = part.model().drawn;
+    if (!drawn) {
+        out.positions = part.state().positions;
+        out.normals = massNormals;
+        out.colours = massColours;
+        return;
+    }
+    part.drawnPositions(out.positions);
+    out.normals = vertexNormals(drawn->mesh.faces, out.positions);
+    out.colours.resize(out.positions.size());
+    for (std::size_t v = 0; v < out.colours.size(); ++v) out.colours[v] = massColours[drawn->nearestMass[v]];
 }
 
 std::span<const Index> MovedMasses::update(const Part& part) {

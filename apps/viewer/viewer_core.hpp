@@ -113,6 +113,20 @@ private:
     std::size_t recomputed_ = 0;
 };
 
+// Per-vertex unit normals (area-weighted face normals; +y where they cancel).
+std::vector<Vec3> vertexNormals(std::span<const Face> faces, std::span<const Vec3> positions);
+
+// What the renderer draws of a part, in its frame: the simulated masses, or the part's own drawn
+// mesh (PartModel::drawn, a remeshed part drawn as the user's file) carried by them. Colours
+// come per mass; a drawn vertex takes its nearest mass's colour. A drawn mesh is recomputed
+// whole (O(its vertices)) each time the part's shape changes.
+struct ShownSurface {
+    std::vector<Vec3> positions, normals, colours;
+};
+// `massNormals`: the simulated surface's normals (SurfaceNormals), used when the part has no
+// drawn mesh of its own.
+void showPart(const Part& part, const std::vector<Vec3>& massNormals, const std::vector<Vec3>& massColours, ShownSurface& out);
+
 // A part's face hierarchy for drawing, kept in step with the part's shape by the viewer: the
 // world refits its own hierarchies only when a face query needs them (never for a part met
 // only by point-shell queries, or alone), and drawing must not change the world. Built like the

@@ -17,6 +17,7 @@
 #include "flexfit/mesh.hpp"
 #include "flexfit/mesh_io.hpp"
 #include "flexfit/mesh_repair.hpp"
+#include "flexfit/surface_embedding.hpp"
 #include "flexfit/remesh.hpp"
 #include "flexfit/names.hpp"
 #include "flexfit/part.hpp"

@@ -165,6 +165,10 @@ public:
     const PartState& state() const { return state_; }  // part frame; non-moving masses at rest
     Vec3 worldPosition(Index mass) const { return pose_.apply(state_.positions[mass]); }
     void worldPositions(std::vector<Vec3>& out) const;
+    // The vertices of model().drawnMesh() as the part looks now, in the part frame / the world
+    // (the mass positions themselves when the model has no drawn mesh of its own).
+    void drawnPositions(std::vector<Vec3>& out) const;
+    void drawnWorldPositions(std::vector<Vec3>& out) const;
     // Depth of each mass in the zones covering it (minimum; 0 = seed), -1 when not moving.
     void zoneDepths(std::vector<int>& out) const;
     double time() const { return state_.time; }

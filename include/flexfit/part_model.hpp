@@ -18,7 +18,8 @@
 
 namespace flexfit {
 
-struct SpringBlocks;  // the full step's vector layout of the springs (internal)
+struct SpringBlocks;      // the full step's vector layout of the springs (internal)
+struct SurfaceEmbedding;  // a drawn mesh carried by the simulation surface (surface_embedding.hpp)
 
 // Spring constants: stiffness k (kg/s^2) and damping b (kg/s).
 struct Material {
@@ -39,6 +40,10 @@ struct PartModelSettings {
     double vertexMass = 1.0;                  // kg, for every vertex unless vertexMasses is set
     std::vector<double> vertexMasses;         // (V) optional per-vertex masses
     std::vector<Material> springMaterials;    // (E) optional per-spring constants, Topology order
+    // Optional: the mesh drawn and exported instead of the simulated one (the user's own, when the
+    // part simulates on a remeshed surface), embedded in it (surface_embedding.hpp). Empty: the
+    // simulation mesh is drawn.
+    TriMesh drawnMesh;
 };
 
 struct PartModel {
@@ -65,6 +70,10 @@ struct PartModel {
     std::shared_ptr<const SpringBlocks> springBlocks;
     // Whether the full step runs by spring blocks (else by a per-mass sweep).
     bool hasSpringBlocks() const;
+    // The drawn mesh tied to the simulation surface; null when the simulation mesh is drawn.
+    std::shared_ptr<const SurfaceEmbedding> drawn;
+    // What the part looks like at rest: the drawn mesh, else the simulation mesh.
+    const TriMesh& drawnMesh() const;
 
     std::size_t massCount() const { return mass.size(); }
     std::size_t springCount() const { return springA.size(); }
@@ -73,7 +82,7 @@ struct PartModel {
 
 // Builds a model from a validated mesh. Throws InputError (source "part model settings") for
 // non-positive or non-finite masses and constants, or per-vertex / per-spring arrays of the
-// wrong size.
+// wrong size; a drawn mesh must pass validateMesh.
 std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings = {});
 
 }  // namespace flexfit

@@ -13,10 +13,6 @@ namespace {
 // Nodes computed when the field is built: those within this many cells of a face's box.
 constexpr int kBandCells = 6;
 
-double squaredDistance(const Aabb& box, const Vec3& p) {
-    return (box.min - p).cwiseMax(p - box.max).cwiseMax(0.0).squaredNorm();
-}
-
 double angleAt(const Vec3& corner, const Vec3& u, const Vec3& v) {
     return std::atan2((u - corner).cross(v - corner).norm(), (u - corner).dot(v - corner));
 }
@@ -119,41 +115,11 @@ void SignedDistanceField::fill(Grid& grid, int i, int j, int k) const {
 }
 
 SignedDistanceField::Sample SignedDistanceField::query(const Vec3& p) const {
-    double best = std::numeric_limits<double>::infinity();
-    Vec3 closest = p;
-    TriangleFeature closestFeature = TriangleFeature::Interior;
-    Index bestFace = 0;
-    const auto& nodes = bvh_.nodes();
-    thread_local std::vector<std::int32_t> stack;
-    stack.assign(1, 0);
-    while (!stack.empty()) {
-        const auto& node = nodes[std::size_t(stack.back())];
-        stack.pop_back();
-        if (squaredDistance(node.volume, p) >= best) continue;
-        if (node.isLeaf()) {
-            const Face& f = faces_[node.item];
-            TriangleFeature feature;
-            const Vec3 c = closestPointOnTriangle(p, {vertices_[f[0]], vertices_[f[1]], vertices_[f[2]]}, &feature);
-            const double d2 = (p - c).squaredNorm();
-            if (d2 < best) {
-                best = d2;
-                closest = c;
-                closestFeature = feature;
-                bestFace = node.item;
-            }
-            continue;
-        }
-        const double dl = squaredDistance(nodes[std::size_t(node.left)].volume, p);
-        const double dr = squaredDistance(nodes[std::size_t(node.right)].volume, p);
-        // Nearer child on top of the stack.
-        if (dl < dr) {
-            stack.push_back(node.right);
-            stack.push_back(node.left);
-        } else {
-            stack.push_back(node.left);
-            stack.push_back(node.right);
-        }
-    }
+    const ClosestFace nearest = closestFace(bvh_, vertices_, faces_, p);
+    const Index bestFace = nearest.face;
+    const TriangleFeature closestFeature = nearest.feature;
+    const Vec3& closest = nearest.point;
+    const double best = nearest.squaredDistance;
     const Face& f = faces_[bestFace];
     // Pseudonormal of the closest feature (TriangleFeature numbers corners 0..2, edges 3..5).
     const int feature = int(closestFeature);

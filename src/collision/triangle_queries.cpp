@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace flexfit {
 namespace {
@@ -199,6 +200,46 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
     for (int i = 0; i < points.count; ++i) point += points.points[std::size_t(i)];
     point /= double(points.count);
     return TriangleContact{point, bestAxis, bestOverlap};
+}
+
+namespace {
+double squaredDistance(const Aabb& box, const Vec3& p) {
+    return (box.min - p).cwiseMax(p - box.max).cwiseMax(0.0).squaredNorm();
+}
+}  // namespace
+
+ClosestFace closestFace(const Bvh<Aabb>& faceTree, std::span<const Vec3> vertices, std::span<const Face> faces, const Vec3& p) {
+    ClosestFace best;
+    best.squaredDistance = std::numeric_limits<double>::infinity();
+    best.point = p;
+    const auto& nodes = faceTree.nodes();
+    if (nodes.empty()) return best;
+    thread_local std::vector<std::int32_t> stack;
+    stack.assign(1, 0);
+    while (!stack.empty()) {
+        const auto& node = nodes[std::size_t(stack.back())];
+        stack.pop_back();
+        if (squaredDistance(node.volume, p) >= best.squaredDistance) continue;
+        if (node.isLeaf()) {
+            const Face& f = faces[node.item];
+            TriangleFeature feature;
+            const Vec3 c = closestPointOnTriangle(p, {vertices[f[0]], vertices[f[1]], vertices[f[2]]}, &feature);
+            const double d2 = (p - c).squaredNorm();
+            if (d2 < best.squaredDistance) best = {node.item, c, feature, d2};
+            continue;
+        }
+        const double dl = squaredDistance(nodes[std::size_t(node.left)].volume, p);
+        const double dr = squaredDistance(nodes[std::size_t(node.right)].volume, p);
+        // Nearer child on top of the stack.
+        if (dl < dr) {
+            stack.push_back(node.right);
+            stack.push_back(node.left);
+        } else {
+            stack.push_back(node.left);
+            stack.push_back(node.right);
+        }
+    }
+    return best;
 }
 
 }  // namespace flexfit

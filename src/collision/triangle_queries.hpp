@@ -12,6 +12,7 @@
 // as the contact point.
 #pragma once
 
+#include "flexfit/bvh.hpp"
 #include "flexfit/core.hpp"
 
 #include <cstdint>
@@ -29,6 +30,16 @@ enum class TriangleFeature : std::uint8_t { CornerA, CornerB, CornerC, EdgeAB, E
 
 // Closest point of the (closed) triangle to p; `feature`, when given, receives its region.
 Vec3 closestPointOnTriangle(const Vec3& p, const Triangle& t, TriangleFeature* feature = nullptr);
+
+// The closest point to p on a mesh whose faces (by index) a box hierarchy holds: depth-first,
+// nearer child first, subtrees pruned by their box's distance. Ties keep the first face found.
+struct ClosestFace {
+    Index face = 0;
+    Vec3 point = Vec3::Zero();
+    TriangleFeature feature = TriangleFeature::Interior;
+    double squaredDistance = 0.0;
+};
+ClosestFace closestFace(const Bvh<Aabb>& faceTree, std::span<const Vec3> vertices, std::span<const Face> faces, const Vec3& p);
 
 struct TriangleContact {
     Vec3 point;   // on the intersection

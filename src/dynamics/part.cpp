@@ -1,4 +1,5 @@
 #include "flexfit/part.hpp"
+#include "flexfit/surface_embedding.hpp"
 
 #include "divergence.hpp"
 #include "model/kring.hpp"
@@ -317,6 +318,21 @@ void Part::worldPositions(std::vector<Vec3>& out) const {
     out.resize(model_->massCount());
     const Eigen::Matrix3d r = pose_.rotation.toRotationMatrix();
     for (std::size_t i = 0; i < out.size(); ++i) out[i] = r * state_.positions[i] + pose_.translation;
+}
+
+void Part::drawnPositions(std::vector<Vec3>& out) const {
+    if (!model_->drawn) {
+        out.assign(state_.positions.begin(), state_.positions.end());
+        return;
+    }
+    embeddedPositions(*model_->drawn, model_->mesh.faces, state_.positions, out);
+}
+
+void Part::drawnWorldPositions(std::vector<Vec3>& out) const {
+    if (!model_->drawn) return worldPositions(out);
+    drawnPositions(out);
+    const Eigen::Matrix3d r = pose_.rotation.toRotationMatrix();
+    for (Vec3& p : out) p = r * p + pose_.translation;
 }
 
 void Part::zoneDepths(std::vector<int>& out) const {

@@ -194,7 +194,14 @@ std::optional<RemeshOptions> readRemesh(Table& t) {
 // Mesh input errors stay as they are (they name the mesh file and its line); the scene's
 // line is added so the user knows which part asked for the file. What the repair changed
 // becomes the scene's warnings, at the mesh key's line: nothing is changed silently.
-TriMesh readPartMesh(Table& t, const std::filesystem::path& base, const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
+// A remeshed part simulates on the new surface; the file's mesh (repaired) is what it draws
+// (`draw = "original"`, the default) unless `draw = "simulation"`.
+struct PartMeshes {
+    TriMesh simulated;
+    TriMesh drawn;  // empty: the simulated mesh is drawn
+};
+
+PartMeshes readPartMesh(Table& t, const std::filesystem::path& base, const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
     const std::string file = t.text("mesh", "");
     const std::filesystem::path path = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : base / file;
     const std::size_t line = t.line("mesh");
@@ -209,9 +216,14 @@ TriMesh readPartMesh(Table& t, const std::filesystem::path& base, const SceneRea
     }
     for (const std::string& repair : result.repairs.warnings())
         warnings.push_back({line, t.what() + ", key 'mesh': " + path.string() + ": " + repair});
-    if (!remesh) return std::move(result.mesh);
+    const std::string draw = t.text("draw", "original");
+    if (draw != "original" && draw != "simulation")
+        t.fail(*t.node("draw"), "draw", "unknown value '" + draw + "' (expected 'original' or 'simulation')");
+    const bool drawOriginal = draw == "original";
+    if (!remesh) return {std::move(result.mesh), {}};
     try {
-        return remeshForSimulation(result.mesh, *remesh, path.string()).mesh;
+        TriMesh simulated = remeshForSimulation(result.mesh, *remesh, path.string()).mesh;
+        return {std::move(simulated), drawOriginal ? std::move(result.mesh) : TriMesh{}};
     } catch (const InputError& e) {
         throw InputError(t.file(), t.line("remesh"), t.what() + ", key 'remesh': " + e.problem());
     }
@@ -275,11 +287,13 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     ScenePart p;
     p.name = t.requiredText("name");
     if (t.has("mesh") == t.has("generator")) t.fail("needs exactly one of 'mesh' and 'generator'");
-    for (const char* key : {"repair", "remesh"})
+    for (const char* key : {"repair", "remesh", "draw"})
         if (t.has(key) && !t.has("mesh")) t.fail(*t.node(key), key, "applies only to a part read from a 'mesh' file");
-    TriMesh mesh = t.has("mesh") ? readPartMesh(t, base, options, warnings) : generatePartMesh(t);
+    PartMeshes meshes = t.has("mesh") ? readPartMesh(t, base, options, warnings) : PartMeshes{generatePartMesh(t), {}};
+    TriMesh mesh = std::move(meshes.simulated);
     mesh.name = p.name;
     PartModelSettings model;
+    model.drawnMesh = std::move(meshes.drawn);
     model.material = readMaterial(t);
     model.vertexMass = t.positive("vertex_mass", 1.0);
 

@@ -1,5 +1,6 @@
 #include "flexfit/part_model.hpp"
 
+#include "flexfit/surface_embedding.hpp"
 #include "model/spring_blocks.hpp"
 
 #include <cmath>
@@ -69,10 +70,16 @@ std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSet
     for (std::size_t v = 0; v < vertices; ++v) model->springAdr[v + 1] += model->springAdr[v];
     model->springBlocks = std::make_shared<const SpringBlocks>(
         buildSpringBlocks(model->springA, model->springB, model->restLength, model->stiffness, model->damping));
+    if (!settings.drawnMesh.faces.empty()) {
+        validateMesh(settings.drawnMesh, kSettingsSource + ", drawn mesh");
+        model->drawn = std::make_shared<const SurfaceEmbedding>(embedSurface(settings.drawnMesh, mesh, kSettingsSource));
+    }
     model->mesh = std::move(mesh);
     return model;
 }
 
 bool PartModel::hasSpringBlocks() const { return springBlocks != nullptr && !springBlocks->empty(); }
+
+const TriMesh& PartModel::drawnMesh() const { return drawn ? drawn->mesh : mesh; }
 
 }  // namespace flexfit

@@ -123,7 +123,7 @@ TEST(BlockStep, EveryKernelMatchesTheNaiveReference) {
     // The naive model (heap objects, its own spring set) shares no code with the library.
     for (const TriMesh& mesh : {makeTorus2(), makeHeart()}) {
         const Material material = Material::elastic();
-        const auto model = buildPartModel(mesh, {material, 1.5, {}, {}});
+        const auto model = buildPartModel(mesh, {material, 1.5, {}, {}, {}});
         for (BlockKernel kernel : kAllKernels) {
             if (!detail::blockKernelAvailable(kernel)) continue;
             SCOPED_TRACE(mesh.name + " " + detail::toString(kernel));

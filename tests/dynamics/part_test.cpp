@@ -109,7 +109,7 @@ TEST(Part, SpringsEvaluatedEqualTheActiveRegion) {
 }
 
 TEST(Part, ZonesRetireAndMassesReturnExactlyToRest) {
-    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}});
     PartSettings settings = zoneSettings();
     settings.simulation.restoration = {RestorationMethod::AnchorSprings, 1.0, 0.5, 0.05};
     Part part(model, settings);
@@ -134,7 +134,7 @@ TEST(Part, ZonesRetireAndMassesReturnExactlyToRest) {
 }
 
 TEST(Part, LoadedZoneStaysOpen) {
-    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}});
     Part part(model, zoneSettings());
     for (int i = 0; i < 2000; ++i) {
         part.applyForce(3, Vec3(1e-9, 0, 0));  // tiny: the zone is at rest but loaded
@@ -188,7 +188,7 @@ TEST(Part, RigidMotionDoesNotDisturbAZone) {
 }
 
 TEST(Part, WholeMeshZoneMatchesFullDeformableModel) {
-    const auto model = buildPartModel(makeTorus1(), {Material::elastic(), 1.0, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material::elastic(), 1.0, {}, {}, {}});
     PartSettings zones = zoneSettings();
     zones.zones.fullSweepWhenComplete = false;  // exercise the compact-array path
     zones.simulation.gravity = Vec3(0, -0.5, 0);
@@ -245,7 +245,7 @@ TEST(Part, PartialRegionMatchesFullModelWithPinnedMasses) {
     part.openZone(ZoneSeed::mass(100), 4);
     std::vector<double> masses(model->massCount(), 1e300);
     for (Index m : part.movingMasses()) masses[m] = 1.0;
-    const auto pinned = buildPartModel(mesh, {Material::elastic(), 1.0, masses, {}});
+    const auto pinned = buildPartModel(mesh, {Material::elastic(), 1.0, masses, {}, {}});
     PartState reference = PartState::atRest(*pinned);
     SimulationSettings settings = zoneSettings().simulation;
     for (int i = 0; i < 1000; ++i) {
@@ -342,7 +342,7 @@ TEST(Part, ChangedMassesAreTheMovedOnesAndEveryMassWhenAllMove) {
 TEST(Part, GoldenHashUnderLoad) {
     // Zones opened by a face and by forces, grown, a rigid turn each step, the load released and
     // every zone retired by the end: the whole zone lifecycle in one hash.
-    const auto model = buildPartModel(makeTorus2(), {Material::rigid(), 1.0, {}, {}});
+    const auto model = buildPartModel(makeTorus2(), {Material::rigid(), 1.0, {}, {}, {}});
     PartSettings settings = zoneSettings();
     settings.simulation.restoration = {RestorationMethod::AnchorSprings, 2.0, 0.5, 0.05};
     Part part(model, settings);
@@ -417,4 +417,56 @@ TEST(Part, AHugeForceOnAZoneDivergesAndThrowsNamingThePart) {
         EXPECT_NE(what.find("likely cause: a force beyond what the model can take"), std::string::npos) << what;
     }
     EXPECT_LT(part.movingMasses().size(), model->massCount());  // it was a zone, not the whole part
+}
+
+// A part simulating on one mesh and drawn with another (surface_embedding.hpp): at rest it
+// draws exactly the drawn mesh, in its frame and in the world (as a rigid part of that mesh
+// would); deformed, the drawn vertices tied to faces no moving mass touches stay where they were.
+TEST(Part, ADrawnMeshIsExactAtRestAndMovesOnlyOverTheZone) {
+    const TriMesh drawn = makeIcoSphere(2.01, 4);
+    PartModelSettings withDrawn;
+    withDrawn.drawnMesh = drawn;
+    const auto model = buildPartModel(makeIcoSphere(2.0, 2), withDrawn);
+    ASSERT_TRUE(model->drawn);
+    EXPECT_EQ(model->drawnMesh().faces, drawn.faces);
+    Part part(model, zoneSettings());
+    const Pose pose{Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Vec3::UnitZ())), Vec3(1, 2, 3)};
+    part.setPose(pose);
+    std::vector<Vec3> local, world, reference;
+    part.drawnPositions(local);
+    EXPECT_EQ(local, drawn.vertices);
+    part.drawnWorldPositions(world);
+    Part rigidDrawn(buildPartModel(drawn), zoneSettings());
+    rigidDrawn.setPose(pose);
+    rigidDrawn.worldPositions(reference);
+    EXPECT_EQ(world, reference);
+
+    for (int i = 0; i < 20; ++i) {
+        part.applyForce(0, Vec3(0.0, 0.0, -5.0));
+        part.step();
+    }
+    ASSERT_FALSE(part.movingMasses().empty());
+    part.drawnPositions(local);
+    std::size_t moved = 0;
+    for (std::size_t v = 0; v < local.size(); ++v) {
+        const Face& f = model->mesh.faces[model->drawn->triangle[v]];
+        const bool overZone = part.isMoving(f[0]) || part.isMoving(f[1]) || part.isMoving(f[2]);
+        if (!overZone) {
+            EXPECT_EQ(local[v], drawn.vertices[v]) << "vertex " << v;
+        }
+        moved += local[v] != drawn.vertices[v];
+    }
+    EXPECT_GT(moved, 0u);
+}
+
+TEST(Part, AnInvalidDrawnMeshIsRejected) {
+    PartModelSettings settings;
+    settings.drawnMesh = makeIcoSphere(1.0, 1);
+    settings.drawnMesh.faces[3][1] = 9999;
+    try {
+        buildPartModel(makeIcoSphere(1.0, 1), settings);
+        FAIL() << "accepted a drawn mesh with a vertex index out of range";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("drawn mesh"), std::string::npos) << e.what();
+    }
 }

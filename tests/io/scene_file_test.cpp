@@ -419,8 +419,19 @@ TEST(SceneFile, RemeshGivesTheModelNearUniformEdges) {
         EXPECT_GT(model.faceCount(), 300u) << remesh;
         const double meanLength = std::accumulate(model.restLength.begin(), model.restLength.end(), 0.0) / double(model.springCount());
         EXPECT_NEAR(meanLength, 0.1, 0.03) << remesh;
+        // Drawn as the file's tetrahedron (draw = "original" is the default).
+        ASSERT_TRUE(model.drawn) << remesh;
+        EXPECT_EQ(model.drawnMesh().vertices, plain.parts[0].model->mesh.vertices) << remesh;
+        EXPECT_EQ(model.drawnMesh().faces, plain.parts[0].model->mesh.faces) << remesh;
     }
+    const Scene simulationDrawn = parseScene(part + "remesh = 0.1\ndraw = \"simulation\"\n", "scene.toml", dir.path());
+    EXPECT_FALSE(simulationDrawn.parts[0].model->drawn);
+    EXPECT_GT(simulationDrawn.parts[0].model->drawnMesh().faces.size(), 300u);
     auto error = [&](const std::string& extra) { return errorOf(part + extra, dir.path()); };
+    EXPECT_NE(error("remesh = 0.1\ndraw = \"both\"\n").find("scene.toml:5: part 1, key 'draw': unknown value 'both'"), std::string::npos)
+        << error("remesh = 0.1\ndraw = \"both\"\n");
+    EXPECT_NE(errorOf(withLine("name = \"ball\"", "draw = \"original\"")).find("key 'draw': applies only to a part read from a 'mesh' file"),
+              std::string::npos);
     EXPECT_NE(error("remesh = -0.1\n").find("scene.toml:4: part 1, key 'remesh': must be > 0"), std::string::npos) << error("remesh = -0.1\n");
     EXPECT_NE(error("remesh = { iterations = 3 }\n").find("needs 'edge'"), std::string::npos) << error("remesh = { iterations = 3 }\n");
     EXPECT_NE(error("remesh = { edge = 0.1, angle = 3 }\n").find("key 'angle': unknown key"), std::string::npos)

@@ -116,6 +116,33 @@ TEST(SurfaceNormals, IncrementalUpdateEqualsFullRecomputationAndStaysLocal) {
     for (Index v = 0; v < model->massCount(); ++v) EXPECT_LT((normals.normals()[v] - rest[v]).norm(), 1e-12) << v;
 }
 
+// A part with a drawn mesh of its own shows that mesh: its vertices at rest, unit normals
+// pointing out of the sphere, each vertex in its nearest mass's colour; a plain part shows its masses.
+TEST(ShowPart, ADrawnMeshIsWhatIsShown) {
+    PartModelSettings settings;
+    settings.drawnMesh = makeIcoSphere(1.01, 3);
+    Part drawnPart(buildPartModel(makeIcoSphere(1.0, 1), settings));
+    const std::size_t masses = drawnPart.model().massCount();
+    std::vector<Vec3> massColours(masses);
+    for (std::size_t m = 0; m < masses; ++m) massColours[m] = Vec3(double(m), 0.0, 0.0);
+    ShownSurface shown;
+    showPart(drawnPart, SurfaceNormals::computeAll(drawnPart), massColours, shown);
+    EXPECT_EQ(shown.positions, settings.drawnMesh.vertices);
+    ASSERT_EQ(shown.normals.size(), shown.positions.size());
+    for (std::size_t v = 0; v < shown.positions.size(); ++v) {
+        EXPECT_GT(shown.normals[v].dot(shown.positions[v].normalized()), 0.95) << v;
+        // The colour names the mass: the simulated vertex nearest to the drawn one, among its face's corners.
+        const Index mass = Index(shown.colours[v].x());
+        EXPECT_LT((drawnPart.model().mesh.vertices[mass] - shown.positions[v]).norm(), 0.6) << v;
+    }
+    Part plain(buildPartModel(makeIcoSphere(1.0, 1)));
+    const std::vector<Vec3> normals = SurfaceNormals::computeAll(plain);
+    showPart(plain, normals, massColours, shown);
+    EXPECT_EQ(shown.positions, plain.state().positions);
+    EXPECT_EQ(shown.normals, normals);
+    EXPECT_EQ(shown.colours, massColours);
+}
+
 TEST(Session, FixedStepWhateverTheFrameTimes) {
     // Irregular frames (20-90 Hz) for 1.2 s of wall time: the world takes exactly the steps
     // that fit, and ends where the scene stepped directly ends after as many steps.
