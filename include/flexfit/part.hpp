@@ -141,7 +141,9 @@ public:
     void displaceMass(Index mass, const Vec3& worldDisplacement);
     // Masses whose position may have changed since clearChangedMasses(): every mass stepped or
     // displaced, and every mass that returned to rest. Collision hierarchies refit from it.
-    std::span<const Index> changedMasses() const { return allChanged_ ? std::span<const Index>(allMasses_) : changed_.members(); }
+    // (After a region step the region's masses join the list when it is first read: a part
+    // stepped with no one reading it pays nothing for it.)
+    std::span<const Index> changedMasses() const;
     void clearChangedMasses();
 
     // --- Step ---
@@ -195,7 +197,8 @@ private:
     ZoneId nextZoneId_ = 1;
     ActiveRegion region_;
     std::vector<std::uint64_t> lastLoadStep_; // (V) step of the last force on each mass
-    IndexSet changed_;                        // (V) masses changed since clearChangedMasses()
+    mutable IndexSet changed_;                // (V) masses changed since clearChangedMasses()
+    mutable bool regionStepped_ = false;      // the region's masses moved and are not in changed_ yet
     // Every mass changed (a step moved them all): O(1) instead of marking each.
     bool allChanged_ = false;
     bool fullModelStepped_ = false;  // the last advance() ran the full model's step (which checked every mass)

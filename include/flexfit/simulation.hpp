@@ -110,7 +110,7 @@ void stepRegionByFullModel(const PartModel& model, const SimulationSettings& set
 // `computedSprings` springs and `movingMasses` masses. A rule on counts alone, so every machine
 // chooses alike and a run's bits do not depend on the CPU: per spring, the region step costs
 // about 13 ns (gathered), the full step about 4 ns by spring blocks (AVX-512 or AVX2) and 10 ns
-// by the per-mass sweep, plus ~1.5 ns per mass put back (measured on this project's machine,
+// by the per-mass sweep, plus ~0.5 ns per mass put back (measured on this project's machine,
 // torus2, heart, shuffled heart: equal costs near 30 % and 80 % of the springs; the rule asks
 // the full step to be 10 % cheaper, so it switches past about 35 % and 85 %). On CPUs
 // without AVX2 the blocks run at about the sweep's speed, and the rule chooses the full step

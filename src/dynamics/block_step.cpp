@@ -110,6 +110,25 @@ void blockForces(const SpringBlocks& blocks, const double* x, const double* v, d
     }
 }
 
+void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, PartState& state, BlockKernel kernel) {
+    std::size_t done = 0;
+#if defined(FLEXFIT_X86_KERNELS)
+    if (kernel == BlockKernel::Avx512) done = holdAtRestAvx512(model, cover.data(), state);
+#endif
+    (void)kernel;
+    // The rest by selection, without a branch per mass (the region's edge is irregular).
+    const double* rest = model.restPositions.data()->data();
+    double* __restrict x = state.positions.data()->data();
+    double* __restrict v = state.velocities.data()->data();
+    for (std::size_t m = done; m < model.massCount(); ++m) {
+        const bool moves = cover[m] != 0;
+        for (std::size_t c = 0; c < 3; ++c) {
+            x[3 * m + c] = moves ? x[3 * m + c] : rest[3 * m + c];
+            v[3 * m + c] = moves ? v[3 * m + c] : 0.0;
+        }
+    }
+}
+
 void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel) {
     const double* x = state.positions.data()->data();
     const double* v = state.velocities.data()->data();

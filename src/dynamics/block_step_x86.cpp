@@ -198,6 +198,37 @@ FLEXFIT_AVX512 std::size_t remainder512(const PartModel& model, const double* x,
     return n;
 }
 
+// Bit 3i..3i+2 set for each bit i of an 8-bit mass mask: one mask bit per double of 8 masses.
+constexpr std::array<std::uint32_t, 256> kSpread3 = [] {
+    std::array<std::uint32_t, 256> table{};
+    for (unsigned k = 0; k < 256; ++k)
+        for (unsigned bit = 0; bit < 8; ++bit)
+            if ((k >> bit) & 1u) table[k] |= 7u << (3 * bit);
+    return table;
+}();
+
+FLEXFIT_AVX512 std::size_t holdAtRest512(const PartModel& model, const std::uint16_t* cover, PartState& state) {
+    const std::size_t n = model.massCount() / 8 * 8;
+    const double* rest = model.restPositions.data()->data();
+    double* x = state.positions.data()->data();
+    double* v = state.velocities.data()->data();
+    const __m512d zero = _mm512_setzero_pd();
+    for (std::size_t i = 0; i < n; i += 8) {
+        // 8 cover counts == 0 -> 8 bytes of 0xff -> 8 bits.
+        const __m128i zeroCount = _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(cover + i)), _mm_setzero_si128());
+        const auto held = unsigned(_mm_movemask_epi8(_mm_packs_epi16(zeroCount, _mm_setzero_si128())));
+        if (held == 0) continue;
+        const std::uint32_t lanes = kSpread3[held];
+        for (std::size_t j = 0; j < 3; ++j) {
+            const auto m = __mmask8((lanes >> (8 * j)) & 0xffu);
+            const std::size_t o = 3 * i + 8 * j;
+            _mm512_mask_storeu_pd(x + o, m, _mm512_maskz_loadu_pd(m, rest + o));
+            _mm512_mask_storeu_pd(v + o, m, zero);
+        }
+    }
+    return n;
+}
+
 FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate& p, PartState& state) {
     const std::size_t n = model.massCount() / 8 * 8;
     double* x = state.positions.data()->data();
@@ -396,6 +427,9 @@ std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, Part
 }
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state) {
     return integrate512(model, update, state);
+}
+std::size_t holdAtRestAvx512(const PartModel& model, const std::uint16_t* cover, PartState& state) {
+    return holdAtRest512(model, cover, state);
 }
 
 }  // namespace flexfit::detail

@@ -45,6 +45,11 @@ void blockForces(const SpringBlocks& blocks, const double* x, const double* v, d
 // the kernel must be available.
 void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel);
 
+// After a full step that stood for a region's (stepRegionByFullModel): every mass whose cover
+// count is 0 back to rest, velocity zero (the full step left every force at zero). A pure
+// selection, so every kernel gives the same bits.
+void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, PartState& state, BlockKernel kernel);
+
 // The vector kernels (block_step_x86.cpp). Forces of all blocks into f (3 doubles per mass).
 void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* v, double* f);
 void blockForcesAvx512(const SpringBlocks& blocks, const double* x, const double* v, double* f);
@@ -53,5 +58,7 @@ std::size_t remainderForcesAvx512(const PartModel& model, const double* x, const
 // Integrates masses [0, n) for the largest n that is a multiple of the width; returns n.
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state);
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state);
+// holdAtRest for masses [0, n), n the largest multiple of 8; returns n.
+std::size_t holdAtRestAvx512(const PartModel& model, const std::uint16_t* cover, PartState& state);
 
 }  // namespace flexfit::detail

@@ -65,6 +65,7 @@ Part::Part(const Part& other)
       region_(other.region_),
       lastLoadStep_(other.lastLoadStep_),
       changed_(other.changed_),
+      regionStepped_(other.regionStepped_),
       allChanged_(other.allChanged_),
       allMasses_(other.allMasses_) {}
 
@@ -124,8 +125,18 @@ void Part::markAllChanged() {
     allChanged_ = true;
 }
 
+std::span<const Index> Part::changedMasses() const {
+    if (allChanged_) return allMasses_;
+    if (regionStepped_) {
+        for (Index m : region_.masses()) changed_.insert(m);
+        regionStepped_ = false;
+    }
+    return changed_.members();
+}
+
 void Part::clearChangedMasses() {
     changed_.clear();
+    regionStepped_ = false;
     allChanged_ = false;
 }
 
@@ -251,7 +262,7 @@ void Part::advance(const StepContext& context, StepCounters* counters) {
     if (region_.coversEveryMass())
         markAllChanged();
     else
-        for (Index m : region_.masses()) markChanged(m);
+        regionStepped_ = true;  // changedMasses() adds the region's masses when read
 }
 
 // --- Contacts ---

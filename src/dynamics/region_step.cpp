@@ -1,6 +1,7 @@
 // The step of an active region (rigid-deformable parts): springs, then moving masses.
 #include "flexfit/simulation.hpp"
 #include "flush_denormals.hpp"
+#include "full_step.hpp"
 #include "mass_update.hpp"
 
 namespace flexfit {
@@ -42,17 +43,12 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
 void stepRegionByFullModel(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                            PartState& state, StepCounters* counters) {
     stepFullModel(model, settings, {}, state, counters);
-    for (Index m = 0; m < model.massCount(); ++m)
-        if (!region.moves(m)) {
-            state.positions[m] = model.restPositions[m];
-            state.velocities[m] = Vec3::Zero();
-            state.forces[m] = Vec3::Zero();
-        }
+    detail::holdAtRest(model, region.coverCounts(), state, detail::fullStepKernel());
 }
 
 bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses) {
     // Costs in ns on the reference machine (simulation.hpp); only their ratios matter.
-    constexpr double kRegionSpring = 13.0, kRegionMass = 2.0, kBlockSpring = 4.0, kSweepSpring = 10.0, kPutBack = 1.5;
+    constexpr double kRegionSpring = 13.0, kRegionMass = 2.0, kBlockSpring = 4.0, kSweepSpring = 10.0, kPutBack = 0.5;
     // Switch only when clearly cheaper: near the crossover the two cost the same, and in a world
     // the full step's streaming also evicts what the collision stages keep in cache (measured on
     // the haptic scene, ~35 % of the springs: no difference either way).
