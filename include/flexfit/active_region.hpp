@@ -8,6 +8,12 @@
 // retiring a zone costs what it changes. Members keep the order in which they joined until one
 // leaves (swap-remove), so the same calls always give the same order (determinism).
 //
+// For the region step's vector kernels the region also keeps its whole groups of 8: the spring
+// blocks (the full step's vector layout, on models that have them) all of whose springs are
+// computed, and the octets of masses 8k..8k+7 that all move. The step runs those by the vector
+// kernels and the other ("loose") springs and masses one at a time. O(8) more per joining or
+// leaving spring or mass.
+//
 // Known limit: a mass can be covered by at most 65,535 zones at once (the count is 16-bit, to
 // keep the per-mass mask that the region step reads small).
 #pragma once
@@ -41,13 +47,41 @@ public:
     const IndexSet& springs() const { return springs_; }  // the computed springs
     // (V) the zones covering each mass: non-zero exactly for the moving masses.
     std::span<const std::uint16_t> coverCounts() const { return coverCount_; }
+    // Blocks (indices into the model's spring blocks) all 8 of whose springs are computed, and
+    // the computed springs in no such block; without blocks, every computed spring is loose.
+    const IndexSet& fullBlocks() const { return blockGroups_.whole; }
+    const IndexSet& looseSprings() const { return blocks_ != nullptr ? blockGroups_.loose : springs_; }
+    // Octets k (masses 8k..8k+7) whose masses all move, and the moving masses in no such octet.
+    const IndexSet& fullOctets() const { return octets_.whole; }
+    const IndexSet& looseMasses() const { return octets_.loose; }
 
 private:
+    // Members (springs, masses) in groups of 8: which groups have all 8 in the region, and which
+    // members of the region are in no such group.
+    struct WholeGroups {
+        std::vector<std::uint8_t> count;  // (groups) members in the region
+        IndexSet whole;                   // (groups)
+        IndexSet loose;                   // (members)
+        void reset(std::size_t groups, std::size_t members);
+        // `group` is kNoGroup for a member of no group; memberOf(group, i) is its i-th member.
+        template <class MemberOf>
+        void join(Index member, Index group, MemberOf memberOf);
+        template <class MemberOf>
+        void leave(Index member, Index group, MemberOf memberOf);
+    };
+    static constexpr Index kNoGroup = ~Index(0);
+    void springJoins(Index spring);
+    void springLeaves(Index spring);
+    Index octetOf(Index mass) const { return mass < coverCount_.size() / 8 * 8 ? mass / 8 : kNoGroup; }
+
     const Topology* topology_ = nullptr;
     std::vector<std::uint16_t> coverCount_;  // (V)
     std::vector<std::uint8_t> movingEnds_;   // (E) 0, 1 or 2
     IndexSet masses_;                        // (V)
     IndexSet springs_;                       // (E)
+    const SpringBlocks* blocks_ = nullptr;   // the model's, when it has any
+    WholeGroups blockGroups_;                // spring blocks (with blocks_)
+    WholeGroups octets_;                     // mass octets
 };
 
 }  // namespace flexfit

@@ -93,8 +93,11 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings,
 
 // Advances only an active region (active_region.hpp): its moving masses and computed springs.
 // Masses outside the region are read (at their current, rest, positions) but never written.
-// Two passes over the compact arrays: springs, then masses. O(|moving| + |computed|). Does not
-// check for divergence: Part::step() and World::step() check the moving masses.
+// Two passes over the compact arrays: springs, then masses. O(|moving| + |computed|). On models
+// with spring blocks, the region's whole blocks (ActiveRegion::fullBlocks) run by the full
+// step's vector kernel (AVX-512 where the CPU has it, else scalar; the same bits), then its
+// other springs one at a time; forces are summed in that order. Does not check for divergence:
+// Part::step() and World::step() check the moving masses.
 void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                       PartState& state, StepCounters* counters = nullptr);
 
@@ -107,15 +110,16 @@ void stepRegionByFullModel(const PartModel& model, const SimulationSettings& set
                            PartState& state, StepCounters* counters = nullptr);
 
 // Whether stepRegionByFullModel costs less than stepActiveRegion for a region of
-// `computedSprings` springs and `movingMasses` masses. A rule on counts alone, so every machine
+// `computedSprings` springs (`springsInWholeBlocks` of them in whole spring blocks,
+// ActiveRegion::fullBlocks) and `movingMasses` masses. A rule on counts alone, so every machine
 // chooses alike and a run's bits do not depend on the CPU: per spring, the region step costs
-// about 13 ns (gathered), the full step about 4 ns by spring blocks (AVX-512 or AVX2) and 10 ns
-// by the per-mass sweep, plus ~0.5 ns per mass put back (measured on this project's machine,
-// torus2, heart, shuffled heart: equal costs near 30 % and 80 % of the springs; the rule asks
-// the full step to be 10 % cheaper, so it switches past about 35 % and 85 %). On CPUs
-// without AVX2 the blocks run at about the sweep's speed, and the rule chooses the full step
-// somewhat early there.
-bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses);
+// about 13 ns one at a time and 4.5 ns in whole blocks, the full step about 4 ns by spring
+// blocks (AVX-512 or AVX2) and 10 ns by the per-mass sweep, plus ~0.5 ns per mass put back
+// (measured on this project's machine, torus2, heart, shuffled heart); the rule asks the full
+// step to be 10 % cheaper. On CPUs without AVX2 the blocks run at about the sweep's speed, and
+// the rule chooses the full step somewhat early there.
+bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses,
+                       std::size_t springsInWholeBlocks = 0);
 
 // Total kinetic + spring + anchor potential energy (no gravity), and linear momentum.
 double totalEnergy(const PartModel& model, const SimulationSettings& settings, const PartState& state);

@@ -54,15 +54,15 @@ void remainderForces(const PartModel& model, const double* x, const double* v, d
     }
 }
 
+void integrateMass(const PartModel& model, const MassUpdate& p, PartState& state, std::size_t i) {
+    Vec3& f = state.forces[i];
+    const Vec3 total = f + p.bodyForce(model.mass[i], state.positions[i], state.velocities[i], model.restPositions[i]);
+    f = Vec3::Zero();
+    p.integrate(model.inverseMass[i], total, model.restPositions[i], state.positions[i], state.velocities[i]);
+}
+
 void integrateScalar(const PartModel& model, const MassUpdate& p, PartState& state, std::size_t begin) {
-    Vec3* x = state.positions.data();
-    Vec3* v = state.velocities.data();
-    Vec3* f = state.forces.data();
-    for (std::size_t i = begin; i < model.massCount(); ++i) {
-        const Vec3 total = f[i] + p.bodyForce(model.mass[i], x[i], v[i], model.restPositions[i]);
-        f[i] = Vec3::Zero();
-        p.integrate(model.inverseMass[i], total, model.restPositions[i], x[i], v[i]);
-    }
+    for (std::size_t i = begin; i < model.massCount(); ++i) integrateMass(model, p, state, i);
 }
 
 bool cpuHas(BlockKernel kernel) {
@@ -108,6 +108,40 @@ void blockForces(const SpringBlocks& blocks, const double* x, const double* v, d
 #endif
         default: blockForcesScalar(blocks, x, v, f); return;
     }
+}
+
+void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+                       const double* x, const double* v, double* f, BlockKernel kernel) {
+#if defined(FLEXFIT_X86_KERNELS)
+    if (kernel == BlockKernel::Avx512) return regionBlockForcesAvx512(blocks, fullBlocks, cover, x, v, f);
+#endif
+    (void)kernel;
+    for (const Index q : fullBlocks) {
+        const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
+        double g[W][3];
+        for (std::size_t i = 0; i < W; ++i) {
+            const std::size_t lane = W * q + i;
+            springForce(blocks.stiffness[lane], blocks.damping[lane], blocks.restLength[lane], x + 3 * (a0 + i),
+                        x + 3 * (b0 + i), v + 3 * (a0 + i), v + 3 * (b0 + i), g[i]);
+        }
+        for (std::size_t i = 0; i < W; ++i)
+            if (cover[a0 + i] != 0)
+                for (std::size_t c = 0; c < 3; ++c) f[3 * (a0 + i) + c] += g[i][c];
+        for (std::size_t i = 0; i < W; ++i)
+            if (cover[b0 + i] != 0)
+                for (std::size_t c = 0; c < 3; ++c) f[3 * (b0 + i) + c] -= g[i][c];
+    }
+}
+
+void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
+                     BlockKernel kernel) {
+#if defined(FLEXFIT_X86_KERNELS)
+    if (kernel == BlockKernel::Avx512) return integrateOctetsAvx512(model, update, octets, state);
+    if (kernel == BlockKernel::Avx2) return integrateOctetsAvx2(model, update, octets, state);
+#endif
+    (void)kernel;
+    for (const Index octet : octets)
+        for (std::size_t i = 8 * std::size_t(octet); i < 8 * std::size_t(octet) + 8; ++i) integrateMass(model, update, state, i);
 }
 
 void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, PartState& state, BlockKernel kernel) {

@@ -207,6 +207,12 @@ constexpr std::array<std::uint32_t, 256> kSpread3 = [] {
     return table;
 }();
 
+// Bits of the masses cover[0..7] whose cover count is 0.
+FLEXFIT_AVX512 inline unsigned heldBits8(const std::uint16_t* cover) {
+    const __m128i zeroCount = _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(cover)), _mm_setzero_si128());
+    return unsigned(_mm_movemask_epi8(_mm_packs_epi16(zeroCount, _mm_setzero_si128())));
+}
+
 FLEXFIT_AVX512 std::size_t holdAtRest512(const PartModel& model, const std::uint16_t* cover, PartState& state) {
     const std::size_t n = model.massCount() / 8 * 8;
     const double* rest = model.restPositions.data()->data();
@@ -214,9 +220,7 @@ FLEXFIT_AVX512 std::size_t holdAtRest512(const PartModel& model, const std::uint
     double* v = state.velocities.data()->data();
     const __m512d zero = _mm512_setzero_pd();
     for (std::size_t i = 0; i < n; i += 8) {
-        // 8 cover counts == 0 -> 8 bytes of 0xff -> 8 bits.
-        const __m128i zeroCount = _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(cover + i)), _mm_setzero_si128());
-        const auto held = unsigned(_mm_movemask_epi8(_mm_packs_epi16(zeroCount, _mm_setzero_si128())));
+        const unsigned held = heldBits8(cover + i);
         if (held == 0) continue;
         const std::uint32_t lanes = kSpread3[held];
         for (std::size_t j = 0; j < 3; ++j) {
@@ -229,8 +233,29 @@ FLEXFIT_AVX512 std::size_t holdAtRest512(const PartModel& model, const std::uint
     return n;
 }
 
-FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate& p, PartState& state) {
-    const std::size_t n = model.massCount() / 8 * 8;
+FLEXFIT_AVX512 void regionBlocks512(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+                                    const double* x, const double* v, double* f) {
+    for (const Index q : fullBlocks) {
+        const Flat24 g = blockSpringForces(blocks, q, x, v);
+        const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
+        const std::uint32_t movingA = kSpread3[~heldBits8(cover + a0) & 0xffu];
+        const std::uint32_t movingB = kSpread3[~heldBits8(cover + b0) & 0xffu];
+        double* fa = f + 3 * a0;
+        for (std::size_t j = 0; j < 3; ++j) {
+            const __m512d old = _mm512_loadu_pd(fa + 8 * j);
+            _mm512_storeu_pd(fa + 8 * j, _mm512_mask_add_pd(old, __mmask8((movingA >> (8 * j)) & 0xffu), old, g.v[j]));
+        }
+        double* fb = f + 3 * b0;  // after the first ends' stores: the ranges overlap when offset < 8
+        for (std::size_t j = 0; j < 3; ++j) {
+            const __m512d old = _mm512_loadu_pd(fb + 8 * j);
+            _mm512_storeu_pd(fb + 8 * j, _mm512_mask_sub_pd(old, __mmask8((movingB >> (8 * j)) & 0xffu), old, g.v[j]));
+        }
+    }
+}
+
+// Groups of 8 masses: group g starts at 8 octets[g], or at 8 g without a list.
+FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate& p, PartState& state,
+                                        const Index* octets, std::size_t groups) {
     double* x = state.positions.data()->data();
     double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
@@ -240,7 +265,8 @@ FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate
     const __m512d h = _mm512_set1_pd(p.h), invH = _mm512_set1_pd(p.invH), drag = _mm512_set1_pd(p.drag);
     const __m512d anchor = _mm512_set1_pd(p.anchorStiffness), constraint = _mm512_set1_pd(p.constraint);
     const bool anchored = p.anchorStiffness != 0.0, readsRest = p.readsRest();
-    for (std::size_t i = 0; i < n; i += 8) {
+    for (std::size_t g = 0; g < groups; ++g) {
+        const std::size_t i = 8 * (octets != nullptr ? std::size_t(octets[g]) : g);
         const __m512d mass = _mm512_loadu_pd(model.mass.data() + i);
         const __m512d hOverMass = _mm512_mul_pd(h, _mm512_loadu_pd(model.inverseMass.data() + i));
         for (int j = 0; j < 3; ++j) {
@@ -270,7 +296,7 @@ FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate
             _mm512_storeu_pd(f + o, _mm512_setzero_pd());
         }
     }
-    return n;
+    return 8 * groups;
 }
 
 // ---------------------------------------------------------------- AVX2: a block as two halves
@@ -368,8 +394,9 @@ FLEXFIT_AVX2 inline __m256d spread4(__m256d values, int j) {
     }
 }
 
-FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& p, PartState& state) {
-    const std::size_t n = model.massCount() / 4 * 4;
+// Groups of 4 masses: group g starts at 4 g, or with an octet list at 8 octets[g / 2] + 4 (g % 2).
+FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& p, PartState& state, const Index* octets,
+                                      std::size_t groups) {
     double* x = state.positions.data()->data();
     double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
@@ -379,7 +406,8 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
     const __m256d h = _mm256_set1_pd(p.h), invH = _mm256_set1_pd(p.invH), drag = _mm256_set1_pd(p.drag);
     const __m256d anchor = _mm256_set1_pd(p.anchorStiffness), constraint = _mm256_set1_pd(p.constraint);
     const bool anchored = p.anchorStiffness != 0.0, readsRest = p.readsRest();
-    for (std::size_t i = 0; i < n; i += 4) {
+    for (std::size_t g = 0; g < groups; ++g) {
+        const std::size_t i = octets != nullptr ? 8 * std::size_t(octets[g / 2]) + 4 * (g % 2) : 4 * g;
         const __m256d mass = _mm256_loadu_pd(model.mass.data() + i);
         const __m256d hOverMass = _mm256_mul_pd(h, _mm256_loadu_pd(model.inverseMass.data() + i));
         for (int j = 0; j < 3; ++j) {
@@ -408,7 +436,7 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
             _mm256_storeu_pd(f + o, _mm256_setzero_pd());
         }
     }
-    return n;
+    return 4 * groups;
 }
 
 }  // namespace
@@ -423,10 +451,20 @@ std::size_t remainderForcesAvx512(const PartModel& model, const double* x, const
     return remainder512(model, x, v, f);
 }
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state) {
-    return integrate256(model, update, state);
+    return integrate256(model, update, state, nullptr, model.massCount() / 4);
 }
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state) {
-    return integrate512(model, update, state);
+    return integrate512(model, update, state, nullptr, model.massCount() / 8);
+}
+void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state) {
+    integrate256(model, update, state, octets.data(), 2 * octets.size());
+}
+void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state) {
+    integrate512(model, update, state, octets.data(), octets.size());
+}
+void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+                             const double* x, const double* v, double* f) {
+    regionBlocks512(blocks, fullBlocks, cover, x, v, f);
 }
 std::size_t holdAtRestAvx512(const PartModel& model, const std::uint16_t* cover, PartState& state) {
     return holdAtRest512(model, cover, state);

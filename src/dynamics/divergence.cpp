@@ -51,6 +51,28 @@ bool allFinite(const PartState& state, std::span<const Index> masses) {
     return (any >> 63) == 0;
 }
 
+namespace {
+
+// The exponent trick of allFinite over a region: whole octets contiguously, the rest gathered.
+bool regionFinite(const SimulationSettings& settings, const PartState& state, const ActiveRegion& region) {
+    constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL, kExponentOne = std::uint64_t(1) << 52;
+    const bool velocities = settings.integrator != Integrator::SemiImplicitEuler;
+    std::uint64_t lanes[8] = {};
+    auto scan = [&](const double* p) {
+        for (std::size_t i = 0; i < 24; i += 8)
+            for (std::size_t k = 0; k < 8; ++k) lanes[k] |= (std::bit_cast<std::uint64_t>(p[i + k]) & kExponent) + kExponentOne;
+    };
+    for (const Index octet : region.fullOctets()) {
+        scan(state.positions.data()->data() + 24 * std::size_t(octet));
+        if (velocities) scan(state.velocities.data()->data() + 24 * std::size_t(octet));
+    }
+    std::uint64_t any = 0;
+    for (std::uint64_t lane : lanes) any |= lane;
+    return (any >> 63) == 0 && allFinite(state, region.looseMasses().members());
+}
+
+}  // namespace
+
 std::optional<std::string> nonFiniteMass(const PartState& state, Index m) {
     if (!finite(state.positions[m])) return describe("position", m, state.positions[m]);
     if (!finite(state.velocities[m])) return describe("velocity", m, state.velocities[m]);
@@ -93,6 +115,12 @@ void checkAllMassesFinite(const PartModel& model, const SimulationSettings& sett
     for (Index m = 0; m < state.positions.size(); ++m)
         if (const std::optional<std::string> problem = nonFiniteMass(state, m))
             throw DivergenceError(body, time, *problem + "; " + likelyCause(model, settings));
+}
+
+void checkRegionFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
+                       const ActiveRegion& region, std::optional<BodyId> body, double time) {
+    if (regionFinite(settings, state, region)) return;
+    checkMassesFinite(model, settings, state, region.masses().members(), body, time);  // finds it and throws
 }
 
 }  // namespace flexfit::detail

@@ -2,6 +2,7 @@
 // the likely cause, for DivergenceError (core.hpp).
 #pragma once
 
+#include "flexfit/active_region.hpp"
 #include "flexfit/simulation.hpp"
 
 #include <optional>
@@ -33,5 +34,10 @@ void checkMassesFinite(const PartModel& model, const SimulationSettings& setting
                        std::span<const Index> masses, std::optional<BodyId> body, double time);
 void checkAllMassesFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
                           std::optional<BodyId> body, double time);
+// checkMassesFinite over a region's moving masses after stepActiveRegion: its whole octets in
+// contiguous passes over their positions (and velocities with explicit Euler; the octets' forces
+// were consumed by the step, as in checkAllMassesFinite), its other masses gathered.
+void checkRegionFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
+                       const ActiveRegion& region, std::optional<BodyId> body, double time);
 
 }  // namespace flexfit::detail

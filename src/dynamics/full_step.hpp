@@ -50,6 +50,18 @@ void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartStat
 // selection, so every kernel gives the same bits.
 void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, PartState& state, BlockKernel kernel);
 
+// The region step's whole blocks (ActiveRegion::fullBlocks), in that order: block q's forces
+// g_i, then f[a0 + i] += g_i for each first end that moves, then f[a0 + offset + i] -= g_i for
+// each second end that moves (cover count non-zero). AVX-512 or scalar (the AVX2 choice runs the
+// scalar kernel); the same bits.
+void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+                       const double* x, const double* v, double* f, BlockKernel kernel);
+
+// Integrates the masses of the given octets (masses 8k..8k+7, each once) as integrateScalar
+// would, mass by mass: the same bits in every kernel.
+void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
+                     BlockKernel kernel);
+
 // The vector kernels (block_step_x86.cpp). Forces of all blocks into f (3 doubles per mass).
 void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* v, double* f);
 void blockForcesAvx512(const SpringBlocks& blocks, const double* x, const double* v, double* f);
@@ -58,6 +70,10 @@ std::size_t remainderForcesAvx512(const PartModel& model, const double* x, const
 // Integrates masses [0, n) for the largest n that is a multiple of the width; returns n.
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state);
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state);
+void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+                             const double* x, const double* v, double* f);
+void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state);
+void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state);
 // holdAtRest for masses [0, n), n the largest multiple of 8; returns n.
 std::size_t holdAtRestAvx512(const PartModel& model, const std::uint16_t* cover, PartState& state);
 

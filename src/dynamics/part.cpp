@@ -3,6 +3,7 @@
 
 #include "divergence.hpp"
 #include "model/kring.hpp"
+#include "model/spring_blocks.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -237,7 +238,7 @@ void Part::step(StepCounters* counters) {
     const double start = state_.time;
     advance({settings_.simulation.timeStep, settings_.simulation.gravity}, counters);
     // The full step checks every mass itself (stepFullModel); the region step's are checked here.
-    if (!fullModelStepped_) detail::checkMassesFinite(*model_, settings_.simulation, state_, movingMasses(), std::nullopt, start);
+    if (!fullModelStepped_) detail::checkRegionFinite(*model_, settings_.simulation, state_, region_, std::nullopt, start);
     retireRestingZones();
 }
 
@@ -253,7 +254,8 @@ void Part::advance(const StepContext& context, StepCounters* counters) {
     fullModelStepped_ = true;
     if (region_.coversEveryMass() && settings_.zones.fullSweepWhenComplete)
         stepFullModel(*model_, s, {}, state_, counters);
-    else if (settings_.zones.fullStepWhenCheaper && fullStepCostsLess(*model_, region_.springs().size(), region_.masses().size()))
+    else if (settings_.zones.fullStepWhenCheaper && fullStepCostsLess(*model_, region_.springs().size(), region_.masses().size(),
+                                                                     SpringBlocks::kWidth * region_.fullBlocks().size()))
         stepRegionByFullModel(*model_, s, region_, state_, counters);
     else {
         fullModelStepped_ = false;

@@ -12,22 +12,28 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
     const detail::MassUpdate p = detail::MassUpdate::from(settings);
     const Index* springA = model.springA.data();
     const Index* springB = model.springB.data();
-    Vec3* __restrict x = state.positions.data();
-    Vec3* __restrict v = state.velocities.data();
-    Vec3* __restrict f = state.forces.data();
+    Vec3* x = state.positions.data();
+    Vec3* v = state.velocities.data();
+    Vec3* f = state.forces.data();
     const std::uint16_t* mask = region.coverCounts().data();
     const std::span<const Index> computed = region.springs().members(), moving = region.masses().members();
 
-    // Springs: forces reach only the moving ends (a fixed end is held by the rigid body).
-    for (Index e : computed) {
+    // Springs: forces reach only the moving ends (a fixed end is held by the rigid body). Whole
+    // spring blocks by the vector kernel, then the others one at a time.
+    if (!region.fullBlocks().empty())
+        detail::regionBlockForces(*model.springBlocks, region.fullBlocks().members(), mask, state.positions.data()->data(),
+                                  state.velocities.data()->data(), state.forces.data()->data(), detail::fullStepKernel());
+    for (Index e : region.looseSprings()) {
         const Index a = springA[e], b = springB[e];
         const Vec3 g =
             detail::springForceOnFirst(model.stiffness[e], model.damping[e], model.restLength[e], x[a], x[b], v[a], v[b]);
         if (mask[a] != 0) f[a] += g;
         if (mask[b] != 0) f[b] -= g;
     }
-    // Moving masses: body forces, integration, restoration; pending forces consumed.
-    for (Index i : moving) {
+    // Moving masses: body forces, integration, restoration; pending forces consumed. Whole
+    // octets by the vector kernel, then the others one at a time (each mass alone: same bits).
+    detail::integrateOctets(model, p, region.fullOctets().members(), state, detail::fullStepKernel());
+    for (Index i : region.looseMasses()) {
         const Vec3 total = f[i] + p.bodyForce(model.mass[i], x[i], v[i], model.restPositions[i]);
         f[i] = Vec3::Zero();
         p.integrate(model.inverseMass[i], total, model.restPositions[i], x[i], v[i]);
@@ -46,14 +52,17 @@ void stepRegionByFullModel(const PartModel& model, const SimulationSettings& set
     detail::holdAtRest(model, region.coverCounts(), state, detail::fullStepKernel());
 }
 
-bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses) {
+bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses,
+                       std::size_t springsInWholeBlocks) {
     // Costs in ns on the reference machine (simulation.hpp); only their ratios matter.
-    constexpr double kRegionSpring = 13.0, kRegionMass = 2.0, kBlockSpring = 4.0, kSweepSpring = 10.0, kPutBack = 0.5;
+    constexpr double kRegionSpring = 13.0, kRegionBlockSpring = 4.5, kRegionMass = 2.0;
+    constexpr double kBlockSpring = 4.0, kSweepSpring = 10.0, kPutBack = 0.5;
     // Switch only when clearly cheaper: near the crossover the two cost the same, and in a world
     // the full step's streaming also evicts what the collision stages keep in cache (measured on
     // the haptic scene, ~35 % of the springs: no difference either way).
     constexpr double kMargin = 0.9;
-    const double region = kRegionSpring * double(computedSprings) + kRegionMass * double(movingMasses);
+    const double region = kRegionSpring * double(computedSprings - springsInWholeBlocks) +
+                          kRegionBlockSpring * double(springsInWholeBlocks) + kRegionMass * double(movingMasses);
     const double full = (model.hasSpringBlocks() ? kBlockSpring : kSweepSpring) * double(model.springCount()) +
                         kPutBack * double(model.massCount() - movingMasses);
     return full < kMargin * region;

@@ -12,6 +12,8 @@ void appendBlock(SpringBlocks& blocks, std::span<const std::size_t> lanes, std::
     blocks.first.push_back(springA[lanes[0]]);
     blocks.offset.push_back(springB[lanes[0]] - springA[lanes[0]]);
     for (std::size_t e : lanes) {
+        blocks.laneOfSpring[e] = Index(blocks.laneSpring.size());
+        blocks.laneSpring.push_back(Index(e));
         blocks.restLength.push_back(restLength[e]);
         blocks.stiffness.push_back(stiffness[e]);
         blocks.damping.push_back(damping[e]);
@@ -32,6 +34,7 @@ SpringBlocks buildSpringBlocks(std::span<const Index> springA, std::span<const I
     std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) { return key(p) < key(q); });
 
     SpringBlocks blocks;
+    blocks.laneOfSpring.assign(springs, SpringBlocks::kNoLane);
     std::vector<bool> blocked(springs, false);
     for (std::size_t start = 0; start < springs;) {
         std::size_t end = start + 1;

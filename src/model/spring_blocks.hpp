@@ -41,6 +41,11 @@ struct SpringBlocks {
     // (8B) constants of lane i of block q at 8q + i.
     std::vector<double> restLength, stiffness, damping;
     std::vector<Index> remainder;  // springs in no block, ascending
+    // Lane 8q + i of block q is spring laneSpring[8q + i]; laneOfSpring[e] is its lane, or
+    // kNoLane for a remainder spring (the active region tracks its blocks with them).
+    static constexpr Index kNoLane = ~Index(0);
+    std::vector<Index> laneSpring;    // (8B)
+    std::vector<Index> laneOfSpring;  // (E)
 
     std::size_t blockCount() const { return first.size(); }
     bool empty() const { return first.empty(); }

@@ -27,7 +27,7 @@ void checkFinite(const StepContext& step, const Bodies& bodies) {
         if (part.movingMasses().empty()) continue;
         SimulationSettings used = part.settings().simulation;  // as the zone dynamics stepped it
         used.timeStep = step.timeStep;
-        checkMassesFinite(part.model(), used, part.state(), part.movingMasses(), id, step.time);
+        checkRegionFinite(part.model(), used, part.state(), part.region(), id, step.time);
     }
     for (BodyId id = 0; id < bodies.size(); ++id) {
         const RigidBody& body = bodies.rigid[id];

@@ -2,9 +2,11 @@
 // uncovers, the moving masses are the covered ones and the computed springs are exactly the
 // springs with a moving end, each listed once; the counts are the covers.
 #include "flexfit/flexfit.hpp"
+#include "model/spring_blocks.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 
@@ -54,4 +56,57 @@ TEST(ActiveRegion, CoveringEveryMassComputesEverySpring) {
     for (Index m = 0; m < model->massCount(); ++m) region.uncover(m);
     EXPECT_TRUE(region.empty());
     EXPECT_TRUE(region.springs().empty());
+}
+
+// The region step's layout on a model with spring blocks, against brute force over the blocks'
+// lanes: the full blocks are those whose 8 springs are all computed, the loose springs are the
+// computed springs in none of them, each listed once. Covers sweep whole rows so blocks fill.
+TEST(ActiveRegion, FullBlocksAndLooseSpringsPartitionTheComputedSprings) {
+    const auto model = buildPartModel(makeTorus1());
+    ASSERT_TRUE(model->hasSpringBlocks());
+    const SpringBlocks& blocks = *model->springBlocks;
+    ActiveRegion region(*model);
+    std::vector<int> covers(model->massCount(), 0);
+    std::mt19937 rng(9);
+    std::size_t largestFull = 0;
+    for (int op = 0; op < 6000; ++op) {
+        const Index start = Index(rng() % model->massCount()), length = Index(1 + rng() % 40);
+        const bool add = rng() % 3 != 0;
+        for (Index m = start; m < std::min<Index>(start + length, Index(model->massCount())); ++m) {
+            if (add) {
+                region.cover(m);
+                ++covers[m];
+            } else if (covers[m] > 0) {
+                region.uncover(m);
+                --covers[m];
+            }
+        }
+        if (op % 50 != 0) continue;
+        const std::set<Index> computed(region.springs().members().begin(), region.springs().members().end());
+        std::set<Index> full, loose = computed;
+        for (Index q = 0; q < blocks.blockCount(); ++q) {
+            bool all = true;
+            for (Index i = 0; i < SpringBlocks::kWidth; ++i) all = all && computed.count(blocks.laneSpring[SpringBlocks::kWidth * q + i]) > 0;
+            if (!all) continue;
+            full.insert(q);
+            for (Index i = 0; i < SpringBlocks::kWidth; ++i) loose.erase(blocks.laneSpring[SpringBlocks::kWidth * q + i]);
+        }
+        const auto fullMembers = region.fullBlocks().members(), looseMembers = region.looseSprings().members();
+        EXPECT_EQ(std::set<Index>(fullMembers.begin(), fullMembers.end()), full) << "op " << op;
+        EXPECT_EQ(fullMembers.size(), full.size());
+        EXPECT_EQ(std::set<Index>(looseMembers.begin(), looseMembers.end()), loose) << "op " << op;
+        EXPECT_EQ(looseMembers.size(), loose.size());
+        largestFull = std::max(largestFull, full.size());
+    }
+    EXPECT_GT(largestFull, 20u);  // the test saw whole blocks come and go
+}
+
+TEST(ActiveRegion, WithoutBlocksEveryComputedSpringIsLoose) {
+    const auto model = buildPartModel(makeIcoSphere(1.0, 2));
+    ASSERT_FALSE(model->hasSpringBlocks());
+    ActiveRegion region(*model);
+    for (Index m = 0; m < 30; ++m) region.cover(m);
+    EXPECT_TRUE(region.fullBlocks().empty());
+    EXPECT_EQ(std::vector<Index>(region.looseSprings().members().begin(), region.looseSprings().members().end()),
+              std::vector<Index>(region.springs().members().begin(), region.springs().members().end()));
 }

@@ -265,3 +265,44 @@ TEST(BlockStep, HoldAtRestPutsBackExactlyTheUncoveredMassesInEveryKernel) {
         }
     }
 }
+
+// The region step's whole blocks: every kernel gives the bits of a spring-by-spring reference
+// that applies each force to the moving ends only, blocks in the listed order (first ends, then
+// second ends).
+TEST(BlockStep, RegionBlocksReachOnlyMovingEndsInEveryKernel) {
+    const auto model = buildPartModel(makeTorus2());
+    const SpringBlocks& blocks = *model->springBlocks;
+    ASSERT_FALSE(blocks.empty());
+    const PartState moved = kickedState(*model, 8);
+    std::mt19937 rng(4);
+    std::vector<std::uint16_t> cover(model->massCount());
+    for (auto& c : cover) c = rng() % 3 == 0 ? 0 : 1;
+    std::vector<Index> listed;
+    for (Index q = 0; q < blocks.blockCount(); q += 1 + rng() % 3) listed.push_back(q);
+    std::shuffle(listed.begin(), listed.end(), rng);
+    PartState expected = moved;
+    for (Index q : listed) {
+        Vec3 g[SpringBlocks::kWidth];
+        for (Index i = 0; i < SpringBlocks::kWidth; ++i) {
+            const Index e = blocks.laneSpring[SpringBlocks::kWidth * q + i];
+            g[i] = detail::springForceOnFirst(model->stiffness[e], model->damping[e], model->restLength[e], moved.positions[model->springA[e]],
+                                              moved.positions[model->springB[e]], moved.velocities[model->springA[e]],
+                                              moved.velocities[model->springB[e]]);
+        }
+        for (Index i = 0; i < SpringBlocks::kWidth; ++i) {
+            const Index a = model->springA[blocks.laneSpring[SpringBlocks::kWidth * q + i]];
+            if (cover[a] != 0) expected.forces[a] += g[i];
+        }
+        for (Index i = 0; i < SpringBlocks::kWidth; ++i) {
+            const Index b = model->springB[blocks.laneSpring[SpringBlocks::kWidth * q + i]];
+            if (cover[b] != 0) expected.forces[b] -= g[i];
+        }
+    }
+    for (BlockKernel kernel : kAllKernels) {
+        if (!detail::blockKernelAvailable(kernel)) continue;
+        PartState state = moved;
+        detail::regionBlockForces(blocks, listed, cover.data(), state.positions.data()->data(), state.velocities.data()->data(),
+                                  state.forces.data()->data(), kernel);
+        EXPECT_EQ(state.forces, expected.forces) << detail::toString(kernel);
+    }
+}

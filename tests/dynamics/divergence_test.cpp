@@ -113,3 +113,33 @@ TEST(Divergence, TheLikelyCauseComesFromTheStabilityBound) {
     bound << "likely cause: the time step 10 s is above the stability bound " << unstable.unstableTimeStep << " s of this material";
     EXPECT_TRUE(contains(step, bound.str())) << step;
 }
+
+// The region check (whole octets contiguously, other masses gathered) finds a bad value wherever
+// the mass-by-mass test would after a step: positions of any moving mass, velocities with
+// explicit Euler, anything of a loose mass; and never looks outside the region.
+TEST(Divergence, RegionCheckFindsWhatTheMassByMassTestFinds) {
+    const auto model = buildPartModel(makeTorus1());
+    ActiveRegion region(*model);
+    for (Index m = 0; m < 16; ++m) region.cover(m);  // octets 0 and 1
+    region.cover(100);                               // a loose mass
+    ASSERT_EQ(region.fullOctets().size(), 2u);
+    ASSERT_EQ(region.looseMasses().size(), 1u);
+    SimulationSettings semiImplicit, explicitEuler;
+    explicitEuler.integrator = Integrator::ExplicitEuler;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    auto throwsFor = [&](const SimulationSettings& settings, auto spoil) {
+        PartState state = PartState::atRest(*model);
+        spoil(state);
+        try {
+            detail::checkRegionFinite(*model, settings, state, region, BodyId(2), 0.5);
+        } catch (const DivergenceError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(throwsFor(semiImplicit, [](PartState&) {}), "");
+    EXPECT_NE(throwsFor(semiImplicit, [&](PartState& s) { s.positions[9].y() = nan; }).find("position of mass 9"), std::string::npos);
+    EXPECT_NE(throwsFor(explicitEuler, [&](PartState& s) { s.velocities[3].z() = nan; }).find("velocity of mass 3"), std::string::npos);
+    EXPECT_NE(throwsFor(semiImplicit, [&](PartState& s) { s.forces[100].x() = nan; }).find("force of mass 100"), std::string::npos);
+    EXPECT_EQ(throwsFor(semiImplicit, [&](PartState& s) { s.positions[200].x() = nan; }), "");  // not moving: not checked
+}
