@@ -142,7 +142,8 @@ public:
     // Masses whose position may have changed since clearChangedMasses(): every mass stepped or
     // displaced, and every mass that returned to rest. Collision hierarchies refit from it.
     // (After a region step the region's masses join the list when it is first read: a part
-    // stepped with no one reading it pays nothing for it.)
+    // stepped with no one reading it pays nothing for it. So this const read writes the part's
+    // bookkeeping: not for concurrent readers.)
     std::span<const Index> changedMasses() const;
     void clearChangedMasses();
 

@@ -56,7 +56,7 @@ namespace {
 // The exponent trick of allFinite over a region: whole octets contiguously, the rest gathered.
 bool regionFinite(const SimulationSettings& settings, const PartState& state, const ActiveRegion& region) {
     constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL, kExponentOne = std::uint64_t(1) << 52;
-    const bool velocities = settings.integrator != Integrator::SemiImplicitEuler;
+    (void)settings;
     std::uint64_t lanes[8] = {};
     auto scan = [&](const double* p) {
         for (std::size_t i = 0; i < 24; i += 8)
@@ -64,7 +64,7 @@ bool regionFinite(const SimulationSettings& settings, const PartState& state, co
     };
     for (const Index octet : region.fullOctets()) {
         scan(state.positions.data()->data() + 24 * std::size_t(octet));
-        if (velocities) scan(state.velocities.data()->data() + 24 * std::size_t(octet));
+        scan(state.velocities.data()->data() + 24 * std::size_t(octet));
     }
     std::uint64_t any = 0;
     for (std::uint64_t lane : lanes) any |= lane;

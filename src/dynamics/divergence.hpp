@@ -35,8 +35,8 @@ void checkMassesFinite(const PartModel& model, const SimulationSettings& setting
 void checkAllMassesFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
                           std::optional<BodyId> body, double time);
 // checkMassesFinite over a region's moving masses after stepActiveRegion: its whole octets in
-// contiguous passes over their positions (and velocities with explicit Euler; the octets' forces
-// were consumed by the step, as in checkAllMassesFinite), its other masses gathered.
+// contiguous passes over their positions and velocities (the step consumed their forces), its
+// other masses gathered.
 void checkRegionFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
                        const ActiveRegion& region, std::optional<BodyId> body, double time);
 

@@ -78,8 +78,9 @@ void embeddedPositions(const SurfaceEmbedding& e, std::span<const Face> simulati
                        std::vector<Vec3>& out) {
     out.resize(e.vertexCount());
     for (std::size_t i = 0; i < out.size(); ++i) {
-        const Vec3 anchor = anchorOf(x, simulationFaces[e.triangle[i]], e.weights[i], e.offset[i]);
-        out[i] = e.mesh.vertices[i] + (anchor - e.restAnchor[i]);
+        const Vec3 moved = anchorOf(x, simulationFaces[e.triangle[i]], e.weights[i], e.offset[i]) - e.restAnchor[i];
+        // A coordinate that did not move is copied, not added to: p + 0 would turn -0.0 into +0.0.
+        for (int c = 0; c < 3; ++c) out[i][c] = moved[c] == 0.0 ? e.mesh.vertices[i][c] : e.mesh.vertices[i][c] + moved[c];
     }
 }
 

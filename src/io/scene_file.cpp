@@ -220,6 +220,8 @@ PartMeshes readPartMesh(Table& t, const std::filesystem::path& base, const Scene
     if (draw != "original" && draw != "simulation")
         t.fail(*t.node("draw"), "draw", "unknown value '" + draw + "' (expected 'original' or 'simulation')");
     const bool drawOriginal = draw == "original";
+    if (!remesh && t.has("draw"))
+        warnings.push_back({t.line("draw"), t.what() + ", key 'draw': has no effect without 'remesh' (the file's mesh is simulated and drawn)"});
     if (!remesh) return {std::move(result.mesh), {}};
     try {
         TriMesh simulated = remeshForSimulation(result.mesh, *remesh, path.string()).mesh;

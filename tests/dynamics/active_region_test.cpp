@@ -101,6 +101,47 @@ TEST(ActiveRegion, FullBlocksAndLooseSpringsPartitionTheComputedSprings) {
     EXPECT_GT(largestFull, 20u);  // the test saw whole blocks come and go
 }
 
+// The octets, against brute force: whole octets are those whose 8 masses all move; loose masses
+// are the moving masses in none (the last V mod 8 masses are always loose). A mesh whose mass
+// count is not a multiple of 8, covered and uncovered in runs so octets form and break up.
+TEST(ActiveRegion, FullOctetsAndLooseMassesPartitionTheMovingMasses) {
+    const auto model = buildPartModel(makeIcoSphere(1.0, 2));  // 162 masses: 20 octets and 2 more
+    ActiveRegion region(*model);
+    std::vector<int> covers(model->massCount(), 0);
+    std::mt19937 rng(21);
+    std::size_t largestWhole = 0;
+    for (int op = 0; op < 4000; ++op) {
+        const Index start = Index(rng() % model->massCount()), length = Index(1 + rng() % 20);
+        const bool add = rng() % 2 == 0;
+        for (Index m = start; m < std::min<Index>(start + length, Index(model->massCount())); ++m) {
+            if (add) {
+                region.cover(m);
+                ++covers[m];
+            } else if (covers[m] > 0) {
+                region.uncover(m);
+                --covers[m];
+            }
+        }
+        std::set<Index> whole, loose;
+        for (Index m = 0; m < model->massCount(); ++m)
+            if (covers[m] > 0) loose.insert(m);
+        for (Index o = 0; o < model->massCount() / 8; ++o) {
+            bool all = true;
+            for (Index m = 8 * o; m < 8 * o + 8; ++m) all = all && covers[m] > 0;
+            if (!all) continue;
+            whole.insert(o);
+            for (Index m = 8 * o; m < 8 * o + 8; ++m) loose.erase(m);
+        }
+        const auto w = region.fullOctets().members(), l = region.looseMasses().members();
+        ASSERT_EQ(std::set<Index>(w.begin(), w.end()), whole) << "op " << op;
+        ASSERT_EQ(w.size(), whole.size());
+        ASSERT_EQ(std::set<Index>(l.begin(), l.end()), loose) << "op " << op;
+        ASSERT_EQ(l.size(), loose.size());
+        largestWhole = std::max(largestWhole, whole.size());
+    }
+    EXPECT_GT(largestWhole, 5u);
+}
+
 TEST(ActiveRegion, WithoutBlocksEveryComputedSpringIsLoose) {
     const auto model = buildPartModel(makeIcoSphere(1.0, 2));
     ASSERT_FALSE(model->hasSpringBlocks());

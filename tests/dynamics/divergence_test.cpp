@@ -140,6 +140,7 @@ TEST(Divergence, RegionCheckFindsWhatTheMassByMassTestFinds) {
     EXPECT_EQ(throwsFor(semiImplicit, [](PartState&) {}), "");
     EXPECT_NE(throwsFor(semiImplicit, [&](PartState& s) { s.positions[9].y() = nan; }).find("position of mass 9"), std::string::npos);
     EXPECT_NE(throwsFor(explicitEuler, [&](PartState& s) { s.velocities[3].z() = nan; }).find("velocity of mass 3"), std::string::npos);
+    EXPECT_NE(throwsFor(semiImplicit, [&](PartState& s) { s.velocities[12].x() = nan; }).find("velocity of mass 12"), std::string::npos);
     EXPECT_NE(throwsFor(semiImplicit, [&](PartState& s) { s.forces[100].x() = nan; }).find("force of mass 100"), std::string::npos);
     EXPECT_EQ(throwsFor(semiImplicit, [&](PartState& s) { s.positions[200].x() = nan; }), "");  // not moving: not checked
 }

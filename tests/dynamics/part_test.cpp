@@ -339,6 +339,27 @@ TEST(Part, ChangedMassesAreTheMovedOnesAndEveryMassWhenAllMove) {
     EXPECT_EQ(part.changedMasses().size(), model->massCount());
 }
 
+// The region's masses join the changed list when it is read, not when they step: a read after
+// the zone retired (its masses back at rest), from a copy, or after a clear still lists exactly
+// what changed since the last clear.
+TEST(Part, ChangedMassesReadLateStillListWhatMoved) {
+    const auto model = buildPartModel(makeTorus1());
+    Part part(model, zoneSettings());
+    const ZoneId zone = part.openZone(ZoneSeed::mass(5), 3);
+    part.step();
+    const std::set<Index> moved = asSet(part.movingMasses());
+    const Part copy = part;  // taken while the region's marks are pending
+    part.retireZone(zone);   // every moved mass back at rest before anyone read the list
+    EXPECT_TRUE(part.movingMasses().empty());
+    EXPECT_EQ(asSet(part.changedMasses()), moved);
+    EXPECT_EQ(asSet(copy.changedMasses()), moved);
+    part.clearChangedMasses();
+    part.openZone(ZoneSeed::mass(300), 2);  // a new zone, not stepped: nothing changed yet
+    EXPECT_TRUE(part.changedMasses().empty());
+    part.step();
+    EXPECT_EQ(asSet(part.changedMasses()), asSet(part.movingMasses()));
+}
+
 // --- Pinned hashes (golden.hpp) ---
 
 TEST(Part, GoldenHashUnderLoad) {

@@ -426,6 +426,9 @@ TEST(SceneFile, RemeshGivesTheModelNearUniformEdges) {
     }
     const Scene simulationDrawn = parseScene(part + "remesh = 0.1\ndraw = \"simulation\"\n", "scene.toml", dir.path());
     EXPECT_FALSE(simulationDrawn.parts[0].model->drawn);
+    const Scene drawnOnly = parseScene(part + "draw = \"original\"\n", "scene.toml", dir.path());
+    ASSERT_EQ(drawnOnly.warnings.size(), 1u);
+    EXPECT_NE(drawnOnly.warnings[0].message.find("key 'draw': has no effect without 'remesh'"), std::string::npos);
     EXPECT_GT(simulationDrawn.parts[0].model->drawnMesh().faces.size(), 300u);
     auto error = [&](const std::string& extra) { return errorOf(part + extra, dir.path()); };
     EXPECT_NE(error("remesh = 0.1\ndraw = \"both\"\n").find("scene.toml:5: part 1, key 'draw': unknown value 'both'"), std::string::npos)
