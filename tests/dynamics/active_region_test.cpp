@@ -58,6 +58,26 @@ TEST(ActiveRegion, CoveringEveryMassComputesEverySpring) {
     EXPECT_TRUE(region.springs().empty());
 }
 
+namespace {
+
+// Covers (or uncovers, where covered) a run of up to maxLength consecutive masses from a random
+// start, keeping `covers` as the brute-force count.
+void coverRun(ActiveRegion& region, std::vector<int>& covers, std::mt19937& rng, Index maxLength, bool add) {
+    const auto masses = Index(covers.size());
+    const Index start = Index(rng() % masses), length = Index(1 + rng() % maxLength);
+    for (Index m = start; m < std::min<Index>(start + length, masses); ++m) {
+        if (add) {
+            region.cover(m);
+            ++covers[m];
+        } else if (covers[m] > 0) {
+            region.uncover(m);
+            --covers[m];
+        }
+    }
+}
+
+}  // namespace
+
 // The region step's layout on a model with spring blocks, against brute force over the blocks'
 // lanes: the full blocks are those whose 8 springs are all computed, the loose springs are the
 // computed springs in none of them, each listed once. Covers sweep whole rows so blocks fill.
@@ -70,17 +90,7 @@ TEST(ActiveRegion, FullBlocksAndLooseSpringsPartitionTheComputedSprings) {
     std::mt19937 rng(9);
     std::size_t largestFull = 0;
     for (int op = 0; op < 6000; ++op) {
-        const Index start = Index(rng() % model->massCount()), length = Index(1 + rng() % 40);
-        const bool add = rng() % 3 != 0;
-        for (Index m = start; m < std::min<Index>(start + length, Index(model->massCount())); ++m) {
-            if (add) {
-                region.cover(m);
-                ++covers[m];
-            } else if (covers[m] > 0) {
-                region.uncover(m);
-                --covers[m];
-            }
-        }
+        coverRun(region, covers, rng, 40, rng() % 3 != 0);
         if (op % 50 != 0) continue;
         const std::set<Index> computed(region.springs().members().begin(), region.springs().members().end());
         std::set<Index> full, loose = computed;
@@ -111,17 +121,7 @@ TEST(ActiveRegion, FullOctetsAndLooseMassesPartitionTheMovingMasses) {
     std::mt19937 rng(21);
     std::size_t largestWhole = 0;
     for (int op = 0; op < 4000; ++op) {
-        const Index start = Index(rng() % model->massCount()), length = Index(1 + rng() % 20);
-        const bool add = rng() % 2 == 0;
-        for (Index m = start; m < std::min<Index>(start + length, Index(model->massCount())); ++m) {
-            if (add) {
-                region.cover(m);
-                ++covers[m];
-            } else if (covers[m] > 0) {
-                region.uncover(m);
-                --covers[m];
-            }
-        }
+        coverRun(region, covers, rng, 20, rng() % 2 == 0);
         std::set<Index> whole, loose;
         for (Index m = 0; m < model->massCount(); ++m)
             if (covers[m] > 0) loose.insert(m);
