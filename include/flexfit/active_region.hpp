@@ -72,6 +72,8 @@ private:
     static constexpr Index kNoGroup = ~Index(0);
     void springJoins(Index spring);
     void springLeaves(Index spring);
+    Index blockOf(Index spring) const;                 // its block, or kNoGroup
+    Index springOfBlock(Index block, Index i) const;   // lane i's spring
     Index octetOf(Index mass) const { return mass < coverCount_.size() / 8 * 8 ? mass / 8 : kNoGroup; }
 
     const Topology* topology_ = nullptr;

@@ -67,20 +67,21 @@ bool ActiveRegion::uncover(Index mass) {
     return true;
 }
 
+Index ActiveRegion::blockOf(Index spring) const {
+    const Index lane = blocks_->laneOfSpring[spring];
+    return lane == SpringBlocks::kNoLane ? kNoGroup : lane / SpringBlocks::kWidth;
+}
+
 void ActiveRegion::springJoins(Index e) {
     springs_.insert(e);
-    if (blocks_ == nullptr) return;
-    const Index lane = blocks_->laneOfSpring[e];
-    blockGroups_.join(e, lane == SpringBlocks::kNoLane ? kNoGroup : lane / SpringBlocks::kWidth,
-                      [this](Index q, Index i) { return blocks_->laneSpring[SpringBlocks::kWidth * q + i]; });
+    if (blocks_ != nullptr) blockGroups_.join(e, blockOf(e), [this](Index q, Index i) { return springOfBlock(q, i); });
 }
 
 void ActiveRegion::springLeaves(Index e) {
     springs_.erase(e);
-    if (blocks_ == nullptr) return;
-    const Index lane = blocks_->laneOfSpring[e];
-    blockGroups_.leave(e, lane == SpringBlocks::kNoLane ? kNoGroup : lane / SpringBlocks::kWidth,
-                       [this](Index q, Index i) { return blocks_->laneSpring[SpringBlocks::kWidth * q + i]; });
+    if (blocks_ != nullptr) blockGroups_.leave(e, blockOf(e), [this](Index q, Index i) { return springOfBlock(q, i); });
 }
+
+Index ActiveRegion::springOfBlock(Index block, Index i) const { return blocks_->laneSpring[SpringBlocks::kWidth * block + i]; }
 
 }  // namespace flexfit

@@ -54,13 +54,6 @@ void remainderForces(const PartModel& model, const double* x, const double* v, d
     }
 }
 
-void integrateMass(const PartModel& model, const MassUpdate& p, PartState& state, std::size_t i) {
-    Vec3& f = state.forces[i];
-    const Vec3 total = f + p.bodyForce(model.mass[i], state.positions[i], state.velocities[i], model.restPositions[i]);
-    f = Vec3::Zero();
-    p.integrate(model.inverseMass[i], total, model.restPositions[i], state.positions[i], state.velocities[i]);
-}
-
 void integrateScalar(const PartModel& model, const MassUpdate& p, PartState& state, std::size_t begin) {
     for (std::size_t i = begin; i < model.massCount(); ++i) integrateMass(model, p, state, i);
 }

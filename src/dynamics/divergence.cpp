@@ -54,9 +54,8 @@ bool allFinite(const PartState& state, std::span<const Index> masses) {
 namespace {
 
 // The exponent trick of allFinite over a region: whole octets contiguously, the rest gathered.
-bool regionFinite(const SimulationSettings& settings, const PartState& state, const ActiveRegion& region) {
+bool regionFinite(const PartState& state, const ActiveRegion& region) {
     constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL, kExponentOne = std::uint64_t(1) << 52;
-    (void)settings;
     std::uint64_t lanes[8] = {};
     auto scan = [&](const double* p) {
         for (std::size_t i = 0; i < 24; i += 8)
@@ -119,7 +118,7 @@ void checkAllMassesFinite(const PartModel& model, const SimulationSettings& sett
 
 void checkRegionFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
                        const ActiveRegion& region, std::optional<BodyId> body, double time) {
-    if (regionFinite(settings, state, region)) return;
+    if (regionFinite(state, region)) return;
     checkMassesFinite(model, settings, state, region.masses().members(), body, time);  // finds it and throws
 }
 

@@ -58,6 +58,14 @@ struct MassUpdate {
     }
 };
 
+// One mass's update: its pending force plus body forces, integrated; the pending force consumed.
+inline void integrateMass(const PartModel& model, const MassUpdate& p, PartState& state, std::size_t i) {
+    Vec3& f = state.forces[i];
+    const Vec3 total = f + p.bodyForce(model.mass[i], state.positions[i], state.velocities[i], model.restPositions[i]);
+    f = Vec3::Zero();
+    p.integrate(model.inverseMass[i], total, model.restPositions[i], state.positions[i], state.velocities[i]);
+}
+
 // Force of a spring on its first mass a (the second mass b receives the opposite):
 // -(k (|d| - L) + c (v_a - v_b).u) u with d = x_a - x_b, u = d/|d|; zero for coincident masses.
 // Every step kernel, scalar or vector, evaluates it in exactly this order (no fused multiply-add:

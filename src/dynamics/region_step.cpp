@@ -33,11 +33,7 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
     // Moving masses: body forces, integration, restoration; pending forces consumed. Whole
     // octets by the vector kernel, then the others one at a time (each mass alone: same bits).
     detail::integrateOctets(model, p, region.fullOctets().members(), state, detail::fullStepKernel());
-    for (Index i : region.looseMasses()) {
-        const Vec3 total = f[i] + p.bodyForce(model.mass[i], x[i], v[i], model.restPositions[i]);
-        f[i] = Vec3::Zero();
-        p.integrate(model.inverseMass[i], total, model.restPositions[i], x[i], v[i]);
-    }
+    for (Index i : region.looseMasses()) detail::integrateMass(model, p, state, i);
     state.time += settings.timeStep;
     ++state.stepCount;
     if (counters != nullptr) {
