@@ -42,9 +42,8 @@ bench: release
 	@scripts/install-deps.sh --bench
 	build/release/bench/bench_msd_step $(BENCH_FLAGS) --benchmark_out=bench/results/msd_step.csv
 	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitFullStep BM_NaiveFullStep
-	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitSweep BM_NaiveFullStep
-	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitBlocksAvx2 BM_NaiveFullStep
-	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitBlocksScalar BM_NaiveFullStep
+	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitAvx2 BM_NaiveFullStep
+	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitScalar BM_NaiveFullStep
 	build/release/bench/bench_part_step $(BENCH_FLAGS) --benchmark_out=bench/results/part_step.csv
 	build/release/bench/bench_part_ratios $(BENCH_FLAGS) --benchmark_out=bench/results/part_ratios.csv
 	/usr/bin/python3 tools/bench_ratios.py bench/results/part_ratios.csv --counter a_over_b

@@ -3,8 +3,8 @@
 // assimp-testmodels Wuson, as the file orders its vertices, renumbered breadth-first, and
 // remeshed at 0.5 % of its size): Flexfit's step against the thesis-style naive
 // array-of-structs reference (tests/support/naive_msd.hpp), same physics, same meshes, in one
-// run. Also each way of the step forced: the per-mass sweep, and the spring blocks with the
-// scalar and AVX2 kernels (stepFullModel itself uses AVX-512 where the CPU has it).
+// run. Also the step with its scalar and AVX2 kernels forced (stepFullModel itself uses AVX-512
+// where the CPU has it).
 // Counters: steps/s and spring updates/s. Single thread.
 #include "dynamics/flush_denormals.hpp"
 #include "dynamics/full_step.hpp"
@@ -99,46 +99,35 @@ void BM_NaiveFullStep(benchmark::State& state) {
     setCounters(state, std::size_t(model.numOfSprings));
 }
 
-// The two ways of the full step, forced (stepFullModel picks blocks and the widest kernel).
-void runDetailStep(benchmark::State& state, bool sweep, flexfit::detail::BlockKernel kernel) {
+// The full step with a kernel forced (stepFullModel picks the widest).
+void runDetailStep(benchmark::State& state, flexfit::detail::BlockKernel kernel) {
     const TriMesh& mesh = meshByIndex(int(state.range(0)));
     state.SetLabel(mesh.name);
     if (skipMissing(state, mesh)) return;
-    if (!sweep && !flexfit::detail::blockKernelAvailable(kernel)) {
+    if (!flexfit::detail::blockKernelAvailable(kernel)) {
         state.SkipWithError("kernel not supported by this CPU");
         return;
     }
     const auto model = flexfit::buildPartModel(mesh, {flexfit::Material::elastic(), 1.0, {}, {}, {}});
-    if (!sweep && !model->hasSpringBlocks()) {
-        state.SkipWithError("no spring blocks in this vertex order");
-        return;
-    }
     const auto update = flexfit::detail::MassUpdate::from(benchSettings());
     flexfit::PartState partState = flexfit::PartState::atRest(*model);
     const flexfit::detail::FlushDenormals flush;  // as stepFullModel
     for (auto _ : state) {
-        if (sweep)
-            flexfit::detail::sweepFullModel(*model, update, partState);
-        else
-            flexfit::detail::stepSpringBlocks(*model, update, partState, kernel);
+        flexfit::detail::stepSpringBlocks(*model, update, partState, kernel);
         benchmark::DoNotOptimize(partState.positions.data());
     }
     setCounters(state, model->springCount());
 }
 
-void BM_FlexfitSweep(benchmark::State& state) { runDetailStep(state, true, flexfit::detail::BlockKernel::Scalar); }
-void BM_FlexfitBlocksScalar(benchmark::State& state) {
-    runDetailStep(state, false, flexfit::detail::BlockKernel::Scalar);
-}
-void BM_FlexfitBlocksAvx2(benchmark::State& state) { runDetailStep(state, false, flexfit::detail::BlockKernel::Avx2); }
+void BM_FlexfitScalar(benchmark::State& state) { runDetailStep(state, flexfit::detail::BlockKernel::Scalar); }
+void BM_FlexfitAvx2(benchmark::State& state) { runDetailStep(state, flexfit::detail::BlockKernel::Avx2); }
 
 // Interleaved per mesh so that all implementations see the same machine state.
 #define FLEXFIT_MSD_BENCHMARKS(mesh)                     \
     BENCHMARK(BM_FlexfitFullStep)->Arg(mesh);            \
     BENCHMARK(BM_NaiveFullStep)->Arg(mesh);              \
-    BENCHMARK(BM_FlexfitSweep)->Arg(mesh);               \
-    BENCHMARK(BM_FlexfitBlocksAvx2)->Arg(mesh);          \
-    BENCHMARK(BM_FlexfitBlocksScalar)->Arg(mesh)
+    BENCHMARK(BM_FlexfitAvx2)->Arg(mesh);                \
+    BENCHMARK(BM_FlexfitScalar)->Arg(mesh)
 FLEXFIT_MSD_BENCHMARKS(0);
 FLEXFIT_MSD_BENCHMARKS(1);
 FLEXFIT_MSD_BENCHMARKS(2);

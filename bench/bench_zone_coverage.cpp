@@ -1,6 +1,6 @@
 // Zones at every coverage against the whole model (issue 16: a rigid-deformable part never
 // costs more than its whole model), side by side in one run, on torus2 and the heart (spring
-// blocks) and the heart with its vertices shuffled (the per-mass sweep). Six zones at mass
+// blocks) and the heart with its vertices shuffled (every spring listed). Six zones at mass
 // seeds spread over the mesh, at levels from 2 to 24; each step loads one mass. With the
 // cheaper path (the default) a large region is stepped by the full step with the other masses
 // held; without it, always by the region step. The counter `coverage` is the share of the

@@ -24,7 +24,7 @@
 // Modes. Rigid: never deforms (zones and forces are ignored). RigidDeformable: zones.
 // FullDeformable: every mass moves always (the thesis's baseline), stepped by stepFullModel.
 // A zone covering the whole mesh is stepped by the same full step (fullSweepWhenComplete: spring
-// blocks or the per-mass sweep), and the compact-array path gives the same trajectory up to
+// blocks and listed springs), and the compact-array path gives the same trajectory up to
 // summation order (tested).
 //
 // Stepping. step() advances a part on its own, with its settings' time step and gravity (on

@@ -68,7 +68,7 @@ struct PartModel {
     // mesh's vertex order gives too few blocks. It copies the spring constants: build models with
     // buildPartModel, and do not edit a model's springs afterwards.
     std::shared_ptr<const SpringBlocks> springBlocks;
-    // Whether the full step runs by spring blocks (else by a per-mass sweep).
+    // Whether some springs fall in spring blocks (the others run by the listed-spring kernel).
     bool hasSpringBlocks() const;
     // The drawn mesh tied to the simulation surface; null when the simulation mesh is drawn.
     std::shared_ptr<const SurfaceEmbedding> drawn;

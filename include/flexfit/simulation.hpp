@@ -81,8 +81,9 @@ struct StepCounters {
 };
 
 // Advances every mass of the part by one time step. Loads must name masses < massCount.
-// Models with spring blocks (PartModel::hasSpringBlocks) are stepped by blocks with the widest kernel
-// the CPU has (scalar, AVX2, AVX-512: the same bits on every CPU); others by a per-mass sweep.
+// Springs in blocks (PartModel::hasSpringBlocks: vertices in rows) run by the block kernel, the
+// others (all of them in a mesh in no useful vertex order) by the listed-spring kernel, with the
+// widest kernel the CPU has (scalar, AVX2, AVX-512: the same bits on every CPU).
 // Throws DivergenceError (core.hpp: "part", the time at the start of the step, the first mass
 // whose position or velocity is no longer finite, the likely cause) after a step that diverged;
 // the check is one vectorised pass over the positions (and the velocities with explicit Euler),
@@ -96,7 +97,8 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings,
 // Two passes over the compact arrays: springs, then masses. O(|moving| + |computed|). On models
 // with spring blocks, the region's whole blocks (ActiveRegion::fullBlocks) run by the full
 // step's vector kernel (AVX-512 where the CPU has it, else scalar; the same bits), then its
-// other springs one at a time; forces are summed in that order. Does not check for divergence:
+// other springs by the listed-spring kernel (AVX2 or AVX-512 CPUs, else scalar; the same bits);
+// forces are summed in that order. Does not check for divergence:
 // Part::step() and World::step() check the moving masses.
 void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                       PartState& state, StepCounters* counters = nullptr);
@@ -104,8 +106,7 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
 // The same region stepped by the full model's step, the masses outside it held at rest (put
 // back after the step: their positions at rest, velocities and pending forces zero). Gives what
 // stepActiveRegion gives up to the order forces are summed in. O(masses + springs), but at the
-// full step's cost per spring (spring blocks or the per-mass sweep), not the region's gathered
-// one. Checks every mass for divergence, as stepFullModel does.
+// full step's cost per spring (streamed in index order), not the region's gathered one. Checks every mass for divergence, as stepFullModel does.
 void stepRegionByFullModel(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                            PartState& state, StepCounters* counters = nullptr);
 
@@ -113,11 +114,11 @@ void stepRegionByFullModel(const PartModel& model, const SimulationSettings& set
 // `computedSprings` springs (`springsInWholeBlocks` of them in whole spring blocks,
 // ActiveRegion::fullBlocks) and `movingMasses` masses. A rule on counts alone, so every machine
 // chooses alike and a run's bits do not depend on the CPU: per spring, the region step costs
-// about 13 ns one at a time and 4.5 ns in whole blocks, the full step about 4 ns by spring
-// blocks (AVX-512 or AVX2) and 10 ns by the per-mass sweep, plus ~0.5 ns per mass put back
-// (measured on this project's machine, torus2, heart, shuffled heart); the rule asks the full
-// step to be 10 % cheaper. On CPUs without AVX2 the blocks run at about the sweep's speed, and
-// the rule chooses the full step somewhat early there.
+// about 13 ns listed (in the order the zones grew: its ends and constants are random reads) and
+// 4.5 ns in whole blocks, the full step about 4 ns by spring blocks and 6 ns listed (in index
+// order), plus ~0.5 ns per mass put back (measured on this project's machine, AVX-512, torus2,
+// heart, shuffled heart); the rule asks the full step to be 10 % cheaper. On CPUs without AVX2
+// both steps run scalar, at 2-3 times these costs in about the same ratios.
 bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses,
                        std::size_t springsInWholeBlocks = 0);
 

@@ -40,20 +40,6 @@ void blockForcesScalar(const SpringBlocks& blocks, const double* x, const double
     }
 }
 
-void remainderForces(const PartModel& model, const double* x, const double* v, double* f, std::size_t begin = 0) {
-    const std::vector<Index>& remainder = model.springBlocks->remainder;
-    for (std::size_t i = begin; i < remainder.size(); ++i) {
-        const Index e = remainder[i];
-        const std::size_t a = 3 * std::size_t(model.springA[e]), b = 3 * std::size_t(model.springB[e]);
-        double g[3];
-        springForce(model.stiffness[e], model.damping[e], model.restLength[e], x + a, x + b, v + a, v + b, g);
-        for (std::size_t c = 0; c < 3; ++c) {
-            f[a + c] += g[c];
-            f[b + c] -= g[c];
-        }
-    }
-}
-
 void integrateScalar(const PartModel& model, const MassUpdate& p, PartState& state, std::size_t begin) {
     for (std::size_t i = begin; i < model.massCount(); ++i) integrateMass(model, p, state, i);
 }
@@ -126,6 +112,25 @@ void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> fullBl
     }
 }
 
+void listedSpringForces(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
+                        const double* x, const double* v, double* f, BlockKernel kernel) {
+    std::size_t done = 0;
+#if defined(FLEXFIT_X86_KERNELS)
+    if (kernel == BlockKernel::Avx512) done = listedSpringForcesAvx512(model, springs, cover, x, v, f);
+    if (kernel == BlockKernel::Avx2) done = listedSpringForcesAvx2(model, springs, cover, x, v, f);
+#endif
+    (void)kernel;
+    for (const Index e : springs.subspan(done)) {
+        const std::size_t a = 3 * std::size_t(model.springA[e]), b = 3 * std::size_t(model.springB[e]);
+        double g[3];
+        springForce(model.stiffness[e], model.damping[e], model.restLength[e], x + a, x + b, v + a, v + b, g);
+        if (cover == nullptr || cover[a / 3] != 0)
+            for (std::size_t c = 0; c < 3; ++c) f[a + c] += g[c];
+        if (cover == nullptr || cover[b / 3] != 0)
+            for (std::size_t c = 0; c < 3; ++c) f[b + c] -= g[c];
+    }
+}
+
 void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
                      BlockKernel kernel) {
 #if defined(FLEXFIT_X86_KERNELS)
@@ -161,11 +166,8 @@ void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartStat
     const double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
     blockForces(*model.springBlocks, x, v, f, kernel);
-    std::size_t gathered = 0, integrated = 0;  // what the vector kernels did; scalar passes finish
-#if defined(FLEXFIT_X86_KERNELS)
-    if (kernel == BlockKernel::Avx512) gathered = remainderForcesAvx512(model, x, v, f);
-#endif
-    remainderForces(model, x, v, f, gathered);
+    listedSpringForces(model, model.springBlocks->remainder, nullptr, x, v, f, kernel);
+    std::size_t integrated = 0;  // what the vector kernels did; the scalar pass finishes
 #if defined(FLEXFIT_X86_KERNELS)
     if (kernel == BlockKernel::Avx512) integrated = integrateAvx512(model, update, state);
     if (kernel == BlockKernel::Avx2) integrated = integrateAvx2(model, update, state);

@@ -18,6 +18,7 @@
 
 #if defined(FLEXFIT_X86_KERNELS)
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <immintrin.h>
@@ -151,53 +152,6 @@ FLEXFIT_AVX512 void blockForces512(const SpringBlocks& blocks, const double* x, 
     }
 }
 
-// Remainder springs 8 at a time: ends gathered (they follow no pattern), forces in vectors, then
-// added one spring after another in ascending order, as the scalar remainder pass does.
-// Components x, y, z of p[a] - p[b] as 8 lanes each.
-FLEXFIT_AVX512 inline Flat24 gatherDifference8(__m256i a, __m256i b, const double* p) {
-    return {{_mm512_sub_pd(_mm512_i32gather_pd(a, p, 8), _mm512_i32gather_pd(b, p, 8)),
-             _mm512_sub_pd(_mm512_i32gather_pd(a, p + 1, 8), _mm512_i32gather_pd(b, p + 1, 8)),
-             _mm512_sub_pd(_mm512_i32gather_pd(a, p + 2, 8), _mm512_i32gather_pd(b, p + 2, 8))}};
-}
-
-FLEXFIT_AVX512 inline __m512d dot8(const Flat24& a, const Flat24& b) {
-    return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a.v[0], b.v[0]), _mm512_mul_pd(a.v[1], b.v[1])),
-                         _mm512_mul_pd(a.v[2], b.v[2]));
-}
-
-FLEXFIT_AVX512 std::size_t remainder512(const PartModel& model, const double* x, const double* v, double* f) {
-    const std::vector<Index>& springs = model.springBlocks->remainder;
-    if (3 * model.massCount() > std::size_t(INT32_MAX) || model.springCount() > std::size_t(INT32_MAX))
-        return 0;  // gather offsets are int32: the scalar pass does them all
-    const std::size_t n = springs.size() / 8 * 8;
-    for (std::size_t i = 0; i < n; i += 8) {
-        alignas(32) std::int32_t e[8], a[8], b[8];
-        for (std::size_t l = 0; l < 8; ++l) {
-            e[l] = std::int32_t(springs[i + l]);
-            a[l] = std::int32_t(3 * model.springA[springs[i + l]]);
-            b[l] = std::int32_t(3 * model.springB[springs[i + l]]);
-        }
-        const __m256i ve = _mm256_load_si256(reinterpret_cast<const __m256i*>(e));
-        const __m256i va = _mm256_load_si256(reinterpret_cast<const __m256i*>(a));
-        const __m256i vb = _mm256_load_si256(reinterpret_cast<const __m256i*>(b));
-        const Flat24 d = gatherDifference8(va, vb, x), w = gatherDifference8(va, vb, v);
-        const __m512d s = springScale8(dot8(d, d), dot8(w, d), _mm512_i32gather_pd(ve, model.stiffness.data(), 8),
-                                       _mm512_i32gather_pd(ve, model.damping.data(), 8),
-                                       _mm512_i32gather_pd(ve, model.restLength.data(), 8));
-        alignas(64) double gx[8], gy[8], gz[8];
-        _mm512_store_pd(gx, _mm512_mul_pd(s, d.v[0]));
-        _mm512_store_pd(gy, _mm512_mul_pd(s, d.v[1]));
-        _mm512_store_pd(gz, _mm512_mul_pd(s, d.v[2]));
-        for (std::size_t l = 0; l < 8; ++l) {
-            double* fa = f + a[l];
-            double* fb = f + b[l];
-            fa[0] += gx[l], fa[1] += gy[l], fa[2] += gz[l];
-            fb[0] -= gx[l], fb[1] -= gy[l], fb[2] -= gz[l];
-        }
-    }
-    return n;
-}
-
 // Bit 3i..3i+2 set for each bit i of an 8-bit mass mask: one mask bit per double of 8 masses.
 constexpr std::array<std::uint32_t, 256> kSpread3 = [] {
     std::array<std::uint32_t, 256> table{};
@@ -299,6 +253,58 @@ FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate
     return 8 * groups;
 }
 
+// A mass's x y z as one vector, lane 3 zero: masked, as the last mass has nothing after it.
+FLEXFIT_AVX2 inline __m256d loadMass(const double* p) {
+    return _mm256_maskload_pd(p, _mm256_setr_epi64x(-1, -1, -1, 0));
+}
+
+// Listed springs 8 at a time (the AVX2 kernel's method, below, in 8 lanes): the 8 springs'
+// (x y z _) rows paired into 4 vectors as (0 2) (1 3) (4 6) (5 7), whose in-lane unpacks and
+// 128-bit shuffles give x, y, z in lane order 0..7. On this machine 8 % faster than 4 lanes.
+FLEXFIT_AVX512 inline __m512d pair(__m256d low, __m256d high) {
+    return _mm512_insertf64x4(_mm512_castpd256_pd512(low), high, 1);
+}
+
+FLEXFIT_AVX512 inline void transposeRows8(const __m256d r[8], __m512d& x, __m512d& y, __m512d& z) {
+    const __m512d r02 = pair(r[0], r[2]), r13 = pair(r[1], r[3]), r46 = pair(r[4], r[6]), r57 = pair(r[5], r[7]);
+    const __m512d xz0123 = _mm512_unpacklo_pd(r02, r13), y0123 = _mm512_unpackhi_pd(r02, r13);
+    const __m512d xz4567 = _mm512_unpacklo_pd(r46, r57), y4567 = _mm512_unpackhi_pd(r46, r57);
+    x = _mm512_shuffle_f64x2(xz0123, xz4567, 0x88);
+    y = _mm512_shuffle_f64x2(y0123, y4567, 0x88);
+    z = _mm512_shuffle_f64x2(xz0123, xz4567, 0xDD);
+}
+
+FLEXFIT_AVX512 inline __m512d lanesOf8(const std::vector<double>& values, const Index* e, bool consecutive) {
+    return consecutive ? _mm512_loadu_pd(values.data() + e[0])
+                       : _mm512_setr_pd(values[e[0]], values[e[1]], values[e[2]], values[e[3]], values[e[4]],
+                                        values[e[5]], values[e[6]], values[e[7]]);
+}
+
+FLEXFIT_AVX512 void listedForces512(const PartModel& model, const Index* springs, std::size_t n, const double* x,
+                                    const double* v, double* gx, double* gy, double* gz) {
+    for (std::size_t i = 0; i < n; i += 8) {
+        const Index* e = springs + i;
+        __m256d d[8], w[8];
+        for (std::size_t l = 0; l < 8; ++l) {
+            const std::size_t a = 3 * std::size_t(model.springA[e[l]]), b = 3 * std::size_t(model.springB[e[l]]);
+            d[l] = _mm256_sub_pd(loadMass(x + a), loadMass(x + b));
+            w[l] = _mm256_sub_pd(loadMass(v + a), loadMass(v + b));
+        }
+        __m512d dx, dy, dz, wx, wy, wz;
+        transposeRows8(d, dx, dy, dz);
+        transposeRows8(w, wx, wy, wz);
+        bool consecutive = true;
+        for (std::size_t l = 1; l < 8; ++l) consecutive = consecutive && e[l] == e[0] + l;
+        const __m512d r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)), _mm512_mul_pd(dz, dz));
+        const __m512d dot = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(wx, dx), _mm512_mul_pd(wy, dy)), _mm512_mul_pd(wz, dz));
+        const __m512d s = springScale8(r2, dot, lanesOf8(model.stiffness, e, consecutive),
+                                       lanesOf8(model.damping, e, consecutive), lanesOf8(model.restLength, e, consecutive));
+        _mm512_storeu_pd(gx + i, _mm512_mul_pd(s, dx));
+        _mm512_storeu_pd(gy + i, _mm512_mul_pd(s, dy));
+        _mm512_storeu_pd(gz + i, _mm512_mul_pd(s, dz));
+    }
+}
+
 // ---------------------------------------------------------------- AVX2: a block as two halves
 
 struct Lanes4 {
@@ -329,8 +335,7 @@ FLEXFIT_AVX2 inline Lanes4 difference4(const double* p, const double* q) {
                          _mm256_sub_pd(_mm256_loadu_pd(p + 8), _mm256_loadu_pd(q + 8)));
 }
 
-FLEXFIT_AVX2 inline Lanes4 springForces4(const Lanes4& d, const Lanes4& w, const double* k, const double* c,
-                                         const double* restLength) {
+FLEXFIT_AVX2 inline Lanes4 springForces4(const Lanes4& d, const Lanes4& w, __m256d k, __m256d c, __m256d restLength) {
     const __m256d zero = _mm256_setzero_pd();
     const __m256d r2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d.x, d.x), _mm256_mul_pd(d.y, d.y)),
                                      _mm256_mul_pd(d.z, d.z));
@@ -341,8 +346,7 @@ FLEXFIT_AVX2 inline Lanes4 springForces4(const Lanes4& d, const Lanes4& w, const
     const __m256d dot = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(w.x, d.x), _mm256_mul_pd(w.y, d.y)),
                                       _mm256_mul_pd(w.z, d.z));
     const __m256d magnitude =
-        _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(k), _mm256_sub_pd(length, _mm256_loadu_pd(restLength))),
-                      _mm256_mul_pd(_mm256_mul_pd(_mm256_loadu_pd(c), dot), inverse));
+        _mm256_add_pd(_mm256_mul_pd(k, _mm256_sub_pd(length, restLength)), _mm256_mul_pd(_mm256_mul_pd(c, dot), inverse));
     const __m256d s = _mm256_xor_pd(_mm256_mul_pd(magnitude, inverse), _mm256_set1_pd(-0.0));
     return {_mm256_mul_pd(s, d.x), _mm256_mul_pd(s, d.y), _mm256_mul_pd(s, d.z)};
 }
@@ -360,8 +364,9 @@ FLEXFIT_AVX2 void blockForces256(const SpringBlocks& blocks, const double* x, co
         for (std::size_t half = 0; half < 2; ++half) {
             const std::size_t o = 12 * half, lane = W * q + 4 * half;
             const Lanes4 forces = springForces4(difference4(x + a + o, x + b + o), difference4(v + a + o, v + b + o),
-                                                blocks.stiffness.data() + lane, blocks.damping.data() + lane,
-                                                blocks.restLength.data() + lane);
+                                                _mm256_loadu_pd(blocks.stiffness.data() + lane),
+                                                _mm256_loadu_pd(blocks.damping.data() + lane),
+                                                _mm256_loadu_pd(blocks.restLength.data() + lane));
             interleave4(forces, g + 3 * half);
         }
         double* fa = f + a;
@@ -384,6 +389,107 @@ FLEXFIT_AVX2 void blockForces256(const SpringBlocks& blocks, const double* x, co
         for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fa + 4 * j, _mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]));
         for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fb + 4 * j, _mm256_sub_pd(_mm256_loadu_pd(fb + 4 * j), g[j]));
     }
+}
+
+// ---------------------------------------------------------------- AVX2: listed springs
+
+// Springs in no block (any vertex order): each end's x y z loaded as one vector, the 4 springs'
+// differences transposed to lanes, the forces stored per spring; then added to the masses one
+// spring after another in list order, as the scalar pass does. Gathers (8 loads per vector, 12
+// vectors per 8 springs) cost more than these 16 vector loads and 14 shuffles per 4 springs.
+
+// Rows r[l] = (x y z _) of 4 springs as lanes x, y, z.
+FLEXFIT_AVX2 inline Lanes4 transposeRows4(const __m256d r[4]) {
+    const __m256d xz01 = _mm256_unpacklo_pd(r[0], r[1]), y01 = _mm256_unpackhi_pd(r[0], r[1]);
+    const __m256d xz23 = _mm256_unpacklo_pd(r[2], r[3]), y23 = _mm256_unpackhi_pd(r[2], r[3]);
+    return {_mm256_permute2f128_pd(xz01, xz23, 0x20), _mm256_permute2f128_pd(y01, y23, 0x20),
+            _mm256_permute2f128_pd(xz01, xz23, 0x31)};
+}
+
+// values[e[0..3]]: one load when the springs are consecutive (all of them in a model without
+// blocks), else built in registers (4 scalar stores read back as one vector would stall).
+FLEXFIT_AVX2 inline __m256d lanesOf(const std::vector<double>& values, const Index* e, bool consecutive) {
+    return consecutive ? _mm256_loadu_pd(values.data() + e[0])
+                       : _mm256_setr_pd(values[e[0]], values[e[1]], values[e[2]], values[e[3]]);
+}
+
+// Forces on the first ends of springs[0..n), n a multiple of 4, into gx, gy, gz.
+FLEXFIT_AVX2 void listedForces256(const PartModel& model, const Index* springs, std::size_t n, const double* x,
+                                  const double* v, double* gx, double* gy, double* gz) {
+    for (std::size_t i = 0; i < n; i += 4) {
+        __m256d d[4], w[4];
+        const Index* e = springs + i;
+        for (std::size_t l = 0; l < 4; ++l) {
+            const std::size_t a = 3 * std::size_t(model.springA[e[l]]), b = 3 * std::size_t(model.springB[e[l]]);
+            d[l] = _mm256_sub_pd(loadMass(x + a), loadMass(x + b));
+            w[l] = _mm256_sub_pd(loadMass(v + a), loadMass(v + b));
+        }
+        const bool consecutive = e[1] == e[0] + 1 && e[2] == e[0] + 2 && e[3] == e[0] + 3;
+        const Lanes4 g = springForces4(transposeRows4(d), transposeRows4(w), lanesOf(model.stiffness, e, consecutive),
+                                       lanesOf(model.damping, e, consecutive), lanesOf(model.restLength, e, consecutive));
+        _mm256_storeu_pd(gx + i, g.x);
+        _mm256_storeu_pd(gy + i, g.y);
+        _mm256_storeu_pd(gz + i, g.z);
+    }
+}
+
+// g_i on the first end, -g_i on the second of each listed spring i, in list order. The first
+// end's force stays in registers while consecutive springs share it (the remainder is sorted by
+// first end): the same additions in the same order, without a store and reload between them.
+// Safe because a spring's second end is never its first.
+inline void addListedForces(const PartModel& model, std::span<const Index> springs, const double* gx, const double* gy,
+                            const double* gz, double* f) {
+    const Index* springA = model.springA.data();
+    const Index* springB = model.springB.data();
+    std::size_t i = 0;
+    while (i < springs.size()) {
+        // The run of listed springs that share the first end a, as a loop of known length.
+        const Index a = springA[springs[i]];
+        std::size_t end = i + 1;
+        while (end < springs.size() && springA[springs[end]] == a) ++end;
+        double* fa = f + 3 * std::size_t(a);
+        double hx = fa[0], hy = fa[1], hz = fa[2];
+        for (; i < end; ++i) {
+            hx += gx[i], hy += gy[i], hz += gz[i];
+            double* fb = f + 3 * std::size_t(springB[springs[i]]);
+            fb[0] -= gx[i], fb[1] -= gy[i], fb[2] -= gz[i];
+        }
+        fa[0] = hx, fa[1] = hy, fa[2] = hz;
+    }
+}
+
+// Forces of springs[0..n) into gx, gy, gz; n a multiple of the kernel's width.
+using ListedForces = void (*)(const PartModel& model, const Index* springs, std::size_t n, const double* x,
+                              const double* v, double* gx, double* gy, double* gz);
+
+// The listed springs' forces added in list order: to both ends, or with a cover only to the
+// ends whose count is non-zero. Does the largest multiple of `width` springs; returns it.
+std::size_t listedSpringForcesBy(ListedForces forces, std::size_t width, const PartModel& model,
+                                 std::span<const Index> springs, const std::uint16_t* cover, const double* x,
+                                 const double* v, double* f) {
+    const std::size_t n = springs.size() / width * width;
+    alignas(64) double gx[kListChunk], gy[kListChunk], gz[kListChunk];
+    for (std::size_t start = 0; start < n; start += kListChunk) {
+        const std::size_t count = std::min(kListChunk, n - start);
+        forces(model, springs.data() + start, count, x, v, gx, gy, gz);
+        if (cover == nullptr) {
+            addListedForces(model, springs.subspan(start, count), gx, gy, gz, f);
+            continue;
+        }
+        for (std::size_t i = 0; i < count; ++i) {
+            const Index e = springs[start + i];
+            const Index a = model.springA[e], b = model.springB[e];
+            if (cover[a] != 0) {
+                double* fa = f + 3 * std::size_t(a);
+                fa[0] += gx[i], fa[1] += gy[i], fa[2] += gz[i];
+            }
+            if (cover[b] != 0) {
+                double* fb = f + 3 * std::size_t(b);
+                fb[0] -= gx[i], fb[1] -= gy[i], fb[2] -= gz[i];
+            }
+        }
+    }
+    return n;
 }
 
 FLEXFIT_AVX2 inline __m256d spread4(__m256d values, int j) {
@@ -447,8 +553,13 @@ void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* 
 void blockForcesAvx512(const SpringBlocks& blocks, const double* x, const double* v, double* f) {
     blockForces512(blocks, x, v, f);
 }
-std::size_t remainderForcesAvx512(const PartModel& model, const double* x, const double* v, double* f) {
-    return remainder512(model, x, v, f);
+std::size_t listedSpringForcesAvx2(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
+                                   const double* x, const double* v, double* f) {
+    return listedSpringForcesBy(listedForces256, 4, model, springs, cover, x, v, f);
+}
+std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
+                                     const double* x, const double* v, double* f) {
+    return listedSpringForcesBy(listedForces512, 8, model, springs, cover, x, v, f);
 }
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state) {
     return integrate256(model, update, state, nullptr, model.massCount() / 4);

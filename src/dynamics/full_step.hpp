@@ -1,9 +1,9 @@
-// Internal to src/dynamics (and the step benchmark): the two ways of a full step.
+// Internal to src/dynamics (and the step benchmark): the full step's kernels.
 //
-// The per-mass sweep serves every model; the spring-block step serves models whose springs
-// mostly fall into blocks (spring_blocks.hpp) and is what stepFullModel uses for them. The block
-// step has a scalar kernel and, on x86-64, AVX2 and AVX-512 kernels chosen at run time; all
-// three give the same bits (tested), so a run does not depend on the machine's vector unit.
+// Every model's springs are laid out as spring blocks plus a remainder (spring_blocks.hpp; a
+// model in no useful vertex order has no blocks, all its springs in the remainder). The step
+// has a scalar kernel and, on x86-64, AVX2 and AVX-512 kernels chosen at run time; all three
+// give the same bits (tested), so a run does not depend on the machine's vector unit.
 #pragma once
 
 #include "mass_update.hpp"
@@ -14,9 +14,6 @@
 #endif
 
 namespace flexfit::detail {
-
-// One pass over the masses in index order: each mass's own springs, then its integration.
-void sweepFullModel(const PartModel& model, const MassUpdate& update, PartState& state);
 
 enum class BlockKernel { Scalar, Avx2, Avx512 };
 
@@ -41,8 +38,7 @@ const char* toString(BlockKernel kernel);
 // fixes; the kernel must be available.
 void blockForces(const SpringBlocks& blocks, const double* x, const double* v, double* f, BlockKernel kernel);
 
-// Springs by blocks, the remainder, then every mass. model.springBlocks must not be empty and
-// the kernel must be available.
+// Springs by blocks, the remainder, then every mass. The kernel must be available.
 void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel);
 
 // After a full step that stood for a region's (stepRegionByFullModel): every mass whose cover
@@ -57,6 +53,14 @@ void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, Pa
 void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
                        const double* x, const double* v, double* f, BlockKernel kernel);
 
+// Listed springs in list order: g on the first end, -g on the second (f[a] += g, f[b] -= g), or
+// with a cover only on the ends whose cover count is non-zero. The vector kernels compute the
+// forces 4 at a time and add them in the same order: the same bits in every kernel.
+void listedSpringForces(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
+                        const double* x, const double* v, double* f, BlockKernel kernel);
+// The vector kernels keep the forces of this many listed springs on the stack between passes.
+inline constexpr std::size_t kListChunk = 256;
+
 // Integrates the masses of the given octets (masses 8k..8k+7, each once) as integrateScalar
 // would, mass by mass: the same bits in every kernel.
 void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
@@ -65,8 +69,12 @@ void integrateOctets(const PartModel& model, const MassUpdate& update, std::span
 // The vector kernels (block_step_x86.cpp). Forces of all blocks into f (3 doubles per mass).
 void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* v, double* f);
 void blockForcesAvx512(const SpringBlocks& blocks, const double* x, const double* v, double* f);
-// Remainder springs [0, n) in order, for the largest n that is a multiple of 8; returns n.
-std::size_t remainderForcesAvx512(const PartModel& model, const double* x, const double* v, double* f);
+// listedSpringForces for springs [0, n), n the largest multiple of 4; returns n.
+std::size_t listedSpringForcesAvx2(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
+                                   const double* x, const double* v, double* f);
+// The same with n a multiple of 8.
+std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
+                                     const double* x, const double* v, double* f);
 // Integrates masses [0, n) for the largest n that is a multiple of the width; returns n.
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state);
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state);

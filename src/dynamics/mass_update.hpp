@@ -1,4 +1,4 @@
-// Internal to src/dynamics: the per-mass half of a step, shared by the full sweep and the
+// Internal to src/dynamics: the per-mass half of a step, shared by the full step and the
 // active-region step so that both integrate bit for bit alike.
 #pragma once
 

@@ -1,5 +1,5 @@
-// One step of the full mass-spring-damper model: by spring blocks when the model has them
-// (block_step.cpp), else a single sweep over the masses.
+// One step of the full mass-spring-damper model: spring blocks, then the springs in no block,
+// then every mass (block_step.cpp).
 #include "flexfit/simulation.hpp"
 #include "divergence.hpp"
 #include "flush_denormals.hpp"
@@ -8,43 +8,6 @@
 #include <cmath>
 
 namespace flexfit {
-namespace detail {
-
-// The whole step is one pass over the masses in index order. Springs are sorted by their first
-// (smaller) mass a, so visiting mass a evaluates springs (a, b > a): g goes to a in a register
-// and to f[b] in memory. When the pass reaches a mass, every spring touching it has been
-// evaluated (those with a smaller first mass earlier, its own now) and nothing later reads its
-// position or velocity, so it is integrated at once. One sweep over memory, no scratch arrays.
-//
-// f_a = (pending external force) + sum_j g_aj + m_a g - drag v_a - k_a (x_a - rest_a)
-// g_ab = -(k (|d| - L) + b (v_a - v_b).u) u,  d = x_a - x_b, u = d/|d|
-void sweepFullModel(const PartModel& model, const MassUpdate& p, PartState& state) {
-    const std::size_t masses = model.massCount();
-    const Index* springAdr = model.springAdr.data();
-    const Index* springB = model.springB.data();
-    const double* restLength = model.restLength.data();
-    const double* k = model.stiffness.data();
-    const double* c = model.damping.data();
-    const double* mass = model.mass.data();
-    const double* invMass = model.inverseMass.data();
-    const Vec3* rest = model.restPositions.data();
-    Vec3* __restrict x = state.positions.data();
-    Vec3* __restrict v = state.velocities.data();
-    Vec3* __restrict f = state.forces.data();
-    for (std::size_t a = 0; a < masses; ++a) {
-        Vec3 fa = f[a] + p.bodyForce(mass[a], x[a], v[a], rest[a]);
-        for (Index e = springAdr[a]; e < springAdr[a + 1]; ++e) {
-            const Index b = springB[e];
-            const Vec3 g = springForceOnFirst(k[e], c[e], restLength[e], x[a], x[b], v[a], v[b]);
-            fa += g;
-            f[b] -= g;
-        }
-        f[a] = Vec3::Zero();  // consumed: the next step starts with no pending force
-        p.integrate(invMass[a], fa, rest[a], x[a], v[a]);
-    }
-}
-
-}  // namespace detail
 
 void validateSettings(const SimulationSettings& s) {
     const std::string source = "simulation settings";
@@ -67,10 +30,7 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings, s
     const double start = state.time;
     for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
     const detail::MassUpdate update = detail::MassUpdate::from(settings);
-    if (!model.hasSpringBlocks())
-        detail::sweepFullModel(model, update, state);
-    else
-        detail::stepSpringBlocks(model, update, state, detail::fullStepKernel());
+    detail::stepSpringBlocks(model, update, state, detail::fullStepKernel());
     state.time += settings.timeStep;
     ++state.stepCount;
     if (counters != nullptr) {

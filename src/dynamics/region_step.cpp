@@ -10,26 +10,18 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
                       PartState& state, StepCounters* counters) {
     const detail::FlushDenormals flush;
     const detail::MassUpdate p = detail::MassUpdate::from(settings);
-    const Index* springA = model.springA.data();
-    const Index* springB = model.springB.data();
-    Vec3* x = state.positions.data();
-    Vec3* v = state.velocities.data();
-    Vec3* f = state.forces.data();
+    const double* x = state.positions.data()->data();
+    const double* v = state.velocities.data()->data();
+    double* f = state.forces.data()->data();
     const std::uint16_t* mask = region.coverCounts().data();
     const std::span<const Index> computed = region.springs().members(), moving = region.masses().members();
 
     // Springs: forces reach only the moving ends (a fixed end is held by the rigid body). Whole
-    // spring blocks by the vector kernel, then the others one at a time.
+    // spring blocks by the block kernel, then the others by the listed-spring kernel.
     if (!region.fullBlocks().empty())
-        detail::regionBlockForces(*model.springBlocks, region.fullBlocks().members(), mask, state.positions.data()->data(),
-                                  state.velocities.data()->data(), state.forces.data()->data(), detail::fullStepKernel());
-    for (Index e : region.looseSprings()) {
-        const Index a = springA[e], b = springB[e];
-        const Vec3 g =
-            detail::springForceOnFirst(model.stiffness[e], model.damping[e], model.restLength[e], x[a], x[b], v[a], v[b]);
-        if (mask[a] != 0) f[a] += g;
-        if (mask[b] != 0) f[b] -= g;
-    }
+        detail::regionBlockForces(*model.springBlocks, region.fullBlocks().members(), mask, x, v, f,
+                                  detail::fullStepKernel());
+    detail::listedSpringForces(model, region.looseSprings().members(), mask, x, v, f, detail::fullStepKernel());
     // Moving masses: body forces, integration, restoration; pending forces consumed. Whole
     // octets by the vector kernel, then the others one at a time (each mass alone: same bits).
     detail::integrateOctets(model, p, region.fullOctets().members(), state, detail::fullStepKernel());
@@ -52,14 +44,15 @@ bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std:
                        std::size_t springsInWholeBlocks) {
     // Costs in ns on the reference machine (simulation.hpp); only their ratios matter.
     constexpr double kRegionSpring = 13.0, kRegionBlockSpring = 4.5, kRegionMass = 2.0;
-    constexpr double kBlockSpring = 4.0, kSweepSpring = 10.0, kPutBack = 0.5;
+    constexpr double kBlockSpring = 4.0, kListedSpring = 6.0, kPutBack = 0.5;
     // Switch only when clearly cheaper: near the crossover the two cost the same, and in a world
     // the full step's streaming also evicts what the collision stages keep in cache (measured on
     // the haptic scene, ~35 % of the springs: no difference either way).
     constexpr double kMargin = 0.9;
     const double region = kRegionSpring * double(computedSprings - springsInWholeBlocks) +
                           kRegionBlockSpring * double(springsInWholeBlocks) + kRegionMass * double(movingMasses);
-    const double full = (model.hasSpringBlocks() ? kBlockSpring : kSweepSpring) * double(model.springCount()) +
+    const std::size_t blocked = model.springBlocks->blockCount() * SpringBlocks::kWidth;
+    const double full = kBlockSpring * double(blocked) + kListedSpring * double(model.springCount() - blocked) +
                         kPutBack * double(model.massCount() - movingMasses);
     return full < kMargin * region;
 }

@@ -48,7 +48,6 @@ SpringBlocks buildSpringBlocks(std::span<const Index> springA, std::span<const I
         }
         start = end;
     }
-    if (double(blocks.blockCount() * W) < SpringBlocks::kMinBlockedShare * double(springs)) return {};
     for (std::size_t e = 0; e < springs; ++e)
         if (!blocked[e]) blocks.remainder.push_back(Index(e));
     return blocks;

@@ -6,14 +6,15 @@
 // Meshes whose vertices come in rows (the torus, UV-sphere and heart generators, many parametric
 // or scanned surfaces) put nearly all springs in a few offsets: the heart 97% of its springs in
 // blocks, torus2 94%, torus1 88%, a 16 x 16 UV sphere 80%. The springs that fit no block are the
-// remainder, done one at a time (8 at a time, gathered, by the AVX-512 kernel). Icospheres
-// (vertices in subdivision order) and tori under 9 segments get no blocks.
+// remainder: the vector kernels load each end's x y z as one vector and transpose 4 springs to
+// lanes (block_step_x86.cpp), nearly as fast as blocks on this machine (the heart's remainder
+// kernel alone: 1.3x its block kernel's time), so meshes in any vertex order (files as exporters
+// write them, icospheres in subdivision order) need no blocks to be fast. A model keeps every
+// block it finds: even at 43 % of the springs (the shuffled heart renumbered breadth-first)
+// blocks plus remainder beat the remainder alone (91 against 108 us a step).
 //
-// Without AVX2 (or off x86-64) the scalar kernel runs: 1.1x the naive reference on the heart,
-// below the per-mass sweep's 1.25x. It is kept so that every CPU gives the same bits.
-//
-// The model keeps blocks only when they hold at least kMinBlockedShare of its springs; other
-// meshes (vertices in no useful order) keep the per-mass sweep of stepFullModel.
+// Without AVX2 (or off x86-64) the scalar kernel runs: about the naive reference's speed. It is
+// kept so that every CPU gives the same bits.
 //
 // Order of the forces, fixed so that every kernel (scalar, AVX2, AVX-512) gives the same bits:
 //   1. blocks in order; block q with forces g_i on its first masses:
@@ -34,7 +35,6 @@ namespace flexfit {
 
 struct SpringBlocks {
     static constexpr int kWidth = 8;
-    static constexpr double kMinBlockedShare = 0.75;
 
     std::vector<Index> first;   // (B) a0
     std::vector<Index> offset;  // (B) b - a of all its springs, >= 1
@@ -57,8 +57,7 @@ struct SpringBlocks {
 
 // Groups springs (a = springA[e] < springB[e], per-spring constants) into blocks: by offset in
 // increasing order, then by a; each maximal run of consecutive a gives floor(run / 8) blocks.
-// Returns an empty SpringBlocks (no blocks, no remainder) if blocks would hold less than
-// kMinBlockedShare of the springs.
+// Every other spring goes to the remainder (all of them when no run reaches 8).
 SpringBlocks buildSpringBlocks(std::span<const Index> springA, std::span<const Index> springB,
                                std::span<const double> restLength, std::span<const double> stiffness,
                                std::span<const double> damping);

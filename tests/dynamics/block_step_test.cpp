@@ -1,8 +1,9 @@
 // The spring-block full step (src/dynamics/block_step*.cpp): its kernels against each other bit
-// for bit, and each against the thesis-style naive implementation and the per-mass sweep.
+// for bit, and each against the thesis-style naive implementation and the same springs listed.
 #include "dynamics/flush_denormals.hpp"
 #include "dynamics/full_step.hpp"
 #include "flexfit/flexfit.hpp"
+#include "golden.hpp"
 #include "naive_from_mesh.hpp"
 #include "shuffled_mesh.hpp"
 
@@ -31,7 +32,7 @@ PartState kickedState(const PartModel& model, unsigned seed) {
         const Index a = blocks.first[0] + 3;
         state.positions[a + blocks.offset[0]] = state.positions[a];
     }
-    if (!blocks.remainder.empty()) {  // the first: in the AVX-512 kernel's gathered groups of 8
+    if (!blocks.remainder.empty()) {  // the first: in the vector kernels' first group of 4
         const Index e = blocks.remainder.front();
         state.positions[model.springB[e]] = state.positions[model.springA[e]];
     }
@@ -97,11 +98,11 @@ SimulationSettings settingsFor(RestorationMethod method, Integrator integrator) 
 
 }  // namespace
 
+// Row meshes (mostly blocks) and a shuffled one (every spring listed).
 TEST(BlockStep, EveryKernelGivesTheScalarKernelsBits) {
     int compared = 0;
-    for (const TriMesh& mesh : {makeTorus1(), makeTorus2(), makeHeart()}) {
+    for (const TriMesh& mesh : {makeTorus1(), makeTorus2(), makeHeart(), flexfit::testing::shuffledVertices(makeTorus2(), 4)}) {
         const auto model = buildPartModel(mesh);
-        ASSERT_FALSE(model->springBlocks->empty());
         for (RestorationMethod method : {RestorationMethod::None, RestorationMethod::AnchorSprings, RestorationMethod::Constraint})
             for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::ExplicitEuler}) {
                 SCOPED_TRACE(mesh.name + " " + toString(method) + " " + toString(integrator));
@@ -121,7 +122,7 @@ TEST(BlockStep, EveryKernelGivesTheScalarKernelsBits) {
 
 TEST(BlockStep, EveryKernelMatchesTheNaiveReference) {
     // The naive model (heap objects, its own spring set) shares no code with the library.
-    for (const TriMesh& mesh : {makeTorus2(), makeHeart()}) {
+    for (const TriMesh& mesh : {makeTorus2(), makeHeart(), flexfit::testing::shuffledVertices(makeTorus2(), 4)}) {
         const Material material = Material::elastic();
         const auto model = buildPartModel(mesh, {material, 1.5, {}, {}, {}});
         for (BlockKernel kernel : kAllKernels) {
@@ -153,21 +154,29 @@ TEST(BlockStep, EveryKernelMatchesTheNaiveReference) {
     }
 }
 
-TEST(BlockStep, AgreesWithThePerMassSweep) {
+// The heart's springs by blocks, and the same springs all listed (no blocks), in every kernel.
+TEST(BlockStep, AgreesWithTheSameSpringsInNoBlock) {
     const auto model = buildPartModel(makeHeart());
-    for (RestorationMethod method : {RestorationMethod::None, RestorationMethod::AnchorSprings, RestorationMethod::Constraint}) {
-        const SimulationSettings settings = settingsFor(method, Integrator::SemiImplicitEuler);
-        const detail::MassUpdate update = detail::MassUpdate::from(settings);
-        PartState blocks = kickedState(*model, 9), sweep = blocks;
-        for (int step = 0; step < 100; ++step) {
-            detail::stepSpringBlocks(*model, update, blocks, BlockKernel::Scalar);
-            detail::sweepFullModel(*model, update, sweep);
+    ASSERT_TRUE(model->hasSpringBlocks());
+    auto unblocked = std::make_shared<PartModel>(*model);
+    SpringBlocks none;
+    none.laneOfSpring.assign(model->springCount(), SpringBlocks::kNoLane);
+    for (std::size_t e = 0; e < model->springCount(); ++e) none.remainder.push_back(Index(e));
+    unblocked->springBlocks = std::make_shared<const SpringBlocks>(std::move(none));
+    for (const auto kernel : flexfit::testing::availableBlockKernels())
+        for (RestorationMethod method : {RestorationMethod::None, RestorationMethod::AnchorSprings, RestorationMethod::Constraint}) {
+            const SimulationSettings settings = settingsFor(method, Integrator::SemiImplicitEuler);
+            const detail::MassUpdate update = detail::MassUpdate::from(settings);
+            PartState blocks = kickedState(*model, 9), listed = blocks;
+            for (int step = 0; step < 100; ++step) {
+                detail::stepSpringBlocks(*model, update, blocks, kernel);
+                detail::stepSpringBlocks(*unblocked, update, listed, kernel);
+            }
+            double worst = 0.0;
+            for (std::size_t i = 0; i < model->massCount(); ++i)
+                worst = std::max(worst, (blocks.positions[i] - listed.positions[i]).norm());
+            EXPECT_LT(worst, 1e-12) << toString(method) << " " << toString(kernel);  // only the order of the sums differs
         }
-        double worst = 0.0;
-        for (std::size_t i = 0; i < model->massCount(); ++i)
-            worst = std::max(worst, (blocks.positions[i] - sweep.positions[i]).norm());
-        EXPECT_LT(worst, 1e-12) << toString(method);  // only the order of the force sums differs
-    }
 }
 
 TEST(BlockStep, StepFullModelTakesBlocksWhenTheModelHasThem) {
@@ -185,16 +194,17 @@ TEST(BlockStep, StepFullModelTakesBlocksWhenTheModelHasThem) {
     EXPECT_TRUE(sameBits(viaApi, viaBlocks));
     EXPECT_EQ(counters.springsEvaluated, 20 * rows->springCount());
     EXPECT_EQ(counters.massesIntegrated, 20 * rows->massCount());
-    // No useful vertex order: the sweep.
+    // No useful vertex order: every spring listed, the same bits as the scalar kernel's.
     const auto unordered = buildPartModel(flexfit::testing::shuffledVertices(makeTorus1(), 8));
     ASSERT_TRUE(unordered->springBlocks->empty());
-    PartState apiState = kickedState(*unordered, 2), sweepState = apiState;
+    ASSERT_EQ(unordered->springBlocks->remainder.size(), unordered->springCount());
+    PartState apiState = kickedState(*unordered, 2), scalarState = apiState;
     for (int step = 0; step < 20; ++step) {
         stepFullModel(*unordered, settings, {}, apiState);
         const detail::FlushDenormals flush;
-        detail::sweepFullModel(*unordered, update, sweepState);
+        detail::stepSpringBlocks(*unordered, update, scalarState, BlockKernel::Scalar);
     }
-    EXPECT_TRUE(sameBits(apiState, sweepState));
+    EXPECT_TRUE(sameBits(apiState, scalarState));
 }
 
 TEST(BlockStep, HandMadeBlocksFollowTheDocumentedOrderInEveryKernel) {
@@ -304,5 +314,49 @@ TEST(BlockStep, RegionBlocksReachOnlyMovingEndsInEveryKernel) {
         detail::regionBlockForces(blocks, listed, cover.data(), state.positions.data()->data(), state.velocities.data()->data(),
                                   state.forces.data()->data(), kernel);
         EXPECT_EQ(state.forces, expected.forces) << detail::toString(kernel);
+    }
+}
+
+// Listed springs (the remainder, a region's loose springs): a shuffled list with runs of
+// consecutive springs in order and out of order, each spring's force from springForceOnFirst
+// applied in list order, to both ends or only to covered ones; the lists' lengths leave 0-3
+// springs for the scalar tail. Every kernel gives these exact bits.
+TEST(BlockStep, ListedSpringsFollowTheListInEveryKernel) {
+    const auto model = buildPartModel(flexfit::testing::shuffledVertices(makeTorus2(), 6));
+    const PartState moved = kickedState(*model, 12);
+    std::mt19937 rng(9);
+    std::vector<std::uint16_t> cover(model->massCount());
+    for (auto& c : cover) c = rng() % 3 == 0 ? 0 : 1;
+    std::vector<Index> runs;  // groups of 4 consecutive springs: in order, reversed, middle swapped
+    for (Index e = 0; e + 4 <= model->springCount(); e += 4) runs.push_back(e);
+    std::shuffle(runs.begin(), runs.end(), rng);
+    const Index orders[3][4] = {{0, 1, 2, 3}, {3, 2, 1, 0}, {0, 2, 1, 3}};
+    std::vector<Index> list;
+    for (std::size_t r = 0; r < runs.size() / 3; ++r)
+        for (Index i : orders[r % 3]) list.push_back(runs[r] + i);
+    for (std::size_t r = runs.size() / 3; r < runs.size() / 2; ++r) list.push_back(runs[r] + Index(rng() % 4));
+    ASSERT_GT(list.size(), 2 * detail::kListChunk);  // several chunks
+    for (std::size_t tail = 0; tail < 4; ++tail) {
+        const std::span<const Index> springs(list.data(), list.size() - tail);
+        for (const bool covered : {false, true}) {
+            PartState expected = moved;
+            for (const Index e : springs) {
+                const Index a = model->springA[e], b = model->springB[e];
+                const Vec3 g = detail::springForceOnFirst(model->stiffness[e], model->damping[e], model->restLength[e],
+                                                          moved.positions[a], moved.positions[b], moved.velocities[a],
+                                                          moved.velocities[b]);
+                if (!covered || cover[a] != 0) expected.forces[a] += g;
+                if (!covered || cover[b] != 0) expected.forces[b] -= g;
+            }
+            for (BlockKernel kernel : kAllKernels) {
+                if (!detail::blockKernelAvailable(kernel)) continue;
+                PartState state = moved;
+                detail::listedSpringForces(*model, springs, covered ? cover.data() : nullptr,
+                                           state.positions.data()->data(), state.velocities.data()->data(),
+                                           state.forces.data()->data(), kernel);
+                EXPECT_TRUE(sameBits(state.forces, expected.forces))
+                    << detail::toString(kernel) << " tail " << tail << " covered " << covered;
+            }
+        }
     }
 }

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <numeric>
+
 #include <algorithm>
 #include <map>
 
@@ -51,7 +53,7 @@ TEST(SpringBlocks, RowMeshesPutMostSpringsInBlocksAndEverySpringOnce) {
         const auto model = buildPartModel(mesh);
         ASSERT_FALSE(model->springBlocks->empty());
         const double share = double(model->springBlocks->blockCount() * SpringBlocks::kWidth) / double(model->springCount());
-        EXPECT_GE(share, SpringBlocks::kMinBlockedShare);
+        EXPECT_GE(share, 0.85);  // torus1 88 %, torus2 94 %, heart 97 %
         expectEverySpringOnceWithItsConstants(*model);
     }
 }
@@ -89,12 +91,17 @@ TEST(SpringBlocks, BlocksAreMaximalRunsCutIntoEights) {
         EXPECT_TRUE(b.offset[q - 1] < b.offset[q] || (b.offset[q - 1] == b.offset[q] && b.first[q - 1] < b.first[q]));
 }
 
-TEST(SpringBlocks, ShuffledVerticesAndSmallMeshesKeepTheSweep) {
-    EXPECT_TRUE(buildPartModel(flexfit::testing::shuffledVertices(makeTorus1(), 3))->springBlocks->empty());
-    EXPECT_TRUE(buildPartModel(flexfit::testing::shuffledVertices(makeHeart(), 4))->springBlocks->empty());
-    const auto cube = buildPartModel(flexfit::testing::unitCube());
-    EXPECT_TRUE(cube->springBlocks->empty());
-    EXPECT_TRUE(cube->springBlocks->remainder.empty());
+// No useful vertex order: no blocks, every spring in the remainder (the listed-spring kernel).
+TEST(SpringBlocks, ShuffledVerticesAndSmallMeshesListEverySpring) {
+    for (const TriMesh& mesh : {flexfit::testing::shuffledVertices(makeTorus1(), 3),
+                                flexfit::testing::shuffledVertices(makeHeart(), 4), flexfit::testing::unitCube()}) {
+        const auto model = buildPartModel(mesh);
+        EXPECT_TRUE(model->springBlocks->empty());
+        std::vector<Index> every(model->springCount());
+        std::iota(every.begin(), every.end(), Index{0});
+        EXPECT_EQ(model->springBlocks->remainder, every);
+        EXPECT_EQ(model->springBlocks->laneOfSpring, std::vector<Index>(model->springCount(), SpringBlocks::kNoLane));
+    }
 }
 
 TEST(SpringBlocks, ContinuesRowOnlyForAdjacentOffsetOneBlocks) {
