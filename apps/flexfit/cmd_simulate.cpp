@@ -120,6 +120,10 @@ void run(const SimulateOptions& opt) {
                toString(s.integrator), toString(s.restoration.method), double(result.steps) / std::max(result.wallSeconds, 1e-9));
     fmt::print("active region: at most {} moving masses and {} computed springs; {} spring evaluations in all\n",
                result.maxMovingMasses, result.maxComputedSprings, result.counters.springsEvaluated);
+    if (s.integrator == Integrator::ImplicitEuler)
+        fmt::print("implicit solve: {:.1f} conjugate-gradient iterations a step, largest relative residual {:.2e}\n",
+                   double(result.counters.solverIterations) / double(std::max<std::size_t>(result.steps, 1)),
+                   result.counters.solverResidual);
     for (const ActivityTracker& t : result.trackers) {
         const auto restored = t.restorationTime();
         fmt::print("threshold {}: max active {}, total distinct {}, restoration time {}\n", t.threshold(), t.maxActive(),

@@ -22,6 +22,11 @@ void SimulationOptions::addTo(CLI::App& cmd) {
         ->capture_default_str();
     cmd.add_option("--integrator", integrator, "Time integrator: " + nameList<Integrator>())
         ->check(CLI::IsMember(enumChoices<Integrator>()))->capture_default_str();
+    cmd.add_option("--implicit-iterations", implicitIterations, "Implicit integrator: conjugate-gradient iterations at most")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    cmd.add_option("--implicit-tolerance", implicitTolerance,
+                   "Implicit integrator: relative residual to stop at (0: always run every iteration)")
+        ->check(CLI::Range(0.0, 0.999999))->capture_default_str();
     cmd.add_option("--dt", timeStep, "Time step (s)")->capture_default_str();
     cmd.add_option("--gravity", gravity, "Gravity x,y,z (m/s^2)")->capture_default_str();
     cmd.add_option("--global-damping", globalDamping, "Global damping gamma (kg/s)")->capture_default_str();
@@ -47,6 +52,8 @@ SimulationSettings SimulationOptions::simulationSettings(const PartModel& model)
     SimulationSettings s;
     s.timeStep = timeStep;
     s.integrator = enumOption<Integrator>(integrator, "option --integrator");
+    s.implicit.maxIterations = implicitIterations;
+    s.implicit.tolerance = implicitTolerance;
     s.gravity = parseVec3(gravity, "--gravity");
     s.globalDamping = globalDamping;
     s.restoration.method = enumOption<RestorationMethod>(restore, "option --restore");

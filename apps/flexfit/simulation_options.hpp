@@ -18,6 +18,8 @@ struct SimulationOptions {
     double anchorStiffness = -1.0, anchorDamping = -1.0;  // < 0: the material's k and b
     double constraintFraction = 1e-3;
     std::string integrator = "semi-implicit";
+    int implicitIterations = 50;
+    double implicitTolerance = 1e-6;
     double timeStep = 1e-3;
     std::string gravity = "0,0,0";
     double globalDamping = 0.0;

@@ -7,13 +7,17 @@
 // Integrators (h = time step):
 //   semi-implicit (symplectic) Euler: v += h a(x, v); x += h v      -- the default
 //   explicit Euler:                   x += h v;      v += h a(x, v) -- the thesis's, to compare
+//   implicit (backward) Euler:        v += h a(x + h v+, v+); x += h v+, one Newton step solved
+//                                     by conjugate gradient (src/dynamics/implicit_step.cpp):
+//                                     unconditionally stable, for stiff materials and large h
 // Stability (per vibration mode of angular frequency w with modal damping c = 2 zeta w):
 //   symplectic Euler is stable iff h^2 w^2 + 2 c h < 4  (undamped: h < 2/w);
 //   explicit Euler is stable iff h < c / w^2, so it always blows up without damping; with
 //   stiffness-proportional damping (b/k per spring) that is h < b/k for the fast modes.
 // analyzeStability() evaluates both with a Gershgorin upper bound on w (warn: may blow up) and a
-// Rayleigh-quotient lower bound (reject: certain to blow up). Known limit: neither integrator
-// is unconditionally stable; stiff materials need h below the bound it reports.
+// Rayleigh-quotient lower bound (reject: certain to blow up). Neither explicit integrator is
+// unconditionally stable: stiff materials need h below the bound it reports, or the implicit
+// integrator, which has no bound (it damps the fast modes numerically instead).
 //
 // Shape restoration (SPEC 3):
 //   AnchorSprings: a zero-rest-length spring (k_a, b_a) ties each mass to its rest position.
@@ -36,7 +40,7 @@
 
 namespace flexfit {
 
-enum class Integrator { SemiImplicitEuler, ExplicitEuler };
+enum class Integrator { SemiImplicitEuler, ExplicitEuler, ImplicitEuler };
 enum class RestorationMethod { None, AnchorSprings, Constraint };
 
 struct RestorationSettings {
@@ -48,9 +52,20 @@ struct RestorationSettings {
     double constraintFraction = 1e-3;
 };
 
+// The implicit step's linear solve (conjugate gradient, Jacobi preconditioner). It stops at
+// `maxIterations` or when the residual falls to `tolerance` times the right-hand side's norm;
+// tolerance 0 runs maxIterations every step (fewer only once the residual reaches rounding
+// level, 1e-14), a bounded cost for haptic loops; the residual reached is reported in
+// StepCounters.
+struct ImplicitSettings {
+    int maxIterations = 50;
+    double tolerance = 1e-6;
+};
+
 struct SimulationSettings {
     double timeStep = 1e-3;  // s
     Integrator integrator = Integrator::SemiImplicitEuler;
+    ImplicitSettings implicit;
     Vec3 gravity = Vec3::Zero();  // m/s^2
     double globalDamping = 0.0;   // gamma, kg/s
     RestorationSettings restoration;
@@ -78,10 +93,14 @@ struct PointLoad {
 struct StepCounters {
     std::size_t springsEvaluated = 0;
     std::size_t massesIntegrated = 0;
+    std::size_t solverIterations = 0;  // implicit steps: conjugate-gradient iterations, summed
+    double solverResidual = 0.0;       // implicit steps: the largest relative residual left
 };
 
 // Advances every mass of the part by one time step. Loads must name masses < massCount.
-// Springs in blocks (PartModel::hasSpringBlocks: vertices in rows) run by the block kernel, the
+// With Integrator::ImplicitEuler the step is the implicit one (implicit_step.cpp: O(springs)
+// per conjugate-gradient iteration, scalar; the same bits on every CPU). Otherwise springs in
+// blocks (PartModel::hasSpringBlocks: vertices in rows) run by the block kernel, the
 // others (all of them in a mesh in no useful vertex order) by the listed-spring kernel, with the
 // widest kernel the CPU has (scalar, AVX2, AVX-512: the same bits on every CPU).
 // Throws DivergenceError (core.hpp: "part", the time at the start of the step, the first mass
@@ -98,7 +117,9 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings,
 // with spring blocks, the region's whole blocks (ActiveRegion::fullBlocks) run by the full
 // step's vector kernel (AVX-512 where the CPU has it, else scalar; the same bits), then its
 // other springs by the listed-spring kernel (AVX2 or AVX-512 CPUs, else scalar; the same bits);
-// forces are summed in that order. Does not check for divergence:
+// forces are summed in that order. With Integrator::ImplicitEuler, one implicit step of the
+// moving masses with every other mass held (a zone's solve is small: O(computed springs) per
+// iteration). Does not check for divergence:
 // Part::step() and World::step() check the moving masses.
 void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                       PartState& state, StepCounters* counters = nullptr);
@@ -142,6 +163,7 @@ StabilityReport analyzeStability(const PartModel& model, const SimulationSetting
 inline constexpr EnumName<Integrator> kIntegratorNames[] = {
     {Integrator::SemiImplicitEuler, "semi-implicit", "semi-implicit (symplectic) Euler"},
     {Integrator::ExplicitEuler, "explicit", "explicit Euler"},
+    {Integrator::ImplicitEuler, "implicit", "implicit Euler"},
 };
 template <> inline constexpr std::span<const EnumName<Integrator>> kEnumNames<Integrator> = kIntegratorNames;
 // Its names (names.hpp).

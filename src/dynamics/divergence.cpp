@@ -110,7 +110,7 @@ void checkAllMassesFinite(const PartModel& model, const SimulationSettings& sett
     // One pass over the positions: with semi-implicit Euler a non-finite force or velocity makes
     // the position non-finite in the same step (x += h v_new); explicit Euler moves x with the
     // old velocity, so its velocities are read as well.
-    if (allFinite(state.positions) && (settings.integrator == Integrator::SemiImplicitEuler || allFinite(state.velocities))) return;
+    if (allFinite(state.positions) && (settings.integrator != Integrator::ExplicitEuler || allFinite(state.velocities))) return;
     for (Index m = 0; m < state.positions.size(); ++m)
         if (const std::optional<std::string> problem = nonFiniteMass(state, m))
             throw DivergenceError(body, time, *problem + "; " + likelyCause(model, settings));

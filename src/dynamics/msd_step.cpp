@@ -4,6 +4,7 @@
 #include "divergence.hpp"
 #include "flush_denormals.hpp"
 #include "full_step.hpp"
+#include "implicit_step.hpp"
 
 #include <cmath>
 
@@ -22,6 +23,9 @@ void validateSettings(const SimulationSettings& s) {
         throw InputError(source, 0, "anchor damping must be finite and >= 0");
     if (r.method == RestorationMethod::Constraint && !(r.constraintFraction > 0.0 && r.constraintFraction <= 1.0))
         throw InputError(source, 0, "restoration constraint fraction must be in (0, 1]");
+    if (s.implicit.maxIterations < 1) throw InputError(source, 0, "implicit iterations must be >= 1");
+    if (!std::isfinite(s.implicit.tolerance) || s.implicit.tolerance < 0.0 || s.implicit.tolerance >= 1.0)
+        throw InputError(source, 0, "implicit tolerance must be in [0, 1)");
 }
 
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
@@ -29,13 +33,17 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings, s
     const detail::FlushDenormals flush;
     const double start = state.time;
     for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
-    const detail::MassUpdate update = detail::MassUpdate::from(settings);
-    detail::stepSpringBlocks(model, update, state, detail::fullStepKernel());
-    state.time += settings.timeStep;
-    ++state.stepCount;
-    if (counters != nullptr) {
-        counters->springsEvaluated += model.springCount();
-        counters->massesIntegrated += model.massCount();
+    if (settings.integrator == Integrator::ImplicitEuler) {
+        detail::stepImplicit(model, settings, nullptr, state, counters);
+    } else {
+        const detail::MassUpdate update = detail::MassUpdate::from(settings);
+        detail::stepSpringBlocks(model, update, state, detail::fullStepKernel());
+        state.time += settings.timeStep;
+        ++state.stepCount;
+        if (counters != nullptr) {
+            counters->springsEvaluated += model.springCount();
+            counters->massesIntegrated += model.massCount();
+        }
     }
     detail::checkAllMassesFinite(model, settings, state, std::nullopt, start);  // every mass was touched anyway
 }

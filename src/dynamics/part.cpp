@@ -254,7 +254,9 @@ void Part::advance(const StepContext& context, StepCounters* counters) {
     fullModelStepped_ = true;
     if (region_.coversEveryMass() && settings_.zones.fullSweepWhenComplete)
         stepFullModel(*model_, s, {}, state_, counters);
-    else if (settings_.zones.fullStepWhenCheaper && fullStepCostsLess(*model_, region_.springs().size(), region_.masses().size(),
+    // The implicit solve holds a region's edge fixed; the full step would solve for it too.
+    else if (settings_.zones.fullStepWhenCheaper && s.integrator != Integrator::ImplicitEuler &&
+             fullStepCostsLess(*model_, region_.springs().size(), region_.masses().size(),
                                                                      SpringBlocks::kWidth * region_.fullBlocks().size()))
         stepRegionByFullModel(*model_, s, region_, state_, counters);
     else {

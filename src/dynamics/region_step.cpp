@@ -2,6 +2,7 @@
 #include "flexfit/simulation.hpp"
 #include "flush_denormals.hpp"
 #include "full_step.hpp"
+#include "implicit_step.hpp"
 #include "mass_update.hpp"
 
 namespace flexfit {
@@ -9,6 +10,7 @@ namespace flexfit {
 void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                       PartState& state, StepCounters* counters) {
     const detail::FlushDenormals flush;
+    if (settings.integrator == Integrator::ImplicitEuler) return detail::stepImplicit(model, settings, &region, state, counters);
     const detail::MassUpdate p = detail::MassUpdate::from(settings);
     const double* x = state.positions.data()->data();
     const double* v = state.velocities.data()->data();

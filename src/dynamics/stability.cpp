@@ -81,6 +81,9 @@ StabilityReport analyzeStability(const PartModel& model, const SimulationSetting
         report.safeTimeStep = b.omega2Upper > 0.0 ? b.betaMin + b.alphaMin / b.omega2Upper : kInf;
         report.unstableTimeStep = b.omega2Lower > 0.0 ? b.betaMax + b.alphaMax / b.omega2Lower : kInf;
     }
+    if (s.integrator == Integrator::ImplicitEuler) {  // unconditionally stable: no bound
+        report.safeTimeStep = report.unstableTimeStep = kInf;
+    }
     const double h = s.timeStep;
     report.certainlyUnstable = h > report.unstableTimeStep;
     report.possiblyUnstable = h > report.safeTimeStep;
@@ -89,11 +92,11 @@ StabilityReport analyzeStability(const PartModel& model, const SimulationSetting
         text << "time step " << h << " s diverges with " << labelOf(s.integrator) << ": the fastest mode (>= "
              << report.omegaLower << " rad/s) is unstable above " << report.unstableTimeStep << " s";
         if (report.unstableTimeStep == 0.0) text << " (explicit Euler always blows up without damping)";
-        text << "; use a time step below " << report.safeTimeStep << " s";
+        text << "; use a time step below " << report.safeTimeStep << " s or the implicit integrator (unconditionally stable)";
     } else if (report.possiblyUnstable) {
         text << "time step " << h << " s may be unstable with " << labelOf(s.integrator)
              << ": stability is guaranteed below " << report.safeTimeStep << " s (modes up to " << report.omegaUpper
-             << " rad/s)";
+             << " rad/s; the implicit integrator has no bound)";
     }
     report.message = text.str();
     return report;

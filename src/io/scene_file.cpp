@@ -302,6 +302,9 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     p.part.mode = t.choice("mode", PartMode::RigidDeformable);
     SimulationSettings& sim = p.part.simulation;
     sim.integrator = t.choice("integrator", Integrator::SemiImplicitEuler);
+    sim.implicit.maxIterations = t.integer("implicit_iterations", sim.implicit.maxIterations, 1, 100000);
+    sim.implicit.tolerance = t.nonNegative("implicit_tolerance", sim.implicit.tolerance);
+    if (sim.implicit.tolerance >= 1.0) t.fail(*t.node("implicit_tolerance"), "implicit_tolerance", "must be in [0, 1)");
     sim.globalDamping = t.nonNegative("global_damping", 0.0);
     sim.restoration.method = t.choice("restoration", RestorationMethod::Constraint);
     sim.restoration.constraintFraction = t.positive("constraint_fraction", sim.restoration.constraintFraction);

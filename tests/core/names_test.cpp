@@ -37,7 +37,7 @@ void expectOneNamePerValue(int valueCount) {
 TEST(Names, EveryEnumHasOneNamePerValue) {
     expectOneNamePerValue<PartMode>(3);
     expectOneNamePerValue<MotionType>(3);
-    expectOneNamePerValue<Integrator>(2);
+    expectOneNamePerValue<Integrator>(3);
     expectOneNamePerValue<RestorationMethod>(3);
     expectOneNamePerValue<ExactTest>(2);
     expectOneNamePerValue<BoundingVolumeKind>(2);

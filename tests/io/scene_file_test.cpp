@@ -444,3 +444,16 @@ TEST(SceneFile, RemeshGivesTheModelNearUniformEdges) {
     EXPECT_NE(errorOf(withLine("name = \"ball\"", "remesh = 0.5")).find("key 'remesh': applies only to a part read from a 'mesh' file"),
               std::string::npos);
 }
+
+TEST(SceneFile, ImplicitIntegratorAndItsSolve) {
+    const Scene s = parseScene(withLine("name = \"mouth\"", "integrator = \"implicit\"\nimplicit_iterations = 12\nimplicit_tolerance = 0"),
+                               "scene.toml", ".");
+    const SimulationSettings& sim = s.parts[0].part.simulation;
+    EXPECT_EQ(sim.integrator, Integrator::ImplicitEuler);
+    EXPECT_EQ(sim.implicit.maxIterations, 12);
+    EXPECT_EQ(sim.implicit.tolerance, 0.0);
+    const std::string zero = errorOf(withLine("name = \"mouth\"", "implicit_iterations = 0"));
+    EXPECT_NE(zero.find(":9: part 1, key 'implicit_iterations': must be in [1, 100000]"), std::string::npos) << zero;
+    const std::string one = errorOf(withLine("name = \"mouth\"", "implicit_tolerance = 1.5"));
+    EXPECT_NE(one.find(":9: part 1, key 'implicit_tolerance': must be in [0, 1)"), std::string::npos) << one;
+}
