@@ -15,12 +15,15 @@
 //
 // Why this method. It is unconditionally stable for the linear(ised) system whatever k, m and
 // h, and needs only matrix-vector products, so a zone's solve costs O(springs) per iteration
-// with no assembly; Jacobi preconditioning (the diagonal of the system, 3 per mass) is enough
-// for the meshes here. A fixed iteration budget (tolerance 0) gives a deterministic cost for
-// haptic loops; the relative residual is reported. Known limits: one Newton step per time step
-// (large deformations in one step are damped more than the exact backward Euler would); the
-// clamp makes buckling under compression slower than physical; backward Euler damps
-// oscillations numerically (by 1/|1 - h lambda| per step: at h w = 0.1, 0.5 % per step).
+// with no assembled matrix, and the zone's edge is held simply by not being an unknown. A fixed
+// iteration budget (tolerance 0) bounds the cost for haptic loops; the relative residual is
+// reported. Known limits: one Newton step per time step (large deformations in one step are
+// damped more than the exact backward Euler would); the clamp makes buckling under compression
+// slower than physical; backward Euler damps oscillations numerically (by 1/|1 - h lambda| per
+// step: at h w = 0.1, 0.5 % per step); the code is scalar (about 40 ns per spring to assemble,
+// 10 ns per spring and iteration on the reference machine) and the Jacobi preconditioner
+// converges slowly when h^2 k / m is large (1,000: a residual of 0.64 after 20 iterations on a
+// 2,000-mass zone), where block-Jacobi, multigrid or Vertex Block Descent would do better.
 // The order of every sum is fixed (lists in order), so a run's bits do not depend on the CPU.
 #include "implicit_step.hpp"
 
