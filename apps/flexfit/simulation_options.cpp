@@ -20,6 +20,9 @@ void SimulationOptions::addTo(CLI::App& cmd) {
         ->check(CLI::NonNegativeNumber);
     cmd.add_option("--constraint-fraction", constraintFraction, "Share of the separation restored per step (0, 1]")
         ->capture_default_str();
+    cmd.add_option("--constraint-rate", constraintRate,
+                   "Restoration as a rate (1/s), the same restoration time at any --dt; replaces --constraint-fraction")
+        ->check(CLI::NonNegativeNumber);
     cmd.add_option("--integrator", integrator, "Time integrator: " + nameList<Integrator>())
         ->check(CLI::IsMember(enumChoices<Integrator>()))->capture_default_str();
     cmd.add_option("--implicit-iterations", implicitIterations, "Implicit integrator: conjugate-gradient iterations at most")
@@ -60,6 +63,7 @@ SimulationSettings SimulationOptions::simulationSettings(const PartModel& model)
     s.restoration.anchorStiffness = anchorStiffness >= 0.0 ? anchorStiffness : m.stiffness;
     s.restoration.anchorDamping = anchorDamping >= 0.0 ? anchorDamping : m.damping;
     s.restoration.constraintFraction = constraintFraction;
+    s.restoration.constraintRate = constraintRate;
     validateSettings(s);
     const StabilityReport stability = analyzeStability(model, s);
     if (stability.certainlyUnstable && !allowUnstable)

@@ -17,6 +17,7 @@ struct SimulationOptions {
     std::string restore = "constraint";
     double anchorStiffness = -1.0, anchorDamping = -1.0;  // < 0: the material's k and b
     double constraintFraction = 1e-3;
+    double constraintRate = 0.0;  // > 0 replaces the fraction
     std::string integrator = "semi-implicit";
     int implicitIterations = 50;
     double implicitTolerance = 1e-6;

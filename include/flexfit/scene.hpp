@@ -19,8 +19,8 @@
 //                rotation (degrees about x, then y, then z, world axes), density, velocity,
 //                angular_velocity (rad/s), thickness, bounding_volume, static_friction,
 //                kinetic_friction (default: static_friction), restitution, restoration,
-//                constraint_fraction, anchor_stiffness, anchor_damping, global_damping,
-//                integrator, default_level, contact_level, activity_threshold, rest_speed
+//                constraint_fraction or constraint_rate (1/s), anchor_stiffness, anchor_damping,
+//                global_damping, integrator, implicit_iterations, implicit_tolerance, default_level, contact_level, activity_threshold, rest_speed
 //   [[assembly]] name, primary, secondary (part names), technique, final_position,
 //                final_rotation, snap_duration, distance_tolerance, angle_tolerance (degrees),
 //                primary_vector / secondary_vector = {origin, end}, vector_tolerance,

@@ -25,7 +25,8 @@
 //                  position (position-based, like PBD); its velocity takes the correction /h,
 //                  so the correction removes energy instead of leaving a drift. With no other
 //                  force the offset decays by sqrt(1 - c) per step (|eigenvalue| of the update).
-//                  The fraction is per step, so the decay rate depends on h. On a lone mass it
+//                  The fraction is per step, so the decay rate depends on h, unless it is
+//                  given as a rate (RestorationSettings::constraintRate). On a lone mass it
 //                  acts like a stiff, heavily damped anchor of k ~ c m / h^2: c = 0.05 at
 //                  h = 1 ms is ~50,000 N/m per kg, so point loads barely deform the part; pick
 //                  c for the stiffness wanted (c = 1e-4 at 1 kHz ~ 100 N/m per kg).
@@ -50,7 +51,16 @@ struct RestorationSettings {
     // c in (0, 1]: share of the separation removed per step. 1e-3 at 1 kHz restores with a time
     // constant of ~2 s and resists like ~1,000 N/m per kg of mass.
     double constraintFraction = 1e-3;
+    // lambda > 0 (1/s): the constraint as a rate, which restores in the same simulated time
+    // whatever the time step; it replaces constraintFraction. Alone, the constraint makes an
+    // offset decay by sqrt(1 - c) per step, so the rate lambda is the fraction
+    //   c = 1 - exp(-2 lambda h)   (lambda = -ln(1 - c) / (2 h));
+    // c = 1e-3 at 1 kHz is lambda = 0.50 /s. 0: the fraction is used as given.
+    double constraintRate = 0.0;
 };
+
+// The constraint's fraction per step of `timeStep` (the rate converted, or the fraction).
+double constraintFractionFor(const RestorationSettings& restoration, double timeStep);
 
 // The implicit step's linear solve (conjugate gradient, Jacobi preconditioner). It stops at
 // `maxIterations` or when the residual falls to `tolerance` times the right-hand side's norm;

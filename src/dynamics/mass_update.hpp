@@ -25,7 +25,7 @@ struct MassUpdate {
                 s.gravity,
                 s.globalDamping + (anchors ? s.restoration.anchorDamping : 0.0),
                 anchors ? s.restoration.anchorStiffness : 0.0,
-                constraint ? s.restoration.constraintFraction : 0.0,
+                constraint ? constraintFractionFor(s.restoration, s.timeStep) : 0.0,
                 s.integrator == Integrator::SemiImplicitEuler};
     }
 

@@ -23,9 +23,15 @@ void validateSettings(const SimulationSettings& s) {
         throw InputError(source, 0, "anchor damping must be finite and >= 0");
     if (r.method == RestorationMethod::Constraint && !(r.constraintFraction > 0.0 && r.constraintFraction <= 1.0))
         throw InputError(source, 0, "restoration constraint fraction must be in (0, 1]");
+    if (!std::isfinite(r.constraintRate) || r.constraintRate < 0.0)
+        throw InputError(source, 0, "restoration constraint rate must be finite and >= 0");
     if (s.implicit.maxIterations < 1) throw InputError(source, 0, "implicit iterations must be >= 1");
     if (!std::isfinite(s.implicit.tolerance) || s.implicit.tolerance < 0.0 || s.implicit.tolerance >= 1.0)
         throw InputError(source, 0, "implicit tolerance must be in [0, 1)");
+}
+
+double constraintFractionFor(const RestorationSettings& r, double timeStep) {
+    return r.constraintRate > 0.0 ? -std::expm1(-2.0 * r.constraintRate * timeStep) : r.constraintFraction;
 }
 
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,

@@ -309,6 +309,9 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     sim.restoration.method = t.choice("restoration", RestorationMethod::Constraint);
     sim.restoration.constraintFraction = t.positive("constraint_fraction", sim.restoration.constraintFraction);
     if (sim.restoration.constraintFraction > 1.0) t.fail(*t.node("constraint_fraction"), "constraint_fraction", "must be in (0, 1]");
+    if (t.has("constraint_rate") && t.has("constraint_fraction"))
+        t.fail(*t.node("constraint_rate"), "constraint_rate", "give either constraint_rate or constraint_fraction, not both");
+    if (t.has("constraint_rate")) sim.restoration.constraintRate = t.positive("constraint_rate", 1.0);
     sim.restoration.anchorStiffness = t.nonNegative("anchor_stiffness", sim.restoration.anchorStiffness);
     sim.restoration.anchorDamping = t.nonNegative("anchor_damping", sim.restoration.anchorDamping);
     ZoneSettings& z = p.part.zones;

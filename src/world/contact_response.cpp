@@ -148,7 +148,8 @@ double effectiveContactStiffness(const Part& part, double timeStep) {
     const RestorationSettings& r = part.settings().simulation.restoration;
     switch (r.method) {
         case RestorationMethod::AnchorSprings: return springs + r.anchorStiffness;
-        case RestorationMethod::Constraint: return springs + r.constraintFraction * meanMass / (timeStep * timeStep);
+        case RestorationMethod::Constraint:
+            return springs + constraintFractionFor(r, timeStep) * meanMass / (timeStep * timeStep);
         case RestorationMethod::None: break;
     }
     return springs;

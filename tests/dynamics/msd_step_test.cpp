@@ -369,3 +369,69 @@ TEST(MsdStep, GoldenHashOfTheFullStepInEveryKernel) {
                 << c.name << ", kernel " << detail::toString(kernel);
     }
 }
+
+// The restoration constraint as a rate: c = 1 - exp(-2 lambda h), so the old default fraction
+// 1e-3 at 1 kHz is lambda = -ln(1 - 1e-3) / 2e-3 = 0.50025 /s.
+TEST(MsdStep, ConstraintRateConvertsToAFractionPerStep) {
+    RestorationSettings r;
+    r.constraintFraction = 0.25;
+    EXPECT_EQ(constraintFractionFor(r, 1e-3), 0.25);  // no rate: the fraction as given
+    r.constraintRate = -std::log(1.0 - 1e-3) / 2e-3;
+    EXPECT_NEAR(r.constraintRate, 0.50025, 1e-5);
+    EXPECT_NEAR(constraintFractionFor(r, 1e-3), 1e-3, 1e-15);
+    for (const double h : {2.5e-4, 4e-3, 0.1})
+        EXPECT_NEAR(constraintFractionFor(r, h), 1.0 - std::exp(-2.0 * r.constraintRate * h), 1e-15) << h;
+    SimulationSettings s;
+    s.restoration.constraintRate = -1.0;
+    EXPECT_THROW(validateSettings(s), InputError);
+}
+
+namespace {
+
+// Restoration time of a perturbed torus1 restored by the constraint (elastic springs, no
+// gravity): the last time within 8 s that a mass was farther than 1e-3 of the largest initial
+// offset from rest. The constraint with the velocity correction is an underdamped oscillator
+// (frequency about sqrt(c)/h, envelope sqrt(1 - c) a step), so offsets cross zero on the way;
+// the last time above the threshold follows the envelope.
+double restorationTime(const RestorationSettings& restoration, double h) {
+    const auto model = buildPartModel(makeTorus1());
+    SimulationSettings s;
+    s.timeStep = h;
+    s.restoration = restoration;
+    PartState state = PartState::atRest(*model);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    for (Index m = 0; m < model->massCount(); m += 3) state.positions[m] += Vec3(u(rng), u(rng), u(rng));
+    auto largestOffset = [&] {
+        double largest = 0.0;
+        for (Index m = 0; m < model->massCount(); ++m)
+            largest = std::max(largest, (state.positions[m] - model->restPositions[m]).norm());
+        return largest;
+    };
+    const double threshold = 1e-3 * largestOffset();
+    double lastAbove = 0.0;
+    while (state.time < 8.0) {
+        stepFullModel(*model, s, {}, state);
+        if (largestOffset() > threshold) lastAbove = state.time;
+    }
+    return lastAbove;
+}
+
+}  // namespace
+
+// Issue 17: given as a rate, the constraint restores in the same simulated time at 0.25, 1 and
+// 4 ms (within 5 %); given as a fraction per step, it does not (the same fraction restores about
+// 4 times faster at 0.25 ms than at 1 ms).
+TEST(MsdStep, ARestorationRateRestoresInTheSameTimeAtEveryTimeStep) {
+    RestorationSettings rate;
+    rate.method = RestorationMethod::Constraint;
+    rate.constraintRate = 3.0;
+    const double atOne = restorationTime(rate, 1e-3);
+    EXPECT_GT(atOne, 1.0);  // about ln(1000) / 3 = 2.3 s for the constraint alone
+    for (const double h : {2.5e-4, 4e-3}) EXPECT_NEAR(restorationTime(rate, h), atOne, 0.05 * atOne) << h;
+    RestorationSettings fraction;
+    fraction.method = RestorationMethod::Constraint;
+    fraction.constraintFraction = 1.0 - std::exp(-2.0 * 3.0 * 1e-3);
+    EXPECT_NEAR(restorationTime(fraction, 1e-3), atOne, 1.5e-3);  // the same c up to rounding: within a step
+    EXPECT_LT(restorationTime(fraction, 2.5e-4), 0.5 * atOne);  // 4 times the steps a second
+}

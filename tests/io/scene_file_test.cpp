@@ -457,3 +457,14 @@ TEST(SceneFile, ImplicitIntegratorAndItsSolve) {
     const std::string one = errorOf(withLine("name = \"mouth\"", "implicit_tolerance = 1.5"));
     EXPECT_NE(one.find(":9: part 1, key 'implicit_tolerance': must be in [0, 1)"), std::string::npos) << one;
 }
+
+TEST(SceneFile, ConstraintRateReplacesTheFraction) {
+    const Scene s = parseScene(withLine("name = \"ball\"", "restoration = \"constraint\"\nconstraint_rate = 2.5"), "scene.toml", ".");
+    EXPECT_EQ(s.parts[1].part.simulation.restoration.constraintRate, 2.5);
+    const std::string both = errorOf(withLine("name = \"ball\"", "constraint_fraction = 0.01\nconstraint_rate = 2.5"));
+    EXPECT_NE(both.find(":19: part 2, key 'constraint_rate': give either constraint_rate or constraint_fraction, not both"),
+              std::string::npos)
+        << both;
+    const std::string negative = errorOf(withLine("name = \"ball\"", "constraint_rate = -1"));
+    EXPECT_NE(negative.find(":18: part 2, key 'constraint_rate': must be > 0"), std::string::npos) << negative;
+}
