@@ -121,13 +121,14 @@ void listedSpringForces(const PartModel& model, std::span<const Index> springs, 
 #endif
     (void)kernel;
     for (const Index e : springs.subspan(done)) {
-        const std::size_t a = 3 * std::size_t(model.springA[e]), b = 3 * std::size_t(model.springB[e]);
+        const std::size_t a = model.springA[e], b = model.springB[e];
         double g[3];
-        springForce(model.stiffness[e], model.damping[e], model.restLength[e], x + a, x + b, v + a, v + b, g);
-        if (cover == nullptr || cover[a / 3] != 0)
-            for (std::size_t c = 0; c < 3; ++c) f[a + c] += g[c];
-        if (cover == nullptr || cover[b / 3] != 0)
-            for (std::size_t c = 0; c < 3; ++c) f[b + c] -= g[c];
+        springForce(model.stiffness[e], model.damping[e], model.restLength[e], x + 3 * a, x + 3 * b, v + 3 * a,
+                    v + 3 * b, g);
+        if (cover == nullptr || cover[a] != 0)
+            for (std::size_t c = 0; c < 3; ++c) f[3 * a + c] += g[c];
+        if (cover == nullptr || cover[b] != 0)
+            for (std::size_t c = 0; c < 3; ++c) f[3 * b + c] -= g[c];
     }
 }
 

@@ -206,18 +206,14 @@ int solve(std::size_t masses, std::size_t springs, const ImplicitSettings& setti
     return iterations;
 }
 
-// v+ = v + dv, x+ = x + h v+, then the restoration constraint as in MassUpdate::integrate.
+// v+ = v + dv, x+ = x + h v+, then the restoration constraint (MassUpdate::restore).
 void integrate(const Problem& q, const Workspace& ws, PartState& state) {
     const MassUpdate& p = q.update;
     for (std::size_t k = 0; k < q.masses.size(); ++k) {
         const Index i = q.masses[k];
         Vec3 vNew = state.velocities[i] + Vec3(ws.dv[3 * k], ws.dv[3 * k + 1], ws.dv[3 * k + 2]);
         Vec3 xNew = state.positions[i] + p.h * vNew;
-        if (p.constraint > 0.0) {
-            const Vec3 correction = p.constraint * (q.model.restPositions[i] - xNew);
-            xNew += correction;
-            vNew += p.invH * correction;
-        }
+        p.restore(q.model.restPositions[i], xNew, vNew);
         state.positions[i] = xNew;
         state.velocities[i] = vNew;
     }

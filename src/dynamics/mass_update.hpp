@@ -47,14 +47,19 @@ struct MassUpdate {
             xNew = x + h * v;
             vNew = v + (h * inverseMass) * f;
         }
+        restore(rest, xNew, vNew);
+        x = xNew;
+        v = vNew;
+    }
+
+    // The restoration constraint after integration (every integrator): position-based, a
+    // fraction back towards rest; the velocity takes the correction.
+    void restore(const Vec3& rest, Vec3& xNew, Vec3& vNew) const {
         if (constraint > 0.0) {
-            // Position-based restoration: move a fraction back; the velocity takes the correction.
             const Vec3 correction = constraint * (rest - xNew);
             xNew += correction;
             vNew += invH * correction;
         }
-        x = xNew;
-        v = vNew;
     }
 };
 
