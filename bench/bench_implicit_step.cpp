@@ -18,7 +18,7 @@ using namespace flexfit;
 constexpr Index kZoneMasses = 2000;
 
 std::shared_ptr<const PartModel> heart(double stiffness, double mass) {
-    return buildPartModel(makeHeart(), {Material{stiffness, 0.01 * std::sqrt(stiffness * mass)}, mass, {}, {}, {}});
+    return buildPartModel(makeHeart(), {Material{stiffness, 0.01 * std::sqrt(stiffness * mass)}, mass, {}, {}, {}, {}});
 }
 
 // 0: symplectic Euler; otherwise implicit Euler with that many iterations. Range 1: 0 for the

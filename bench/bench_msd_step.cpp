@@ -75,7 +75,7 @@ void BM_FlexfitFullStep(benchmark::State& state) {
     const TriMesh& mesh = meshByIndex(int(state.range(0)));
     state.SetLabel(mesh.name);
     if (skipMissing(state, mesh)) return;
-    const auto model = flexfit::buildPartModel(mesh, {flexfit::Material::elastic(), 1.0, {}, {}, {}});
+    const auto model = flexfit::buildPartModel(mesh);  // the elastic preset, 1 kg masses
     const flexfit::SimulationSettings settings = benchSettings();
     flexfit::PartState partState = flexfit::PartState::atRest(*model);
     for (auto _ : state) {
@@ -108,7 +108,7 @@ void runDetailStep(benchmark::State& state, flexfit::detail::BlockKernel kernel)
         state.SkipWithError("kernel not supported by this CPU");
         return;
     }
-    const auto model = flexfit::buildPartModel(mesh, {flexfit::Material::elastic(), 1.0, {}, {}, {}});
+    const auto model = flexfit::buildPartModel(mesh);  // the elastic preset, 1 kg masses
     const auto update = flexfit::detail::MassUpdate::from(benchSettings());
     flexfit::PartState partState = flexfit::PartState::atRest(*model);
     const flexfit::detail::FlushDenormals flush;  // as stepFullModel

@@ -108,7 +108,7 @@ Scene makeScene(const RunSpec& spec, const Options& opt) {
 
     ScenePart mouth;
     mouth.name = "mouth";
-    mouth.model = buildPartModel(makeTorus(kMajor, kMinor, opt.u, opt.v), {rim.springs, 1.0, {}, {}, {}});
+    mouth.model = buildPartModel(makeTorus(kMajor, kMinor, opt.u, opt.v), {rim.springs, 1.0, {}, {}, {}, {}});
     mouth.part.mode = rim.mode;
     mouth.part.simulation.globalDamping = 1.0;
     mouth.part.simulation.restoration = {RestorationMethod::AnchorSprings, rim.anchorStiffness, rim.anchorDamping, 1e-3};

@@ -37,7 +37,7 @@ void writeFrame(const std::filesystem::path& path, const Part& yellow, const Par
 void run(const ContactOptions& opt) {
     makeDirectory(opt.out);
     const std::filesystem::path dir(opt.out);
-    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}, {}});
     PartSettings rigidSettings;
     rigidSettings.mode = PartMode::Rigid;
     PartSettings softSettings;

@@ -48,9 +48,16 @@ SimulationSettings anchorSettings(const Material& m, const ExperimentOptions& op
     return s;
 }
 
+// The thesis's models: one material on every spring, 1 kg masses.
+PartModelSettings springsOf(const Material& material) {
+    PartModelSettings settings;
+    settings.material = material;
+    return settings;
+}
+
 MaterialRun runMaterial(const std::string& name, const Material& material, const ExperimentOptions& opt, std::ostream& series) {
     PerturbationConfig config;
-    config.model = buildPartModel(makeTorus1(), PartModelSettings{material, 1.0, {}, {}, {}});
+    config.model = buildPartModel(makeTorus1(), springsOf(material));
     config.part.mode = PartMode::FullDeformable;
     config.part.simulation = anchorSettings(material, opt);
     config.loads = {{opt.mass, Vec3(opt.force, 0.0, 0.0)}};
@@ -72,7 +79,7 @@ MaterialRun runMaterial(const std::string& name, const Material& material, const
 // interleaved over rounds, best round kept.
 std::vector<std::pair<std::string, double>> measureRestorationCost(const ExperimentOptions& opt) {
     const Material m = Material::elastic();
-    const auto model = buildPartModel(makeTorus1(), PartModelSettings{m, 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), springsOf(m));
     const RestorationMethod methods[3] = {RestorationMethod::None, RestorationMethod::AnchorSprings, RestorationMethod::Constraint};
     double best[3] = {0, 0, 0};
     constexpr int kRounds = 5;

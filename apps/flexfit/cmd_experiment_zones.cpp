@@ -79,7 +79,7 @@ double measure(Part& part, const std::vector<Index>& seeds, const ZonesOptions& 
 }
 
 std::vector<Measurement> runModel(const TriMesh& mesh, const ZonesOptions& opt, ProgressBar& bar, int& done, int total) {
-    const auto model = buildPartModel(mesh, {Material::elastic(), 1.0, {}, {}, {}});
+    const auto model = buildPartModel(mesh);  // the elastic preset, 1 kg masses
     const std::vector<Index> allSeeds = spreadSeeds(*model, opt.maxZones);
     std::vector<Measurement> rows;
     Part full(model, experimentSettings(PartMode::FullDeformable));

@@ -4,19 +4,34 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
+
 namespace flexfit::cli {
 
 void SimulationOptions::addTo(CLI::App& cmd) {
-    cmd.add_option("--material", material, "Spring material preset (thesis Table 4.1)")
-        ->check(CLI::IsMember({"rigid", "elastic", "superelastic"}))->capture_default_str();
-    cmd.add_option("--stiffness", stiffness, "Spring stiffness k (overrides the preset)")->check(CLI::NonNegativeNumber);
-    cmd.add_option("--damping", damping, "Spring damping b (overrides the preset)")->check(CLI::NonNegativeNumber);
-    cmd.add_option("--mass", vertexMass, "Mass of every vertex (kg)")->check(CLI::PositiveNumber)->capture_default_str();
+    auto* preset = cmd.add_option("--material", material, "Spring material preset (thesis Table 4.1)")
+                       ->check(CLI::IsMember({"rigid", "elastic", "superelastic"}))->capture_default_str();
+    auto* k = cmd.add_option("--stiffness", stiffness, "Spring stiffness k (overrides the preset)")->check(CLI::NonNegativeNumber);
+    auto* b = cmd.add_option("--damping", damping, "Spring damping b (overrides the preset)")->check(CLI::NonNegativeNumber);
+    auto* m = cmd.add_option("--mass", vertexMass, "Mass of every vertex (kg)")->check(CLI::PositiveNumber)->capture_default_str();
+    // A physical material (the mesh in metres): it gives the springs and the masses.
+    auto* e = cmd.add_option("--youngs-modulus", shell.youngsModulus,
+                             "Physical material: Young's modulus (Pa) of a shell of the surface; needs --thickness and --density")
+                  ->check(CLI::PositiveNumber);
+    auto* t = cmd.add_option("--thickness", shell.thickness, "Physical material: shell thickness (m)")->check(CLI::PositiveNumber);
+    auto* rho = cmd.add_option("--density", shell.density, "Physical material: density (kg/m^3)")->check(CLI::PositiveNumber);
+    auto* nu = cmd.add_option("--poisson-ratio", shell.poissonRatio, "Physical material: Poisson's ratio [0, 0.5) (bending rigidity)")
+                   ->check(CLI::Range(0.0, 0.4999999))->capture_default_str();
+    auto* zeta = cmd.add_option("--damping-ratio", shell.dampingRatio, "Physical material: damping ratio of each spring")
+                     ->check(CLI::NonNegativeNumber)->capture_default_str();
+    auto* bend = cmd.add_flag("--bending-springs", shell.bendingSprings, "Physical material: a spring across each interior edge");
+    e->needs(t)->needs(rho)->excludes(preset)->excludes(k)->excludes(b)->excludes(m);
+    for (CLI::Option* o : {t, rho, nu, zeta, bend}) o->needs(e);
     cmd.add_option("--restore", restore, "Shape restoration: " + nameList<RestorationMethod>())
         ->check(CLI::IsMember(enumChoices<RestorationMethod>()))->capture_default_str();
-    cmd.add_option("--anchor-stiffness", anchorStiffness, "Anchor spring k_a (default: the material's k)")
+    cmd.add_option("--anchor-stiffness", anchorStiffness, "Anchor spring k_a (default: the material's k; a physical material's mean spring k)")
         ->check(CLI::NonNegativeNumber);
-    cmd.add_option("--anchor-damping", anchorDamping, "Anchor spring b_a (default: the material's b)")
+    cmd.add_option("--anchor-damping", anchorDamping, "Anchor spring b_a (default: the material's b; a physical material's mean spring b)")
         ->check(CLI::NonNegativeNumber);
     cmd.add_option("--constraint-fraction", constraintFraction, "Share of the separation restored per step (0, 1]")
         ->capture_default_str();
@@ -47,11 +62,27 @@ PartModelSettings SimulationOptions::modelSettings() const {
     PartModelSettings s;
     s.material = resolvedMaterial();
     s.vertexMass = vertexMass;
+    if (shell.youngsModulus > 0.0) s.shell = shell;
     return s;
 }
 
+namespace {
+
+// The model's mean spring constants: the anchors' default under a physical material.
+Material meanSpring(const PartModel& model) {
+    Material mean{0.0, 0.0};
+    const double n = double(std::max<std::size_t>(model.springCount(), 1));
+    for (std::size_t e = 0; e < model.springCount(); ++e) {
+        mean.stiffness += model.stiffness[e] / n;
+        mean.damping += model.damping[e] / n;
+    }
+    return mean;
+}
+
+}  // namespace
+
 SimulationSettings SimulationOptions::simulationSettings(const PartModel& model) const {
-    const Material m = resolvedMaterial();
+    const Material m = shell.youngsModulus > 0.0 ? meanSpring(model) : resolvedMaterial();
     SimulationSettings s;
     s.timeStep = timeStep;
     s.integrator = enumOption<Integrator>(integrator, "option --integrator");

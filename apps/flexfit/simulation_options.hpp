@@ -14,6 +14,7 @@ struct SimulationOptions {
     std::string material = "elastic";
     double stiffness = -1.0, damping = -1.0;  // < 0: the material's
     double vertexMass = 1.0;
+    ShellMaterial shell;  // used when youngsModulus > 0 (--youngs-modulus)
     std::string restore = "constraint";
     double anchorStiffness = -1.0, anchorDamping = -1.0;  // < 0: the material's k and b
     double constraintFraction = 1e-3;

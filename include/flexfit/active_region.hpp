@@ -76,7 +76,7 @@ private:
     Index springOfBlock(Index block, Index i) const;   // lane i's spring
     Index octetOf(Index mass) const { return mass < coverCount_.size() / 8 * 8 ? mass / 8 : kNoGroup; }
 
-    const Topology* topology_ = nullptr;
+    const PartModel* model_ = nullptr;
     std::vector<std::uint16_t> coverCount_;  // (V)
     std::vector<std::uint8_t> movingEnds_;   // (E) 0, 1 or 2
     IndexSet masses_;                        // (V)

@@ -6,6 +6,8 @@
 
 #include "flexfit/mesh.hpp"
 
+#include <array>
+
 namespace flexfit {
 
 // Torus around the y axis (the thesis's container mouth is open along y), centred at the
@@ -30,6 +32,8 @@ TriMesh makeHeart(double size = 20.0, int segments = 93, int rings = 80);
 // grid of quads (so that contacts find points across a face, not only at its corners):
 // 6 d^2 + 2 vertices. Requires positive half extents and 1 <= divisions <= 256.
 TriMesh makeBox(const Vec3& halfExtents, int divisions = 1);
+// The same with a number of divisions per axis (x, y, z), e.g. a long strip of near-square cells.
+TriMesh makeBox(const Vec3& halfExtents, const std::array<int, 3>& divisions);
 
 // Plate centred at the origin (half extents along x, y, z) with a rectangular hole through it
 // along y (half widths holeX, holeZ, smaller than the plate's): a peg's hole. 16 vertices, 32

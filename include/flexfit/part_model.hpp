@@ -13,6 +13,7 @@
 
 #include <memory>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -35,11 +36,40 @@ struct Material {
 // "rigid" | "elastic" | "superelastic"; nullopt for anything else.
 std::optional<Material> materialPreset(std::string_view name);
 
+// A material as engineers state it, for a part simulated as a shell: its surface mesh is a
+// membrane of the given thickness (SI units: the mesh's coordinates are metres).
+//
+// - Spring stiffness (van Gelder 1998): k_e = E t sum(area of the faces at e) / |e|^2. On a
+//   near-equilateral mesh the network's in-plane Young's modulus is then E; its Poisson ratio is
+//   the triangle lattice's own 1/3 whatever poissonRatio says (linear springs cannot give another:
+//   van Gelder's result). poissonRatio enters the bending rigidity D = E t^3 / (12 (1 - nu^2)).
+// - Lumped masses: density x thickness x a third of the area of the faces at each vertex.
+// - Damping per spring from a damping ratio: b_e = 2 zeta sqrt(k_e mu_e), mu_e the reduced mass
+//   of the spring's two masses (critically damped pair at zeta = 1).
+// - Bending springs (optional): one across each interior edge, joining the two vertices opposite
+//   it, k_b = 3 D |e|^2 / ((A1 + A2) d^2) with d their rest distance. Its hinge stiffness is the
+//   discrete-shell one (Grinspun et al. 2003, 3 D |e|^2 / (A1 + A2)) times (h1 h2 sin(theta) / d^2)^2:
+//   a quarter of it at a right-angle crease, and none on a flat region (a flat sheet gets no
+//   linear bending stiffness from springs: a known limit). They keep creases and corners,
+//   so a thin-walled section keeps its shape; in plane they add O((t / edge)^2) stiffness.
+struct ShellMaterial {
+    double youngsModulus = 0.0;  // E, Pa (> 0)
+    double poissonRatio = 0.35;  // nu, in [0, 0.5)
+    double thickness = 0.0;      // t, m (> 0)
+    double density = 0.0;        // kg/m^3 (> 0)
+    double dampingRatio = 0.1;   // zeta, >= 0
+    bool bendingSprings = false;
+};
+
 struct PartModelSettings {
     Material material = Material::elastic();  // for every spring unless springMaterials is set
     double vertexMass = 1.0;                  // kg, for every vertex unless vertexMasses is set
     std::vector<double> vertexMasses;         // (V) optional per-vertex masses
     std::vector<Material> springMaterials;    // (E) optional per-spring constants, Topology order
+    // Optional: a physical material; when set, it gives every spring's constants and every
+    // vertex's mass in place of material and vertexMass (vertexMasses and springMaterials must
+    // then be empty).
+    std::optional<ShellMaterial> shell;
     // Optional: the mesh drawn and exported instead of the simulated one (the user's own, when the
     // part simulates on a remeshed surface), embedded in it (surface_embedding.hpp). Empty: the
     // simulation mesh is drawn.
@@ -56,7 +86,8 @@ struct PartModel {
     std::vector<double> mass;          // (V) kg, > 0
     std::vector<double> inverseMass;   // (V) 1/kg
 
-    // Springs (E): one per unique edge.
+    // Springs (E): one per unique edge, and with a shell material's bending springs one across
+    // each interior edge; sorted by (springA, springB), so a bending spring's index is not an edge's.
     std::vector<Index> springA;        // (E) first mass (springA < springB; sorted by springA)
     std::vector<Index> springB;        // (E) second mass
     std::vector<double> restLength;    // (E) initial Euclidean distance
@@ -64,6 +95,13 @@ struct PartModel {
     std::vector<double> damping;       // (E) b
     // (V+1) springs whose first mass is a: [springAdr[a], springAdr[a+1]).
     std::vector<Index> springAdr;
+    // mass -> every spring at it (either end): massSprings[massSpringAdr[v] .. adr[v+1]).
+    std::vector<Index> massSpringAdr;  // (V+1)
+    std::vector<Index> massSprings;    // (2E)
+    std::size_t bendingSpringCount = 0;
+    std::span<const Index> springsAt(Index v) const {
+        return {massSprings.data() + massSpringAdr[v], massSprings.data() + massSpringAdr[v + 1]};
+    }
     // The springs again, grouped for the vector full step (an internal layout); empty when the
     // mesh's vertex order gives too few blocks. It copies the spring constants: build models with
     // buildPartModel, and do not edit a model's springs afterwards.
@@ -82,7 +120,9 @@ struct PartModel {
 
 // Builds a model from a validated mesh. Throws InputError (source "part model settings") for
 // non-positive or non-finite masses and constants, or per-vertex / per-spring arrays of the
-// wrong size; a drawn mesh must pass validateMesh.
+// wrong size, a shell material out of range (or set beside per-vertex masses or per-spring
+// materials), or one that leaves a vertex without mass (in no face of positive area); a drawn
+// mesh must pass validateMesh.
 std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings = {});
 
 }  // namespace flexfit

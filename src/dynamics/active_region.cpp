@@ -38,7 +38,7 @@ Index massOfOctet(Index octet, Index i) { return 8 * octet + i; }
 }  // namespace
 
 ActiveRegion::ActiveRegion(const PartModel& model)
-    : topology_(&model.topology),
+    : model_(&model),
       coverCount_(model.massCount(), 0),
       movingEnds_(model.springCount(), 0),
       masses_(model.massCount()),
@@ -53,7 +53,7 @@ bool ActiveRegion::cover(Index mass) {
     if (coverCount_[mass]++ != 0) return false;
     masses_.insert(mass);
     octets_.join(mass, octetOf(mass), massOfOctet);
-    for (Index e : topology_->edgesOf(mass))
+    for (Index e : model_->springsAt(mass))
         if (movingEnds_[e]++ == 0) springJoins(e);
     return true;
 }
@@ -62,7 +62,7 @@ bool ActiveRegion::uncover(Index mass) {
     if (--coverCount_[mass] != 0) return false;
     masses_.erase(mass);
     octets_.leave(mass, octetOf(mass), massOfOctet);
-    for (Index e : topology_->edgesOf(mass))
+    for (Index e : model_->springsAt(mass))
         if (--movingEnds_[e] == 0) springLeaves(e);
     return true;
 }

@@ -304,7 +304,7 @@ bool Part::zoneAtRest(const Zone& zone) const {
         if (lastLoadStep_[i] != kNeverLoaded && state_.stepCount - lastLoadStep_[i] <= interval) return false;
         if (state_.velocities[i].squaredNorm() > restSpeed2) return false;
         if ((state_.positions[i] - model_->restPositions[i]).norm() > threshold) return false;
-        for (Index e : model_->topology.edgesOf(i)) {
+        for (Index e : model_->springsAt(i)) {
             const double length = (state_.positions[model_->springA[e]] - state_.positions[model_->springB[e]]).norm();
             if (std::abs(length - model_->restLength[e]) > threshold) return false;
         }

@@ -128,36 +128,38 @@ TriMesh makeIcoSphere(double radius, int subdivisions) {
     return mesh;
 }
 
-TriMesh makeBox(const Vec3& halfExtents, int divisions) {
+TriMesh makeBox(const Vec3& halfExtents, int divisions) { return makeBox(halfExtents, {divisions, divisions, divisions}); }
+
+TriMesh makeBox(const Vec3& halfExtents, const std::array<int, 3>& divisions) {
     require(halfExtents.allFinite() && halfExtents.minCoeff() > 0.0, "box needs finite half extents > 0");
-    require(divisions >= 1 && divisions <= 256, "box needs 1 <= divisions <= 256");
-    const int d = divisions;
+    for (int d : divisions) require(d >= 1 && d <= 256, "box needs 1 <= divisions <= 256");
+    const std::array<int, 3>& d = divisions;
     TriMesh mesh;
     mesh.name = "box";
-    // Vertices on the surface lattice (i, j, k) in [0, d]^3, each once.
+    // Vertices on the surface lattice (i, j, k) in [0, d_x] x [0, d_y] x [0, d_z], each once.
     std::map<std::array<int, 3>, Index> index;
     auto vertex = [&](std::array<int, 3> g) {
         auto [it, inserted] = index.try_emplace(g, Index(mesh.vertices.size()));
         if (inserted)
-            mesh.vertices.push_back(Vec3(halfExtents.x() * (2.0 * g[0] / d - 1.0), halfExtents.y() * (2.0 * g[1] / d - 1.0),
-                                         halfExtents.z() * (2.0 * g[2] / d - 1.0)));
+            mesh.vertices.push_back(Vec3(halfExtents.x() * (2.0 * g[0] / d[0] - 1.0), halfExtents.y() * (2.0 * g[1] / d[1] - 1.0),
+                                         halfExtents.z() * (2.0 * g[2] / d[2] - 1.0)));
         return it->second;
     };
     // Each face: the lattice point at (a, b) of the face's grid; quads counter-clockwise seen
     // from outside (u x v along the outward normal).
-    for (int axis = 0; axis < 3; ++axis)
-        for (int side : {0, d}) {
-            const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    for (std::size_t axis = 0; axis < 3; ++axis)
+        for (int side : {0, d[axis]}) {
+            const std::size_t u = (axis + 1) % 3, v = (axis + 2) % 3;
             auto at = [&](int a, int b) {
                 std::array<int, 3> g{};
-                g[std::size_t(axis)] = side;
-                g[std::size_t(u)] = a;
-                g[std::size_t(v)] = b;
+                g[axis] = side;
+                g[u] = a;
+                g[v] = b;
                 return vertex(g);
             };
-            for (int a = 0; a < d; ++a)
-                for (int b = 0; b < d; ++b) {
-                    if (side == d) addQuad(mesh.faces, at(a, b), at(a + 1, b), at(a + 1, b + 1), at(a, b + 1));
+            for (int a = 0; a < d[u]; ++a)
+                for (int b = 0; b < d[v]; ++b) {
+                    if (side == d[axis]) addQuad(mesh.faces, at(a, b), at(a + 1, b), at(a + 1, b + 1), at(a, b + 1));
                     else addQuad(mesh.faces, at(a, b), at(a, b + 1), at(a + 1, b + 1), at(a + 1, b));
                 }
         }

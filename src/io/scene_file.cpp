@@ -270,19 +270,49 @@ TriMesh generatePartMesh(Table& t) {
     return mesh;
 }
 
-Material readMaterial(Table& t) {
+// A physical material: {youngs_modulus, thickness, density, poisson_ratio, damping_ratio,
+// bending_springs} (part_model.hpp's ShellMaterial).
+ShellMaterial readShellMaterial(Table& m) {
+    for (const char* key : {"thickness", "density"})
+        if (!m.has(key)) m.fail(std::string("needs '") + key + "' beside 'youngs_modulus' (a physical material)");
+    if (m.has("stiffness") || m.has("damping"))
+        m.fail(*m.node(m.has("stiffness") ? "stiffness" : "damping"), m.has("stiffness") ? "stiffness" : "damping",
+               "give either spring constants {stiffness, damping} or a physical material {youngs_modulus, ...}, not both");
+    ShellMaterial shell;
+    shell.youngsModulus = m.positive("youngs_modulus", 0.0);
+    shell.thickness = m.positive("thickness", 0.0);
+    shell.density = m.positive("density", 0.0);
+    shell.poissonRatio = m.nonNegative("poisson_ratio", shell.poissonRatio);
+    if (!(shell.poissonRatio < 0.5)) m.fail(*m.node("poisson_ratio"), "poisson_ratio", "must be in [0, 0.5)");
+    shell.dampingRatio = m.nonNegative("damping_ratio", shell.dampingRatio);
+    shell.bendingSprings = m.flag("bending_springs", false);
+    return shell;
+}
+
+// `material`: a preset name, spring constants {stiffness, damping}, or a physical material.
+void readMaterial(Table& t, PartModelSettings& model) {
     const toml::node* n = t.node("material");
-    if (!n) return Material::elastic();
+    if (!n) return;
     if (n->is_string()) {
         const std::string name(n->value<std::string>().value());
-        if (auto preset = materialPreset(name)) return *preset;
-        t.fail(*n, "material", "unknown preset '" + name + "' (expected 'rigid', 'elastic', 'superelastic' or {stiffness, damping})");
+        if (auto preset = materialPreset(name)) {
+            model.material = *preset;
+            return;
+        }
+        t.fail(*n, "material", "unknown preset '" + name + "' (expected 'rigid', 'elastic', 'superelastic', {stiffness, damping} or {youngs_modulus, thickness, density, ...})");
     }
-    if (!n->is_table()) t.fail(*n, "material", "expected a preset name or {stiffness, damping}");
+    if (!n->is_table()) t.fail(*n, "material", "expected a preset name, {stiffness, damping} or {youngs_modulus, thickness, density, ...}");
     Table m = t.sub("material");
-    Material material{m.positive("stiffness", 0.1), m.nonNegative("damping", 0.01)};
+    if (m.has("youngs_modulus")) {
+        model.shell = readShellMaterial(m);
+        if (t.has("vertex_mass"))
+            t.fail(*t.node("vertex_mass"), "vertex_mass", "a physical material gives the masses (density x thickness x area): leave vertex_mass out");
+    } else {
+        for (const char* key : {"thickness", "density", "poisson_ratio", "damping_ratio", "bending_springs"})
+            if (m.has(key)) m.fail(*m.node(key), key, "belongs to a physical material: needs 'youngs_modulus'");
+        model.material = Material{m.positive("stiffness", 0.1), m.nonNegative("damping", 0.01)};
+    }
     m.finish();
-    return material;
 }
 
 ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
@@ -296,7 +326,7 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     mesh.name = p.name;
     PartModelSettings model;
     model.drawnMesh = std::move(meshes.drawn);
-    model.material = readMaterial(t);
+    readMaterial(t, model);
     model.vertexMass = t.positive("vertex_mass", 1.0);
 
     p.part.mode = t.choice("mode", PartMode::RigidDeformable);

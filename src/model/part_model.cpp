@@ -3,7 +3,9 @@
 #include "flexfit/surface_embedding.hpp"
 #include "model/spring_blocks.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace flexfit {
 namespace {
@@ -33,6 +35,113 @@ void checkSettings(const PartModelSettings& s, std::size_t vertices, std::size_t
     for (std::size_t e = 0; e < s.springMaterials.size(); ++e) checkMaterial(s.springMaterials[e], "spring " + std::to_string(e));
 }
 
+void checkShell(const ShellMaterial& m, const PartModelSettings& s) {
+    auto fail = [](const std::string& problem) { throw InputError(kSettingsSource, 0, "shell material: " + problem); };
+    if (!positiveFinite(m.youngsModulus)) fail("Young's modulus must be finite and > 0");
+    if (!(std::isfinite(m.poissonRatio) && m.poissonRatio >= 0.0 && m.poissonRatio < 0.5)) fail("Poisson's ratio must be in [0, 0.5)");
+    if (!positiveFinite(m.thickness)) fail("thickness must be finite and > 0");
+    if (!positiveFinite(m.density)) fail("density must be finite and > 0");
+    if (!nonNegativeFinite(m.dampingRatio)) fail("damping ratio must be finite and >= 0");
+    if (!s.vertexMasses.empty() || !s.springMaterials.empty())
+        fail("gives the masses and the spring constants: per-vertex masses or per-spring materials cannot be set beside it");
+}
+
+double faceArea(const std::vector<Vec3>& x, const Face& f) { return 0.5 * (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]).norm(); }
+
+// A spring's two ends and, for the shell's rules, the area of the faces it spans (its edge's
+// faces, or the two faces a bending spring crosses) and the edge it crosses (bending only).
+struct SpringSpec {
+    Index a = 0, b = 0;
+    double faceArea = 0.0;
+    double crossedEdgeLength = 0.0;  // 0: an edge spring
+    bool operator<(const SpringSpec& o) const { return a != o.a ? a < o.a : b < o.b; }
+};
+
+// One spec per unique edge (Topology order) and, with bending springs, one per interior edge
+// joining its two opposite vertices (skipped where those are already joined by an edge or by
+// another bending spring).
+std::vector<SpringSpec> springSpecs(const TriMesh& mesh, const Topology& topo, bool bending) {
+    struct HalfEdge {
+        Index a, b, opposite;
+        double area;
+    };
+    std::vector<HalfEdge> halves;
+    halves.reserve(3 * mesh.faces.size());
+    for (const Face& f : mesh.faces) {
+        const double area = faceArea(mesh.vertices, f);
+        for (int i = 0; i < 3; ++i) {
+            const Index u = f[std::size_t(i)], w = f[std::size_t((i + 1) % 3)], o = f[std::size_t((i + 2) % 3)];
+            halves.push_back({std::min(u, w), std::max(u, w), o, area});
+        }
+    }
+    std::sort(halves.begin(), halves.end(), [](const HalfEdge& l, const HalfEdge& r) {
+        return l.a != r.a ? l.a < r.a : l.b != r.b ? l.b < r.b : l.opposite < r.opposite;
+    });
+    std::vector<SpringSpec> specs;
+    specs.reserve(topo.edgeCount());
+    std::vector<SpringSpec> crossing;
+    for (std::size_t i = 0; i < halves.size();) {  // the runs of halves follow Topology's edge order
+        std::size_t j = i;
+        double area = 0.0;
+        for (; j < halves.size() && halves[j].a == halves[i].a && halves[j].b == halves[i].b; ++j) area += halves[j].area;
+        specs.push_back({halves[i].a, halves[i].b, area, 0.0});
+        if (bending && j - i == 2 && halves[i].opposite != halves[i + 1].opposite) {
+            const Index c = halves[i].opposite, d = halves[i + 1].opposite;
+            const double edge = (mesh.vertices[halves[i].a] - mesh.vertices[halves[i].b]).norm();
+            crossing.push_back({std::min(c, d), std::max(c, d), area, edge});
+        }
+        i = j;
+    }
+    if (crossing.empty()) return specs;
+    std::stable_sort(crossing.begin(), crossing.end());
+    std::vector<SpringSpec> merged;
+    merged.reserve(specs.size() + crossing.size());
+    std::merge(specs.begin(), specs.end(), crossing.begin(), crossing.end(), std::back_inserter(merged));
+    // An edge comes first among equal ends (merge keeps the first range's first): drop the rest.
+    merged.erase(std::unique(merged.begin(), merged.end(), [](const SpringSpec& l, const SpringSpec& r) { return l.a == r.a && l.b == r.b; }),
+                 merged.end());
+    return merged;
+}
+
+std::vector<double> lumpedMasses(const TriMesh& mesh, const ShellMaterial& m) {
+    std::vector<double> mass(mesh.vertices.size(), 0.0);
+    for (const Face& f : mesh.faces) {
+        const double share = m.density * m.thickness * faceArea(mesh.vertices, f) / 3.0;
+        for (Index v : f) mass[v] += share;
+    }
+    for (std::size_t v = 0; v < mass.size(); ++v)
+        if (!(mass[v] > 0.0))
+            throw InputError(kSettingsSource, 0,
+                             "shell material: vertex " + std::to_string(v) + " gets no mass (it is in no face of positive area)");
+    return mass;
+}
+
+// van Gelder's membrane stiffness for an edge, the bending rule for a crossing spring
+// (ShellMaterial's comment).
+double shellStiffness(const ShellMaterial& m, const SpringSpec& s, double restLength) {
+    if (s.crossedEdgeLength == 0.0) return m.youngsModulus * m.thickness * s.faceArea / (restLength * restLength);
+    const double t = m.thickness, nu = m.poissonRatio;
+    const double rigidity = m.youngsModulus * t * t * t / (12.0 * (1.0 - nu * nu));
+    const double e = s.crossedEdgeLength;
+    return 3.0 * rigidity * e * e / (s.faceArea * restLength * restLength);
+}
+
+void buildMassSprings(PartModel& model) {
+    const std::size_t vertices = model.massCount();
+    model.massSpringAdr.assign(vertices + 1, 0);
+    for (std::size_t e = 0; e < model.springCount(); ++e) {
+        ++model.massSpringAdr[model.springA[e] + 1];
+        ++model.massSpringAdr[model.springB[e] + 1];
+    }
+    for (std::size_t v = 0; v < vertices; ++v) model.massSpringAdr[v + 1] += model.massSpringAdr[v];
+    model.massSprings.resize(2 * model.springCount());
+    std::vector<Index> next(model.massSpringAdr.begin(), model.massSpringAdr.end() - 1);
+    for (std::size_t e = 0; e < model.springCount(); ++e) {  // ascending spring order per mass
+        model.massSprings[next[model.springA[e]]++] = Index(e);
+        model.massSprings[next[model.springB[e]]++] = Index(e);
+    }
+}
+
 }  // namespace
 
 std::optional<Material> materialPreset(std::string_view name) {
@@ -45,26 +154,46 @@ std::optional<Material> materialPreset(std::string_view name) {
 std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings) {
     auto model = std::make_shared<PartModel>();
     model->topology = buildTopology(mesh.faces, mesh.vertices.size());
-    const std::size_t vertices = mesh.vertices.size(), springs = model->topology.edgeCount();
-    checkSettings(settings, vertices, springs);
+    const std::size_t vertices = mesh.vertices.size();
+    checkSettings(settings, vertices, model->topology.edgeCount());
+    const ShellMaterial* shell = settings.shell ? &*settings.shell : nullptr;
+    if (shell) checkShell(*shell, settings);
 
     model->name = mesh.name;
     model->restPositions = mesh.vertices;
-    model->mass = settings.vertexMasses.empty() ? std::vector<double>(vertices, settings.vertexMass) : settings.vertexMasses;
+    if (shell) model->mass = lumpedMasses(mesh, *shell);
+    else model->mass = settings.vertexMasses.empty() ? std::vector<double>(vertices, settings.vertexMass) : settings.vertexMasses;
     model->inverseMass.resize(vertices);
     for (std::size_t v = 0; v < vertices; ++v) model->inverseMass[v] = 1.0 / model->mass[v];
 
-    model->springA = model->topology.edgeA;
-    model->springB = model->topology.edgeB;
+    const std::vector<SpringSpec> specs = springSpecs(mesh, model->topology, shell && shell->bendingSprings);
+    const std::size_t springs = specs.size();
+    model->bendingSpringCount = springs - model->topology.edgeCount();
+    model->springA.resize(springs);
+    model->springB.resize(springs);
     model->restLength.resize(springs);
     model->stiffness.resize(springs);
     model->damping.resize(springs);
     for (std::size_t e = 0; e < springs; ++e) {
-        model->restLength[e] = (mesh.vertices[model->springA[e]] - mesh.vertices[model->springB[e]]).norm();
+        const Index a = specs[e].a, b = specs[e].b;
+        model->springA[e] = a;
+        model->springB[e] = b;
+        model->restLength[e] = (mesh.vertices[a] - mesh.vertices[b]).norm();
+        if (shell) {
+            const double k = shellStiffness(*shell, specs[e], model->restLength[e]);
+            const double reducedMass = model->mass[a] * model->mass[b] / (model->mass[a] + model->mass[b]);
+            model->stiffness[e] = k;
+            model->damping[e] = 2.0 * shell->dampingRatio * std::sqrt(k * reducedMass);
+            continue;
+        }
         const Material& m = settings.springMaterials.empty() ? settings.material : settings.springMaterials[e];
         model->stiffness[e] = m.stiffness;
         model->damping[e] = m.damping;
     }
+    for (std::size_t e = 0; e < springs; ++e)
+        if (!std::isfinite(model->stiffness[e]))
+            throw InputError(kSettingsSource, 0, "shell material: spring " + std::to_string(e) + " gets no finite stiffness (a zero-length edge)");
+    buildMassSprings(*model);
     model->springAdr.assign(vertices + 1, 0);
     for (Index a : model->springA) ++model->springAdr[a + 1];
     for (std::size_t v = 0; v < vertices; ++v) model->springAdr[v + 1] += model->springAdr[v];

@@ -1,6 +1,6 @@
 // ActiveRegion (src/dynamics/active_region.cpp) against brute force: after random covers and
 // uncovers, the moving masses are the covered ones and the computed springs are exactly the
-// springs with a moving end, each listed once; the counts are the covers.
+// springs with a moving end (bending springs too), each listed once; the counts are the covers.
 #include "flexfit/flexfit.hpp"
 #include "model/spring_blocks.hpp"
 
@@ -12,8 +12,9 @@
 
 using namespace flexfit;
 
-TEST(ActiveRegion, IsTheCoveredMassesAndEverySpringTouchingThem) {
-    const auto model = buildPartModel(makeTorus1());
+namespace {
+
+void expectCoveredMassesAndTheirSprings(const std::shared_ptr<const PartModel>& model) {
     ActiveRegion region(*model);
     std::vector<int> covers(model->massCount(), 0);
     std::mt19937 rng(5);
@@ -42,6 +43,19 @@ TEST(ActiveRegion, IsTheCoveredMassesAndEverySpringTouchingThem) {
         ASSERT_EQ(region.springs().size(), springs.size());
         ASSERT_EQ(region.empty(), masses.empty());
     }
+}
+
+}  // namespace
+
+TEST(ActiveRegion, IsTheCoveredMassesAndEverySpringTouchingThem) { expectCoveredMassesAndTheirSprings(buildPartModel(makeTorus1())); }
+
+// Bending springs join masses that share no edge: they are computed all the same.
+TEST(ActiveRegion, BendingSpringsAreComputedWithTheirMasses) {
+    PartModelSettings settings;
+    settings.shell = ShellMaterial{2e9, 0.35, 1e-3, 1200.0, 0.1, true};
+    const auto model = buildPartModel(makeTorus(0.1, 0.025, 24, 24), settings);
+    ASSERT_GT(model->bendingSpringCount, 0u);
+    expectCoveredMassesAndTheirSprings(model);
 }
 
 TEST(ActiveRegion, CoveringEveryMassComputesEverySpring) {

@@ -124,7 +124,7 @@ TEST(BlockStep, EveryKernelMatchesTheNaiveReference) {
     // The naive model (heap objects, its own spring set) shares no code with the library.
     for (const TriMesh& mesh : {makeTorus2(), makeHeart(), flexfit::testing::shuffledVertices(makeTorus2(), 4)}) {
         const Material material = Material::elastic();
-        const auto model = buildPartModel(mesh, {material, 1.5, {}, {}, {}});
+        const auto model = buildPartModel(mesh, {material, 1.5, {}, {}, {}, {}});
         for (BlockKernel kernel : kAllKernels) {
             if (!detail::blockKernelAvailable(kernel)) continue;
             SCOPED_TRACE(mesh.name + " " + detail::toString(kernel));

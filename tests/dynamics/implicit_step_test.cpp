@@ -61,7 +61,7 @@ TEST(ImplicitStep, EnergyNeverIncreasesWhateverTheStiffness) {
         for (const double mass : {1e-3, 1.0})
             for (const bool inRegion : {false, true}) {
                 SCOPED_TRACE("k " + std::to_string(k) + " m " + std::to_string(mass) + (inRegion ? " region" : " full"));
-                const auto model = buildPartModel(mesh, {Material{k, 0.0}, mass, {}, {}, {}});
+                const auto model = buildPartModel(mesh, {Material{k, 0.0}, mass, {}, {}, {}, {}});
                 const ActiveRegion region = firstMasses(*model, 6);
                 const ActiveRegion* r = inRegion ? &region : nullptr;
                 const SimulationSettings s = implicitSettings(1e-3);
@@ -91,7 +91,7 @@ TEST(ImplicitStep, OscillatesAtTheDampedFrequency) {
     triangle.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, std::sqrt(3.0) / 2.0, 0)};
     triangle.faces = {{0, 1, 2}};
     const double k = 100.0, c = 0.4, m = 1.0, h = 1e-3;
-    const auto model = buildPartModel(triangle, {Material{k, c}, m, {}, {}, {}});
+    const auto model = buildPartModel(triangle, {Material{k, c}, m, {}, {}, {}, {}});
     ActiveRegion region(*model);
     region.cover(2);
     SimulationSettings s = implicitSettings(h);
@@ -136,7 +136,7 @@ TEST(ImplicitStep, OscillatesAtTheDampedFrequency) {
 TEST(ImplicitStep, StaticDeflectionMatchesADirectSparseSolve) {
     const TriMesh mesh = makeTorus1();
     const double k = 2.0, ka = 0.1;
-    const auto model = buildPartModel(mesh, {Material{k, 0.05}, 1.0, {}, {}, {}});
+    const auto model = buildPartModel(mesh, {Material{k, 0.05}, 1.0, {}, {}, {}, {}});
     for (const bool inRegion : {false, true}) {
         SCOPED_TRACE(inRegion ? "region" : "full");
         const ActiveRegion region = firstMasses(*model, 300);
@@ -195,7 +195,7 @@ TEST(ImplicitStep, StaticDeflectionMatchesADirectSparseSolve) {
 // Stiff steel-like springs on gram masses at 1 kHz: the explicit steps diverge (the stability
 // check says so), the implicit one stays finite and the load deflects the part.
 TEST(ImplicitStep, RunsStiffMaterialsTheExplicitStepsCannot) {
-    const auto model = buildPartModel(makeTorus1(), {Material{1e6, 10.0}, 1e-3, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{1e6, 10.0}, 1e-3, {}, {}, {}, {}});
     SimulationSettings s = implicitSettings(1e-3);
     s.implicit.tolerance = 1e-6;
     s.implicit.maxIterations = 2000;
@@ -220,7 +220,7 @@ TEST(ImplicitStep, RunsStiffMaterialsTheExplicitStepsCannot) {
 // A fixed budget (tolerance 0) runs exactly that many iterations every step, and reports the
 // residual it reached.
 TEST(ImplicitStep, AFixedBudgetRunsExactlyItsIterations) {
-    const auto model = buildPartModel(makeTorus1(), {Material{1e4, 1.0}, 1e-2, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{1e4, 1.0}, 1e-2, {}, {}, {}, {}});
     SimulationSettings s = implicitSettings(1e-3);
     s.implicit.tolerance = 0.0;
     s.implicit.maxIterations = 7;
@@ -239,7 +239,7 @@ TEST(ImplicitStep, AFixedBudgetRunsExactlyItsIterations) {
 // The implicit step's trajectory, pinned (full model and a region; scalar code: the same bits on
 // every CPU).
 TEST(ImplicitStep, GoldenHash) {
-    const auto model = buildPartModel(makeTorus1(), {Material{1e3, 0.5}, 0.01, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{1e3, 0.5}, 0.01, {}, {}, {}, {}});
     SimulationSettings s = implicitSettings(1e-3);
     s.restoration.method = RestorationMethod::Constraint;
     s.gravity = Vec3(0, -9.81, 0);
@@ -260,7 +260,7 @@ TEST(ImplicitStep, GoldenHash) {
 // full step would cost less (the full step would not hold the region's edge), and a zone that
 // covers every mass by the implicit full step.
 TEST(ImplicitStep, PartsKeepTheRegionStepAtAnyCoverage) {
-    const auto model = buildPartModel(makeTorus1(), {Material{1e3, 0.5}, 0.01, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{1e3, 0.5}, 0.01, {}, {}, {}, {}});
     PartSettings settings;
     settings.mode = PartMode::RigidDeformable;
     settings.simulation = implicitSettings(1e-3);

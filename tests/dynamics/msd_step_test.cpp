@@ -84,7 +84,7 @@ TEST(MsdStep, PeriodAndDecayOfTheDampedOscillator) {
 }
 
 TEST(MsdStep, MomentumConservedAndEnergyBoundedWithoutDamping) {
-    const auto model = buildPartModel(makeTorus1(), {Material{1.0, 0.0}, 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{1.0, 0.0}, 1.0, {}, {}, {}, {}});
     PartState state = PartState::atRest(*model);
     std::mt19937 rng(7);
     std::normal_distribution<double> noise(0.0, 0.05);
@@ -104,7 +104,7 @@ TEST(MsdStep, MomentumConservedAndEnergyBoundedWithoutDamping) {
 
 TEST(MsdStep, ExplicitEulerGainsEnergyWithoutDamping) {
     // The documented reason explicit Euler is only for comparison: it amplifies every mode.
-    const auto model = buildPartModel(makeTorus1(), {Material{1.0, 0.0}, 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{1.0, 0.0}, 1.0, {}, {}, {}, {}});
     PartState state = PartState::atRest(*model);
     state.positions[0].x() += 0.2;
     SimulationSettings settings = plain(1e-2);
@@ -117,7 +117,7 @@ TEST(MsdStep, ExplicitEulerGainsEnergyWithoutDamping) {
 TEST(MsdStep, MatchesNaiveReferenceImplementation) {
     const TriMesh mesh = makeTorus1();
     const Material material = Material::elastic();
-    const auto model = buildPartModel(mesh, {material, 1.5, {}, {}, {}});
+    const auto model = buildPartModel(mesh, {material, 1.5, {}, {}, {}, {}});
     const auto owned = naive::modelFromMesh(mesh, 1.5, material.stiffness, material.damping);
     naive::Model& reference = *owned;
     ASSERT_EQ(std::size_t(reference.numOfSprings), model->springCount());
@@ -144,7 +144,7 @@ TEST(MsdStep, MatchesNaiveReferenceImplementation) {
 
 TEST(MsdStep, AnchorSpringOscillatesAboutRestPosition) {
     // No spring forces (k = b = 0): each mass is a harmonic oscillator on its anchor.
-    const auto model = buildPartModel(makeTorus1(), {Material{0.0, 0.0}, 2.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{0.0, 0.0}, 2.0, {}, {}, {}, {}});
     SimulationSettings settings = plain(1e-4);
     settings.restoration = {RestorationMethod::AnchorSprings, 8.0, 0.0, 0.05};
     PartState state = PartState::atRest(*model);
@@ -160,7 +160,7 @@ TEST(MsdStep, RestorationConstraintFollowsItsScalarRecurrence) {
     // Free masses (k = 0): per axis, x <- (1-c)(x + h v) and v <- v - c (x + h v)/h. Iterated
     // here on scalars as the reference; its envelope decays as sqrt(1 - c) per step.
     const double c = 0.1, h = 1e-3;
-    const auto model = buildPartModel(makeTorus1(), {Material{0.0, 0.0}, 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{0.0, 0.0}, 1.0, {}, {}, {}, {}});
     SimulationSettings settings = plain(h);
     settings.restoration = {RestorationMethod::Constraint, 0.0, 0.0, c};
     PartState state = PartState::atRest(*model);
@@ -178,7 +178,7 @@ TEST(MsdStep, RestorationConstraintFollowsItsScalarRecurrence) {
 
 TEST(MsdStep, PerturbedTorusRestoresWithEitherMethod) {
     for (RestorationMethod method : {RestorationMethod::AnchorSprings, RestorationMethod::Constraint}) {
-        const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}});
+        const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}, {}});
         SimulationSettings settings = plain(1e-3);
         settings.globalDamping = 0.1;
         // c = 1e-4 at 1 kHz acts like an anchor of about c m / h^2 = 100 N/m (see simulation.hpp).
@@ -215,7 +215,7 @@ TEST(MsdStep, PendingForcesAreConsumedAndCountersCount) {
 
 TEST(MsdStep, DeterministicStateHash) {
     auto run = [](double force) {
-        const auto model = buildPartModel(makeTorus1(), {Material::elastic(), 1.0, {}, {}, {}});
+        const auto model = buildPartModel(makeTorus1(), {Material::elastic(), 1.0, {}, {}, {}, {}});
         SimulationSettings settings = plain(1e-3);
         settings.gravity = Vec3(0, -9.81, 0);
         settings.restoration.method = RestorationMethod::Constraint;
@@ -292,7 +292,7 @@ TEST(MsdStep, AHugeForceDivergesAndThrowsNamingThePartTheTimeAndTheCause) {
 }
 
 TEST(MsdStep, ATimeStepAboveTheStabilityBoundDivergesAndSaysSo) {
-    const auto model = buildPartModel(makeTorus1(), {Material{1e4, 0.0}, 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{1e4, 0.0}, 1.0, {}, {}, {}, {}});
     SimulationSettings settings = plain(0.05);
     const StabilityReport report = analyzeStability(*model, settings);
     ASSERT_TRUE(report.certainlyUnstable);
@@ -305,7 +305,7 @@ TEST(MsdStep, ATimeStepAboveTheStabilityBoundDivergesAndSaysSo) {
 }
 
 TEST(MsdStep, AStableLoadedRunNeverThrows) {
-    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}, {}});
     SimulationSettings settings = plain(1e-3);
     settings.restoration.method = RestorationMethod::AnchorSprings;
     PartState state = PartState::atRest(*model);

@@ -110,7 +110,7 @@ TEST(Part, SpringsEvaluatedEqualTheActiveRegion) {
 }
 
 TEST(Part, ZonesRetireAndMassesReturnExactlyToRest) {
-    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}, {}});
     PartSettings settings = zoneSettings();
     settings.simulation.restoration = {RestorationMethod::AnchorSprings, 1.0, 0.5, 0.05};
     Part part(model, settings);
@@ -135,7 +135,7 @@ TEST(Part, ZonesRetireAndMassesReturnExactlyToRest) {
 }
 
 TEST(Part, LoadedZoneStaysOpen) {
-    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}, {}});
     Part part(model, zoneSettings());
     for (int i = 0; i < 2000; ++i) {
         part.applyForce(3, Vec3(1e-9, 0, 0));  // tiny: the zone is at rest but loaded
@@ -189,7 +189,7 @@ TEST(Part, RigidMotionDoesNotDisturbAZone) {
 }
 
 TEST(Part, WholeMeshZoneMatchesFullDeformableModel) {
-    const auto model = buildPartModel(makeTorus1(), {Material::elastic(), 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material::elastic(), 1.0, {}, {}, {}, {}});
     PartSettings zones = zoneSettings();
     zones.zones.fullSweepWhenComplete = false;  // exercise the compact-array path
     zones.simulation.gravity = Vec3(0, -0.5, 0);
@@ -247,7 +247,7 @@ TEST(Part, PartialRegionMatchesFullModelWithPinnedMasses) {
     part.openZone(ZoneSeed::mass(100), 4);
     std::vector<double> masses(model->massCount(), 1e300);
     for (Index m : part.movingMasses()) masses[m] = 1.0;
-    const auto pinned = buildPartModel(mesh, {Material::elastic(), 1.0, masses, {}, {}});
+    const auto pinned = buildPartModel(mesh, {Material::elastic(), 1.0, masses, {}, {}, {}});
     PartState reference = PartState::atRest(*pinned);
     SimulationSettings settings = zoneSettings().simulation;
     for (int i = 0; i < 1000; ++i) {
@@ -365,7 +365,7 @@ TEST(Part, ChangedMassesReadLateStillListWhatMoved) {
 TEST(Part, GoldenHashUnderLoad) {
     // Zones opened by a face and by forces, grown, a rigid turn each step, the load released and
     // every zone retired by the end: the whole zone lifecycle in one hash.
-    const auto model = buildPartModel(makeTorus2(), {Material::rigid(), 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus2(), {Material::rigid(), 1.0, {}, {}, {}, {}});
     PartSettings settings = zoneSettings();
     settings.simulation.restoration = {RestorationMethod::AnchorSprings, 2.0, 0.5, 0.05};
     Part part(model, settings);

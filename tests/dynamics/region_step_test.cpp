@@ -64,7 +64,7 @@ void naiveStep(naive::Model& model, const ActiveRegion& region, double dt, doubl
 // exactly at rest, and returns the largest distance from the reference.
 template <class Step>
 double worstAgainstNaive(const TriMesh& mesh, Step step) {
-    const auto model = buildPartModel(mesh, {Material{0.8, 0.05}, 1.0, {}, {}, {}});
+    const auto model = buildPartModel(mesh, {Material{0.8, 0.05}, 1.0, {}, {}, {}, {}});
     const ActiveRegion region = regionOf(*model, scatteredMasses(*model));
     const auto reference = naive::modelFromMesh(mesh, 1.0, 0.8, 0.05);
     for (Index m = 0; m < model->massCount(); ++m)

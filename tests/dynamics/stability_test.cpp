@@ -72,7 +72,7 @@ TEST(Stability, ExplicitEulerNeedsDampingAndStaysBelowBOverK) {
 
 TEST(Stability, ThesisPresetsAreStableAtOneMillisecond) {
     for (const Material m : {Material::rigid(), Material::elastic(), Material::superelastic()}) {
-        const auto model = buildPartModel(makeTorus1(), {m, 1.0, {}, {}, {}});
+        const auto model = buildPartModel(makeTorus1(), {m, 1.0, {}, {}, {}, {}});
         for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::ExplicitEuler}) {
             const StabilityReport report = analyzeStability(*model, with(integrator, 1e-3));
             EXPECT_FALSE(report.possiblyUnstable) << report.message;
@@ -82,7 +82,7 @@ TEST(Stability, ThesisPresetsAreStableAtOneMillisecond) {
 }
 
 TEST(Stability, StiffMaterialIsRejectedAndItsBoundHolds) {
-    const auto model = buildPartModel(makeTorus1(), {Material{1e6, 0.0}, 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{1e6, 0.0}, 1.0, {}, {}, {}, {}});
     SimulationSettings settings = with(Integrator::SemiImplicitEuler, 1e-2);
     const StabilityReport report = analyzeStability(*model, settings);
     EXPECT_TRUE(report.certainlyUnstable);

@@ -468,3 +468,31 @@ TEST(SceneFile, ConstraintRateReplacesTheFraction) {
     const std::string negative = errorOf(withLine("name = \"ball\"", "constraint_rate = -1"));
     EXPECT_NE(negative.find(":18: part 2, key 'constraint_rate': must be > 0"), std::string::npos) << negative;
 }
+
+TEST(SceneFile, PhysicalMaterialGivesTheMassesAndTheSprings) {
+    const Scene s = parseScene(withLine("name = \"ball\"", "material = { youngs_modulus = 2e9, thickness = 0.001, density = 1200, "
+                                                          "poisson_ratio = 0.4, damping_ratio = 0.2, bending_springs = true }"),
+                               "scene.toml", ".");
+    const PartModel& model = *s.parts[1].model;
+    double area = 0.0, mass = 0.0;
+    for (const Face& f : model.mesh.faces)
+        area += 0.5 * (model.mesh.vertices[f[1]] - model.mesh.vertices[f[0]]).cross(model.mesh.vertices[f[2]] - model.mesh.vertices[f[0]]).norm();
+    for (double m : model.mass) mass += m;
+    EXPECT_NEAR(mass, 1200 * 0.001 * area, 1e-9 * mass);  // density x thickness x area
+    EXPECT_GT(model.bendingSpringCount, 0u);
+    EXPECT_EQ(model.springCount(), model.topology.edgeCount() + model.bendingSpringCount);
+}
+
+TEST(SceneFile, PhysicalMaterialErrorsNameTheKey) {
+    auto error = [](const std::string& material) { return errorOf(withLine("name = \"ball\"", "material = " + material)); };
+    const std::string missing = error("{ youngs_modulus = 2e9, thickness = 0.001 }");
+    EXPECT_NE(missing.find(":18: part 2.material: needs 'density' beside 'youngs_modulus'"), std::string::npos) << missing;
+    const std::string both = error("{ youngs_modulus = 2e9, thickness = 0.001, density = 1200, stiffness = 3 }");
+    EXPECT_NE(both.find(":18: part 2.material, key 'stiffness': give either spring constants"), std::string::npos) << both;
+    const std::string poisson = error("{ youngs_modulus = 2e9, thickness = 0.001, density = 1200, poisson_ratio = 0.5 }");
+    EXPECT_NE(poisson.find(":18: part 2.material, key 'poisson_ratio': must be in [0, 0.5)"), std::string::npos) << poisson;
+    const std::string stray = error("{ stiffness = 3, thickness = 0.001 }");
+    EXPECT_NE(stray.find(":18: part 2.material, key 'thickness': belongs to a physical material"), std::string::npos) << stray;
+    const std::string mass = errorOf(withLine("name = \"ball\"", "vertex_mass = 2\nmaterial = { youngs_modulus = 2e9, thickness = 0.001, density = 1200 }"));
+    EXPECT_NE(mass.find(":18: part 2, key 'vertex_mass': a physical material gives the masses"), std::string::npos) << mass;
+}

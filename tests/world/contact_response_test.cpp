@@ -63,7 +63,7 @@ struct Bench {
 }  // namespace
 
 TEST(ContactResponse, RigidTorusPressedIntoDeformableTorusAndWithdrawn) {
-    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}, {}});
     Bench s;
     const BodyId rigid = s.add(model, rigidPart()), soft = s.add(model, deformableSettings());
     // The rigid torus stands upright (axis z, its ring in the xy plane) beside the soft one and
@@ -100,8 +100,8 @@ TEST(ContactResponse, RigidTorusPressedIntoDeformableTorusAndWithdrawn) {
 }
 
 TEST(ContactResponse, BothDeformablePartsShareThePenetrationByStiffness) {
-    const auto softModel = buildPartModel(makeIcoSphere(2.0, 2), {Material{0.1, 0.01}, 1.0, {}, {}, {}});
-    const auto hardModel = buildPartModel(makeIcoSphere(2.0, 2), {Material{3.0, 0.3}, 1.0, {}, {}, {}});
+    const auto softModel = buildPartModel(makeIcoSphere(2.0, 2), {Material{0.1, 0.01}, 1.0, {}, {}, {}, {}});
+    const auto hardModel = buildPartModel(makeIcoSphere(2.0, 2), {Material{3.0, 0.3}, 1.0, {}, {}, {}, {}});
     PartSettings settings = deformableSettings();
     settings.simulation.restoration = {RestorationMethod::AnchorSprings, 1.0, 0.1, 0.0};
     Bench s;
@@ -121,7 +121,7 @@ TEST(ContactResponse, BothDeformablePartsShareThePenetrationByStiffness) {
 }
 
 TEST(ContactResponse, EffectiveStiffnessIsTheMeanSpringPlusTheRestorations) {
-    const auto model = buildPartModel(makeTorus1(), {Material{2.0, 0.1}, 0.5, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{2.0, 0.1}, 0.5, {}, {}, {}, {}});
     PartSettings settings;
     settings.simulation.restoration = {RestorationMethod::Constraint, 0.0, 0.0, 0.01};
     const Part constraint(model, settings);
@@ -137,7 +137,7 @@ TEST(ContactResponse, ADynamicBodyFeelsTheSpringsItDisplaced) {
     // A dynamic ball pressing a deformable torus: after the response it carries the force
     // -k_eff sum (x - rest) of the masses it pushed, for the next step (computed here by hand
     // from the part's state).
-    const auto torusModel = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}});
+    const auto torusModel = buildPartModel(makeTorus1(), {Material::rigid(), 1.0, {}, {}, {}, {}});
     PartSettings anchors = deformableSettings();
     anchors.simulation.restoration = {RestorationMethod::AnchorSprings, 4.0, 0.5, 0.0};
     Bench s;
@@ -168,7 +168,7 @@ TEST(ContactResponse, FrictionIsCoulombsKineticForceAgainstTheSliding) {
     // damping off: each pushed mass presses the ball with k_eff |x - rest| along -(x - rest)
     // and rubs it with 0.4 times that against the ball's sliding over the surface there.
     // Summed by hand from the part's state; the friction opposes the sliding overall.
-    const auto slabModel = buildPartModel(makeBox(Vec3(4, 1, 4), 8), {Material::rigid(), 1.0, {}, {}, {}});
+    const auto slabModel = buildPartModel(makeBox(Vec3(4, 1, 4), 8), {Material::rigid(), 1.0, {}, {}, {}, {}});
     PartSettings anchors = deformableSettings();
     anchors.simulation.restoration = {RestorationMethod::AnchorSprings, 4.0, 0.5, 0.0};
     Bench s;
@@ -217,7 +217,7 @@ struct BallOnRim {
         BodySettings ballBody = flexfit::testing::dynamicBody(velocity);
         ballBody.density = 0.01;
         ballBody.staticFriction = ballBody.kineticFriction = friction;
-        mouth = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}}), rim, mouthBody, Pose{});
+        mouth = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}, {}}), rim, mouthBody, Pose{});
         ball = world.add(buildPartModel(makeIcoSphere(diameter / 2, 2)), rigidPart(), ballBody,
                          flexfit::testing::at(Vec3(0, diameter / 2 + 2.6, 0)));
     }

@@ -110,7 +110,7 @@ TEST(DivergenceCheck, AFullDeformablePartThatDivergesIsNamedByItsBody) {
 
 TEST(DivergenceCheck, TheCauseWeighsTheWorldsTimeStepNotThePartsOwn) {
     // The part's own settings (1 ms) are stable; the world steps it at 50 ms, far above its bound.
-    const auto model = buildPartModel(makeTorus1(), {Material{1e4, 0.0}, 1.0, {}, {}, {}});
+    const auto model = buildPartModel(makeTorus1(), {Material{1e4, 0.0}, 1.0, {}, {}, {}, {}});
     PartSettings zones;
     zones.simulation.restoration.method = RestorationMethod::None;
     zones.zones.defaultLevel = 4;

@@ -19,7 +19,7 @@ TEST(World, ProfilePartitionsEveryStepAmongTheStages) {
     World world;
     PartSettings rim;
     rim.zones.contactLevel = 3;
-    const BodyId torus = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}}), rim, BodySettings{}, Pose{});
+    const BodyId torus = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}, {}}), rim, BodySettings{}, Pose{});
     BodySettings heavy = dynamicBody(Vec3(0, -3, 0));
     heavy.density = 0.01;
     const BodyId ball = world.add(buildPartModel(makeIcoSphere(8.5, 2)), rigidPart(), heavy, at(Vec3(0, 9.5, 0)));
@@ -71,7 +71,7 @@ TEST(World, NoWorkHappensOutsideTheProfiledInterval) {
     World world;
     PartSettings rim;
     rim.zones.contactLevel = 3;
-    world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}}), rim, BodySettings{}, Pose{});
+    world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}, {}}), rim, BodySettings{}, Pose{});
     BodySettings heavy = dynamicBody(Vec3(0, -3, 0));
     heavy.density = 0.01;
     world.add(buildPartModel(makeIcoSphere(8.5, 2)), rigidPart(), heavy, at(Vec3(0, 4.8, 0)));  // 0.2 above the rim
@@ -111,7 +111,7 @@ TEST(World, DeformableRimStopsAWeakPushAndYieldsToAStrongOne) {
         BodySettings ball;
         ball.motion = MotionType::Dynamic;
         ball.density = 0.01;  // about 25 kg
-        const BodyId torus = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}}), rim, BodySettings{}, Pose{});
+        const BodyId torus = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}, {}}), rim, BodySettings{}, Pose{});
         PartSettings rigid;
         rigid.mode = PartMode::Rigid;
         const BodyId b = world.add(buildPartModel(makeIcoSphere(8.5, 2)), rigid, ball, at(Vec3(0, 11, 0)));
