@@ -18,6 +18,7 @@ struct SimulateOptions {
     MeshOptions mesh;
     SimulationOptions sim;
     std::vector<std::string> forces;
+    std::vector<std::string> kicks;
     double forceDuration = 0.5, duration = 10.0;
     std::vector<double> thresholds{0.01, 0.1};
     std::string csv;
@@ -72,7 +73,12 @@ void run(const SimulateOptions& opt) {
     config.part.zones.activityThreshold = opt.thresholds.empty() ? 0.01 : opt.thresholds.front();
     for (const std::string& z : opt.zones) config.zones.push_back(parseZone(z, "--zone"));
     for (const std::string& f : opt.forces) config.loads.push_back(parseLoad(f, "--force"));
-    config.loadDuration = opt.forceDuration;
+    for (const std::string& k : opt.kicks) {
+        const PointLoad kick = parseLoad(k, "--kick");
+        config.kicks.push_back({kick.mass, kick.force});
+    }
+    // Kicked and never pushed: the part is released (its restoration clock starts) at once.
+    config.loadDuration = opt.forces.empty() && !opt.kicks.empty() ? 0.0 : opt.forceDuration;
     config.duration = opt.duration;
     config.stopWhenRestored = opt.untilRestored;
     config.thresholds = opt.thresholds;
@@ -143,6 +149,8 @@ void registerSimulate(CLI::App& app) {
                 "their springs are inactive at the first --threshold and their masses at rest.");
     opt->sim.addTo(*cmd);
     cmd->add_option("--force", opt->forces, "Point load MASS:FX,FY,FZ (repeatable)");
+    cmd->add_option("--kick", opt->kicks,
+                    "Velocity change MASS:VX,VY,VZ (m/s) of one mass at the start, the thesis's perturbation (repeatable)");
     cmd->add_option("--force-duration", opt->forceDuration, "Seconds the loads act before release")->capture_default_str();
     cmd->add_option("--duration", opt->duration, "Simulated seconds")->check(CLI::PositiveNumber)->capture_default_str();
     cmd->add_option("--threshold", opt->thresholds, "Activity thresholds (length units)")->capture_default_str();

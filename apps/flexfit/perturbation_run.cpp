@@ -8,12 +8,16 @@ namespace flexfit::cli {
 PerturbationResult runPerturbation(const PerturbationConfig& config, const StepObserver& observer,
                                    const std::function<void(double)>& progress) {
     const PartModel& model = *config.model;
-    for (const PointLoad& load : config.loads)
-        if (load.mass >= model.massCount())
-            throw InputError("load", 0, "mass " + std::to_string(load.mass) + " does not exist (the model has " +
-                                            std::to_string(model.massCount()) + " masses)");
+    auto checkMass = [&](Index mass, const char* what) {
+        if (mass >= model.massCount())
+            throw InputError(what, 0, "mass " + std::to_string(mass) + " does not exist (the model has " +
+                                          std::to_string(model.massCount()) + " masses)");
+    };
+    for (const PointLoad& load : config.loads) checkMass(load.mass, "load");
+    for (const MassKick& kick : config.kicks) checkMass(kick.mass, "kick");
     Part part(config.model, config.part);
     for (const ZoneRequest& zone : config.zones) part.openZone(zone.seed, zone.level);
+    for (const MassKick& kick : config.kicks) part.kickMass(kick.mass, kick.velocity);
     PerturbationResult result;
     for (double t : config.thresholds) result.trackers.emplace_back(model, t);
 
@@ -21,8 +25,11 @@ PerturbationResult runPerturbation(const PerturbationConfig& config, const StepO
     const auto totalSteps = std::size_t(std::llround(config.duration / h));
     const auto loadSteps = std::size_t(std::llround(config.loadDuration / h));
     const auto start = std::chrono::steady_clock::now();
+    const bool kickedOnly = config.loads.empty() && !config.kicks.empty();
     for (std::size_t step = 0; step < totalSteps; ++step) {
-        if (step == loadSteps)
+        if (step == 0 && kickedOnly)
+            for (ActivityTracker& tracker : result.trackers) tracker.markKick(part.time());
+        else if (step == loadSteps)
             for (ActivityTracker& tracker : result.trackers) tracker.markRelease(part.time());
         if (step < loadSteps)
             for (const PointLoad& load : config.loads) part.applyForce(load.mass, load.force);

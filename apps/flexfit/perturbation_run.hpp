@@ -1,5 +1,5 @@
-// A perturbation run: a part (rigid, rigid-deformable or full-deformable) under loads held for
-// a while, then released, with activity tracked at several thresholds until the part has
+// A perturbation run: a part (rigid, rigid-deformable or full-deformable) kicked at the start
+// and/or under loads held for a while, then released, with activity tracked at several thresholds until the part has
 // restored its shape (or a time limit). Shared by `simulate` and `experiment restoration`.
 #pragma once
 
@@ -16,11 +16,18 @@ struct ZoneRequest {
     int level = 1;
 };
 
+// The thesis's perturbation (chapter 5): one mass's velocity changed at once, at the start.
+struct MassKick {
+    Index mass = 0;
+    Vec3 velocity = Vec3::Zero();  // world-frame change
+};
+
 struct PerturbationConfig {
     std::shared_ptr<const PartModel> model;
     PartSettings part;               // mode, simulation and zone settings
     std::vector<ZoneRequest> zones;  // opened at the start (rigid-deformable mode)
     std::vector<PointLoad> loads;    // world-frame forces
+    std::vector<MassKick> kicks;     // before the first step
     double loadDuration = 0.0;       // loads act during [0, loadDuration)
     double duration = 10.0;          // simulated seconds at most
     bool stopWhenRestored = false;   // end once every threshold has restored after the release

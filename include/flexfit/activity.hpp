@@ -26,6 +26,11 @@ public:
     std::size_t observe(const PartModel& model, const PartState& state, std::span<const Index> springs);
     // The load is released at `time`: the restoration clock starts.
     void markRelease(double time);
+    // A kick at `time` (Part::kickMass): the clock starts, and the part is restored at the first
+    // observation with zero active springs after one with some (a kick deforms only in the
+    // steps after it). A kick too weak to activate a spring leaves the part never restored:
+    // check maxActive().
+    void markKick(double time);
 
     double threshold() const { return threshold_; }
     std::size_t activeNow() const { return activeNow_; }
@@ -46,6 +51,8 @@ private:
     std::size_t totalDistinct_ = 0;
     std::optional<double> releaseTime_;
     std::optional<double> restorationTime_;
+    bool awaitActivity_ = false;       // after a kick: restored only once something was active
+    bool activeSinceRelease_ = false;
 };
 
 }  // namespace flexfit

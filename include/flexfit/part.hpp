@@ -131,6 +131,11 @@ public:
     // A world-frame force on one mass. Opens a zone (defaultLevel) when no zone covers it and
     // keeps the covering zones alive. Ignored in Rigid mode. Throws InputError for a bad mass.
     void applyForce(Index mass, const Vec3& worldForce);
+    // A velocity kick: adds a world-frame velocity change to one mass at once (the thesis's
+    // perturbation, chapter 5: one mass's velocity increased along x). Opens a zone
+    // (defaultLevel) when none covers it. Ignored in Rigid mode. Throws InputError for a bad
+    // mass or a non-finite change.
+    void kickMass(Index mass, const Vec3& worldVelocityChange);
 
     // --- Contacts (collision response) ---
     // Opens a zone at `face` (contactLevel) unless zones already move its masses, and keeps the
@@ -186,6 +191,8 @@ private:
     void collectMembers(Zone& zone);
     bool zoneAtRest(const Zone& zone) const;
     void markChanged(Index mass);
+    // Checks a load on one mass (range, finite) and opens or keeps its zone; false in Rigid mode.
+    bool loadMass(Index mass, const Vec3& worldLoad, const char* what);
     void markAllChanged();
 
     std::shared_ptr<const PartModel> model_;

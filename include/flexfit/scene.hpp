@@ -15,7 +15,9 @@
 //   [[part]]     name, mesh (path relative to the scene) or generator ("torus1", "torus2",
 //                "heart", "container-mouth", or a table {type = "torus" | "sphere" | "box" |
 //                "plate", ...}),
-//                mode, motion, material (preset or {stiffness, damping}), vertex_mass, position,
+//                mode, motion, material (preset, {stiffness, damping} or a physical material
+//                {youngs_modulus, thickness, density, poisson_ratio, damping_ratio,
+//                bending_springs}), vertex_mass (not with a physical material), position,
 //                rotation (degrees about x, then y, then z, world axes), density, velocity,
 //                angular_velocity (rad/s), thickness, bounding_volume, static_friction,
 //                kinetic_friction (default: static_friction), restitution, restoration,
@@ -25,11 +27,11 @@
 //                final_rotation, snap_duration, distance_tolerance, angle_tolerance (degrees),
 //                primary_vector / secondary_vector = {origin, end}, vector_tolerance,
 //                area = {shape, position, rotation, half_extents, radius, half_height}
-//   [[action]]   time, type = "grab" | "move" | "release" | "push" | "force" | "velocity",
+//   [[action]]   time, type = "grab" | "move" | "release" | "push" | "force" | "velocity" | "kick",
 //                part, and per type: grab {frequency, stiffness, damping, angular_stiffness,
 //                angular_damping}; move {position, rotation, duration}; push {force,
 //                duration}; force {force, masses or faces, duration}; velocity {linear,
-//                angular}
+//                angular}; kick {masses, velocity (each mass's velocity change, at once)}
 //   [output]     obj_every (s; 0 = no OBJ frames)
 //
 // Loading builds every mesh and model up front: a scene either loads whole or throws
@@ -60,7 +62,7 @@ struct ScenePart {
 };
 
 struct SceneAction {
-    enum class Kind { Grab, Move, Release, Push, Force, Velocity } kind = Kind::Push;
+    enum class Kind { Grab, Move, Release, Push, Force, Velocity, Kick } kind = Kind::Push;
     std::size_t line = 0;     // in the scene file
     double time = 0.0;        // s
     double duration = 0.0;    // s (move, push, force; 0: one step)
@@ -69,13 +71,14 @@ struct SceneAction {
     Pose target;              // move: the grab target reached at time + duration
     Vec3 force = Vec3::Zero();
     std::vector<Index> masses, faces;
-    Vec3 linear = Vec3::Zero(), angular = Vec3::Zero();
+    Vec3 linear = Vec3::Zero(), angular = Vec3::Zero();  // velocity; kick: linear is the masses' change
 };
 // Its names (names.hpp).
 inline constexpr EnumName<SceneAction::Kind> kActionKindNames[] = {
     {SceneAction::Kind::Grab, "grab", "grab"}, {SceneAction::Kind::Move, "move", "move"},
     {SceneAction::Kind::Release, "release", "release"}, {SceneAction::Kind::Push, "push", "push"},
     {SceneAction::Kind::Force, "force", "force"}, {SceneAction::Kind::Velocity, "velocity", "velocity"},
+    {SceneAction::Kind::Kick, "kick", "kick"},
 };
 template <> inline constexpr std::span<const EnumName<SceneAction::Kind>> kEnumNames<SceneAction::Kind> = kActionKindNames;
 

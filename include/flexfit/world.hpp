@@ -134,6 +134,11 @@ public:
     // Throws InputError for an index out of range.
     void applyMassForce(BodyId id, Index mass, const Vec3& worldForce);
     void applyFaceForce(BodyId id, Index face, const Vec3& worldForce);
+    // A velocity kick on one mass (Part::kickMass) of a deforming part; on a part that does not
+    // deform, the same momentum (the mass's share, m_i dv) as an impulse at that mass on the
+    // rigid body (static and kinematic bodies ignore it). Throws InputError for an index out of
+    // range or a non-finite change.
+    void kickMass(BodyId id, Index mass, const Vec3& worldVelocityChange);
 
     // Assembly rules (assembly.hpp), checked in the assembly stage of every step. When a rule
     // triggers, its primary stops being driven (it becomes kinematic), is brought to its final

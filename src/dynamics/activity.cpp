@@ -43,14 +43,24 @@ void ActivityTracker::countIfActive(const PartModel& model, const PartState& sta
 
 std::size_t ActivityTracker::finishObservation(const PartState& state) {
     maxActive_ = std::max(maxActive_, activeNow_);
-    if (releaseTime_ && !restorationTime_ && activeNow_ == 0) restorationTime_ = state.time - *releaseTime_;
+    if (activeNow_ > 0) activeSinceRelease_ = true;
+    if (releaseTime_ && !restorationTime_ && activeNow_ == 0 && (activeSinceRelease_ || !awaitActivity_))
+        restorationTime_ = state.time - *releaseTime_;
     return activeNow_;
 }
 
 void ActivityTracker::markRelease(double time) {
     releaseTime_ = time;
     restorationTime_.reset();
+    awaitActivity_ = false;
     if (activeNow_ == 0) restorationTime_ = 0.0;  // nothing was deformed at the release
+}
+
+void ActivityTracker::markKick(double time) {
+    releaseTime_ = time;
+    restorationTime_.reset();
+    awaitActivity_ = true;
+    activeSinceRelease_ = activeNow_ > 0;
 }
 
 }  // namespace flexfit

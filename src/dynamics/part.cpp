@@ -219,17 +219,27 @@ std::vector<ZoneId> Part::zoneIds() const {
 
 // --- Loads ---
 
-void Part::applyForce(Index mass, const Vec3& worldForce) {
+bool Part::loadMass(Index mass, const Vec3& worldLoad, const char* what) {
     if (mass >= model_->massCount())
         throw InputError(kPartSource, 0, "mass " + std::to_string(mass) + " does not exist (the model has " +
                                              std::to_string(model_->massCount()) + " masses)");
-    if (!worldForce.allFinite()) throw InputError(kPartSource, 0, "force must be finite");
-    if (settings_.mode == PartMode::Rigid) return;
+    if (!worldLoad.allFinite()) throw InputError(kPartSource, 0, std::string(what) + " must be finite");
+    if (settings_.mode == PartMode::Rigid) return false;
     if (settings_.mode == PartMode::RigidDeformable) {
         if (!region_.moves(mass)) openZone(ZoneSeed::mass(mass), std::max(settings_.zones.defaultLevel, 1));
         lastLoadStep_[mass] = state_.stepCount;  // keeps the zones covering it alive
     }
-    state_.forces[mass] += pose_.rotateInverse(worldForce);
+    return true;
+}
+
+void Part::applyForce(Index mass, const Vec3& worldForce) {
+    if (loadMass(mass, worldForce, "force")) state_.forces[mass] += pose_.rotateInverse(worldForce);
+}
+
+void Part::kickMass(Index mass, const Vec3& worldVelocityChange) {
+    if (!loadMass(mass, worldVelocityChange, "velocity kick")) return;
+    state_.velocities[mass] += pose_.rotateInverse(worldVelocityChange);
+    markChanged(mass);
 }
 
 // --- Step ---

@@ -471,6 +471,13 @@ SceneAction readAction(Table& t, const Scene& scene) {
             a.linear = t.vec3("linear", Vec3::Zero());
             a.angular = t.vec3("angular", Vec3::Zero());
             break;
+        case Kind::Kick:
+            if (!t.has("velocity")) t.fail("missing key 'velocity' (the masses' velocity change)");
+            a.linear = t.vec3("velocity", Vec3::Zero());
+            a.masses = t.indices("masses");
+            if (a.masses.empty()) t.fail("a kick needs 'masses'");
+            checkIndices(t, "masses", a.masses, part.model->massCount());
+            break;
     }
     t.finish();
     return a;

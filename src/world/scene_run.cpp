@@ -36,6 +36,9 @@ void SceneRun::start(const SceneAction& a) {
         case Kind::Grab: world_->grab(a.body, a.grab); return;
         case Kind::Release: world_->release(); return;
         case Kind::Velocity: world_->setVelocity(a.body, a.linear, a.angular); return;
+        case Kind::Kick:
+            for (Index m : a.masses) world_->kickMass(a.body, m, a.linear);
+            return;
         case Kind::Move:
             // A snap may have taken the part from the operator: the move is then void.
             if (world_->grabbed() == a.body) running_.emplace_back(a, world_->grabTarget());

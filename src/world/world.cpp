@@ -144,6 +144,24 @@ void World::applyMassForce(BodyId id, Index mass, const Vec3& worldForce) {
         applyForceAt(id, worldForce, part.worldPosition(mass));
 }
 
+void World::kickMass(BodyId id, Index mass, const Vec3& worldVelocityChange) {
+    checkBody(id, "kick");
+    Part& part = *data_->bodies.parts[id];
+    if (mass >= part.model().massCount())
+        throw InputError(kSource, 0, "kick: mass " + std::to_string(mass) + " out of range for body " + std::to_string(id));
+    if (!worldVelocityChange.allFinite()) throw InputError(kSource, 0, "kick on body " + std::to_string(id) + " must be finite");
+    if (part.deforms()) {
+        part.kickMass(mass, worldVelocityChange);
+        return;
+    }
+    RigidBody& body = data_->bodies.rigid[id];
+    if (body.motion != MotionType::Dynamic) return;
+    const Vec3 impulse = part.model().mass[mass] * worldVelocityChange;
+    const Eigen::Matrix3d r = part.pose().rotation.toRotationMatrix();
+    body.linearVelocity += body.inverseMass * impulse;
+    body.angularVelocity += r * body.inverseInertia * r.transpose() * (part.worldPosition(mass) - centreOfMass(id)).cross(impulse);
+}
+
 void World::applyFaceForce(BodyId id, Index face, const Vec3& worldForce) {
     checkBody(id, "force");
     const auto& faces = data_->bodies.parts[id]->model().mesh.faces;

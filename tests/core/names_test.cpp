@@ -45,7 +45,7 @@ TEST(Names, EveryEnumHasOneNamePerValue) {
     expectOneNamePerValue<RigidDeformableQuery>(3);
     expectOneNamePerValue<SnapTechnique>(4);
     expectOneNamePerValue<AssemblyArea::Shape>(3);
-    expectOneNamePerValue<SceneAction::Kind>(6);
+    expectOneNamePerValue<SceneAction::Kind>(7);
     expectOneNamePerValue<Stage>(int(kStageCount));
 }
 

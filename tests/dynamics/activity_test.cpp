@@ -59,6 +59,29 @@ TEST(Activity, ReleaseOfAnUndeformedPartIsRestoredAtOnce) {
     EXPECT_EQ(*tracker.restorationTime(), 0.0);
 }
 
+// A kick deforms nothing at once: the part is restored at the first quiet observation after an
+// active one, never before.
+TEST(Activity, AKickedPartIsRestoredOnlyAfterItWasActive) {
+    const auto model = triangle();
+    ActivityTracker tracker(*model, 0.01);
+    PartState state = PartState::atRest(*model);
+    tracker.observe(*model, state);
+    tracker.markKick(0.0);
+    EXPECT_FALSE(tracker.restorationTime());
+    state.time = 0.1;
+    tracker.observe(*model, state);  // still undeformed: not yet restored
+    EXPECT_FALSE(tracker.restorationTime());
+    state.time = 0.2;
+    state.positions[1].x() = 1.05;
+    tracker.observe(*model, state);
+    EXPECT_FALSE(tracker.restorationTime());
+    state.time = 0.5;
+    state.positions[1].x() = 1.0;
+    tracker.observe(*model, state);
+    ASSERT_TRUE(tracker.restorationTime());
+    EXPECT_NEAR(*tracker.restorationTime(), 0.5, 1e-12);
+}
+
 TEST(Activity, RejectsBadThreshold) {
     const auto model = triangle();
     EXPECT_THROW(ActivityTracker(*model, 0.0), InputError);

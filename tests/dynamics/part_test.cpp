@@ -272,6 +272,44 @@ TEST(Part, RigidModeNeverDeforms) {
     EXPECT_EQ(part.state().positions, model->restPositions);
 }
 
+// A kick is an impulse on one mass: with only internal forces (springs, no restoration, no
+// gravity) the full-deformable part's momentum is m_i dv from then on, step after step. In a
+// rigid-deformable part it opens a zone around the mass (whose edge is held, so momentum is
+// not kept there).
+TEST(Part, AKickGivesTheMassesMomentumThatTheSpringsConserve) {
+    const auto model = buildPartModel(makeTorus1(), {Material::elastic(), 2.0, {}, {}, {}, {}});
+    const Vec3 kick(0.3, -0.2, 0.1);
+    PartSettings settings;
+    settings.mode = PartMode::FullDeformable;
+    settings.simulation.restoration.method = RestorationMethod::None;
+    Part part(model, settings);
+    part.rotate(Vec3(0, 0, 1), 0.7);  // the kick is world-frame
+    part.kickMass(7, kick);
+    for (int step = 0; step < 200; ++step) {
+        part.step();
+        Vec3 momentum = Vec3::Zero();
+        for (Index i = 0; i < model->massCount(); ++i) momentum += model->mass[i] * part.state().velocities[i];
+        ASSERT_LT((part.pose().rotate(momentum) - 2.0 * kick).norm(), 1e-12) << "step " << step;
+    }
+
+    settings.mode = PartMode::RigidDeformable;
+    settings.zones.defaultLevel = 3;
+    Part zoned(model, settings);
+    zoned.kickMass(7, kick);
+    EXPECT_EQ(zoned.zoneCount(), 1u);
+    EXPECT_TRUE(zoned.region().moves(7));
+    EXPECT_EQ(zoned.state().velocities[7], kick);
+
+    PartSettings rigid;
+    rigid.mode = PartMode::Rigid;
+    Part still(model, rigid);
+    still.kickMass(7, Vec3(1, 0, 0));
+    still.step();
+    EXPECT_EQ(still.state().positions, model->restPositions);
+    EXPECT_THROW(still.kickMass(576, Vec3(1, 0, 0)), InputError);
+    EXPECT_THROW(still.kickMass(0, Vec3(NAN, 0, 0)), InputError);
+}
+
 TEST(Part, BadInputIsRejected) {
     const auto model = buildPartModel(makeTorus1());
     Part part(model);

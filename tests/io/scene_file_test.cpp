@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <filesystem>
 #include <numeric>
@@ -495,4 +497,18 @@ TEST(SceneFile, PhysicalMaterialErrorsNameTheKey) {
     EXPECT_NE(stray.find(":18: part 2.material, key 'thickness': belongs to a physical material"), std::string::npos) << stray;
     const std::string mass = errorOf(withLine("name = \"ball\"", "vertex_mass = 2\nmaterial = { youngs_modulus = 2e9, thickness = 0.001, density = 1200 }"));
     EXPECT_NE(mass.find(":18: part 2, key 'vertex_mass': a physical material gives the masses"), std::string::npos) << mass;
+}
+
+TEST(SceneFile, KickActionNeedsMassesAndAVelocity) {
+    const Scene s = parseScene(std::string(kBall) + "\n[[action]]\ntime = 0.2\ntype = \"kick\"\npart = \"mouth\"\nmasses = [1, 5]\nvelocity = [0.5, 0, 0]\n",
+                               "scene.toml", ".");
+    const auto found = std::find_if(s.actions.begin(), s.actions.end(), [](const SceneAction& a) { return a.kind == SceneAction::Kind::Kick; });
+    ASSERT_NE(found, s.actions.end());
+    const SceneAction& kick = *found;
+    EXPECT_EQ(kick.masses, (std::vector<Index>{1, 5}));
+    EXPECT_EQ(kick.linear, Vec3(0.5, 0, 0));
+    const std::string noVelocity = errorOf(std::string(kBall) + "\n[[action]]\ntime = 0.2\ntype = \"kick\"\npart = \"mouth\"\nmasses = [1]\n");
+    EXPECT_NE(noVelocity.find("missing key 'velocity'"), std::string::npos) << noVelocity;
+    const std::string range = errorOf(std::string(kBall) + "\n[[action]]\ntime = 0.2\ntype = \"kick\"\npart = \"mouth\"\nmasses = [99999]\nvelocity = [1, 0, 0]\n");
+    EXPECT_NE(range.find("key 'masses': index 99999 out of range"), std::string::npos) << range;
 }

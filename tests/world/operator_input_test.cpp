@@ -147,4 +147,16 @@ TEST(Operator, FaceForceDeformsADeformablePartAndPushesARigidOne) {
     world.step();
     EXPECT_NEAR(world.body(ball).linearVelocity.x(), 1e-3 * world.body(ball).inverseMass, 1e-12);
     EXPECT_LT(world.body(ball).angularVelocity.z(), 0.0);  // (0, r, 0) x (1, 0, 0) points along -z
+
+    // A kick on the same mass of the rigid ball: the impulse m_i dv at that mass, at once.
+    const RigidBody before = world.body(ball);
+    const Vec3 r = world.part(ball).worldPosition(top) - world.centreOfMass(ball);
+    const double mi = world.part(ball).model().mass[top];
+    world.kickMass(ball, top, Vec3(0, 0, 2));
+    const Eigen::Matrix3d rot = world.part(ball).pose().rotation.toRotationMatrix();
+    const Vec3 expectedSpin = rot * before.inverseInertia * rot.transpose() * r.cross(Vec3(0, 0, 2 * mi));
+    EXPECT_LT((world.body(ball).linearVelocity - before.linearVelocity - Vec3(0, 0, 2 * mi * before.inverseMass)).norm(), 1e-12);
+    EXPECT_LT((world.body(ball).angularVelocity - before.angularVelocity - expectedSpin).norm(), 1e-12);
+    EXPECT_THROW(world.kickMass(ball, 1u << 30, Vec3::UnitY()), InputError);
+    EXPECT_THROW(world.kickMass(ball, 0, Vec3(NAN, 0, 0)), InputError);
 }

@@ -109,6 +109,39 @@ TEST(SceneRun, PushActsForItsDurationExactly) {
     EXPECT_NEAR(ball.linearVelocity.x(), 3.0 * 0.25 * ball.inverseMass, 1e-12);
 }
 
+// The thesis's perturbation as a scene action: each listed mass's velocity changes at once, and a
+// free full-deformable part (no restoration, no gravity) keeps the momentum sum m_i dv.
+TEST(SceneRun, AKickActionGivesTheMassesTheirVelocityChange) {
+    const char* text = R"(
+[world]
+time_step = 0.001
+gravity = [0, 0, 0]
+duration = 0.3
+
+[[part]]
+name = "ring"
+generator = "torus1"
+mode = "full-deformable"
+restoration = "none"
+vertex_mass = 0.5
+
+[[action]]
+time = 0.1
+type = "kick"
+part = "ring"
+masses = [3, 40]
+velocity = [0.4, 0, -0.2]
+)";
+    SceneRun run(parseScene(text, "kick.toml", "."));
+    runFor(run, 0.05);
+    const Part& ring = run.world().part(0);
+    EXPECT_EQ(ring.state().velocities[3], Vec3::Zero());
+    runFor(run, 0.2);
+    Vec3 momentum = Vec3::Zero();
+    for (Index i = 0; i < ring.model().massCount(); ++i) momentum += ring.model().mass[i] * ring.state().velocities[i];
+    EXPECT_LT((momentum - 2 * 0.5 * Vec3(0.4, 0, -0.2)).norm(), 1e-12);
+}
+
 TEST(SceneRun, MoveInterpolatesTheGrabTargetLinearly) {
     SceneRun run(parseScene(kFreeBall, "free.toml", "."));
     runFor(run, 0.4);  // halfway through the move (0.2 .. 0.6)
