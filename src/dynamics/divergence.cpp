@@ -86,11 +86,11 @@ std::string likelyCause(const PartModel& model, const SimulationSettings& settin
     if (report.certainlyUnstable)
         text << "the time step " << settings.timeStep << " s is above the stability bound " << report.unstableTimeStep
              << " s of this material with " << labelOf(settings.integrator) << " (stable below " << report.safeTimeStep
-             << " s; lower the time step or soften the material)";
+             << " s; lower the time step, soften the material or use the implicit integrator)";
     else if (report.possiblyUnstable)
         text << "the time step " << settings.timeStep << " s is above the stability bound " << report.safeTimeStep
              << " s of this material with " << labelOf(settings.integrator)
-             << " (lower the time step or soften the material), or a force beyond what the model can take";
+             << " (lower the time step, soften the material or use the implicit integrator), or a force beyond what the model can take";
     else
         text << "a force beyond what the model can take (the time step " << settings.timeStep
              << " s is within the stability bound " << report.safeTimeStep << " s of this material)";

@@ -231,6 +231,20 @@ PartMeshes readPartMesh(Table& t, const std::filesystem::path& base, const Scene
     }
 }
 
+// A box's divisions: one number for every axis, or [x, y, z] (e.g. a strip of near-square cells).
+std::array<int, 3> boxDivisions(Table& g) {
+    const toml::node* n = g.node("divisions");
+    if (n == nullptr || !n->is_array()) {
+        const int d = g.integer("divisions", 1, 1, 256);
+        return {d, d, d};
+    }
+    const std::vector<Index> d = g.indices("divisions");
+    if (d.size() != 3) g.fail(*n, "divisions", "expected one integer or three [x, y, z]");
+    for (Index v : d)
+        if (v < 1 || v > 256) g.fail(*n, "divisions", "each must be in [1, 256]");
+    return {int(d[0]), int(d[1]), int(d[2])};
+}
+
 TriMesh generatePartMesh(Table& t) {
     const toml::node* n = t.node("generator");
     if (n->is_string()) {
@@ -256,7 +270,7 @@ TriMesh generatePartMesh(Table& t) {
     } else if (type == "box") {
         const Vec3 half = g.vec3("half_extents", Vec3::Ones());
         if (!(half.minCoeff() > 0.0)) g.fail(*g.node("half_extents"), "half_extents", "must be > 0");
-        mesh = makeBox(half, g.integer("divisions", 1, 1, 256));
+        mesh = makeBox(half, boxDivisions(g));
     } else {
         const Vec3 half = g.vec3("half_extents", Vec3(2.0, 0.5, 2.0));
         if (!(half.minCoeff() > 0.0)) g.fail(*g.node("half_extents"), "half_extents", "must be > 0");
