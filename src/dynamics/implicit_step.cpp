@@ -20,10 +20,11 @@
 // reported. Known limits: one Newton step per time step (large deformations in one step are
 // damped more than the exact backward Euler would); the clamp makes buckling under compression
 // slower than physical; backward Euler damps oscillations numerically (by 1/|1 - h lambda| per
-// step: at h w = 0.1, 0.5 % per step); the code is scalar (about 40 ns per spring to assemble,
-// 10 ns per spring and iteration on the reference machine) and the Jacobi preconditioner
+// step: at h w = 0.1, 0.5 % per step); the code is scalar (about 20 ns per spring to assemble,
+// 6-7 ns per spring and iteration on the reference machine) and the Jacobi preconditioner
 // converges slowly when h^2 k / m is large (1,000: a residual of 0.64 after 20 iterations on a
-// 2,000-mass zone), where block-Jacobi, multigrid or Vertex Block Descent would do better.
+// 2,000-mass zone, 494 iterations to 1e-6), where block-Jacobi, multigrid or Vertex Block
+// Descent would do better.
 // The order of every sum is fixed (lists in order), so a run's bits do not depend on the CPU.
 #include "implicit_step.hpp"
 
@@ -37,19 +38,21 @@ namespace flexfit::detail {
 namespace {
 
 // H_e = h^2 S_e + h C_e = iso I + axial u u^T, and the spring's ends as positions in the
-// solve's compact arrays (kHeld for a held end).
+// solve's compact arrays. A held end points at the held slot: one more position past the
+// moving masses whose input stays zero and whose output nobody reads, so the passes over the
+// springs need no branch (and add the same values as if the held end were skipped).
 struct SpringJacobian {
     double u[3] = {0.0, 0.0, 0.0};
     double iso = 0.0, axial = 0.0;
     std::uint32_t a = 0, b = 0;
 };
 
-constexpr std::uint32_t kHeld = ~std::uint32_t(0);
 constexpr double kRoundingLevel = 1e-14;
 
 // Scratch of the solve, per thread, grown to the largest problem stepped. The solve's vectors
 // are compact: 3 doubles per moving mass, in the order of the mass list, so every vector pass
-// streams; `slot` maps a mass to its position (written for the moving masses each step).
+// streams, then the held slot's 3; `slot` maps a mass to its position (written for the moving
+// masses each step).
 struct Workspace {
     std::vector<double> dv, r, z, p, ap, diagonal, massTerm;
     std::vector<SpringJacobian> jacobians;
@@ -58,7 +61,7 @@ struct Workspace {
 
     void reserve(std::size_t modelMasses, std::size_t masses, std::size_t springs) {
         for (std::vector<double>* v : {&dv, &r, &z, &p, &ap, &diagonal})
-            if (v->size() < 3 * masses) v->resize(3 * masses);
+            if (v->size() < 3 * (masses + 1)) v->resize(3 * (masses + 1));
         if (massTerm.size() < masses) massTerm.resize(masses);
         if (jacobians.size() < springs) jacobians.resize(springs);
         if (slot.size() < modelMasses) slot.resize(modelMasses);
@@ -98,12 +101,14 @@ void assemble(const Problem& q, PartState& state, Workspace& ws) {
         }
         state.forces[i] = Vec3::Zero();
     }
+    const std::size_t held = q.masses.size();
+    for (int c = 0; c < 3; ++c) ws.r[3 * held + c] = ws.diagonal[3 * held + c] = 0.0;  // scratch, never read
     for (std::size_t s = 0; s < q.springs.size(); ++s) {
         const Index e = q.springs[s], a = q.model.springA[e], b = q.model.springB[e];
         SpringJacobian& jacobian = ws.jacobians[s];
         jacobian = {};
-        jacobian.a = q.moves(a) ? ws.slot[a] : kHeld;
-        jacobian.b = q.moves(b) ? ws.slot[b] : kHeld;
+        jacobian.a = q.moves(a) ? ws.slot[a] : std::uint32_t(held);
+        jacobian.b = q.moves(b) ? ws.slot[b] : std::uint32_t(held);
         const Vec3 d = state.positions[a] - state.positions[b];
         const double length = d.norm();
         if (!(length > 0.0)) continue;  // coincident ends: no force, no direction (as the explicit steps)
@@ -121,32 +126,29 @@ void assemble(const Problem& q, PartState& state, Workspace& ws) {
         const Vec3 change = h * g - stiffnessTimesW;
         for (int i = 0; i < 3; ++i) {
             const double diagonal = jacobian.iso + jacobian.axial * u[i] * u[i];
-            if (jacobian.a != kHeld) {
-                ws.r[3 * jacobian.a + i] += change[i];
-                ws.diagonal[3 * jacobian.a + i] += diagonal;
-            }
-            if (jacobian.b != kHeld) {
-                ws.r[3 * jacobian.b + i] -= change[i];
-                ws.diagonal[3 * jacobian.b + i] += diagonal;
-            }
+            ws.r[3 * jacobian.a + i] += change[i];
+            ws.diagonal[3 * jacobian.a + i] += diagonal;
+            ws.r[3 * jacobian.b + i] -= change[i];
+            ws.diagonal[3 * jacobian.b + i] += diagonal;
         }
     }
 }
 
-// out = (M + h C + h^2 S) in over the moving masses (held masses count as zero).
+// out = (M + h C + h^2 S) in over the moving masses (`in`'s held slot is zero; `out`'s is
+// scratch).
 void multiply(std::size_t masses, std::size_t springs, const Workspace& ws, const double* in, double* out) {
     for (std::size_t k = 0; k < masses; ++k)
         for (int c = 0; c < 3; ++c) out[3 * k + c] = ws.massTerm[k] * in[3 * k + c];
+    for (int c = 0; c < 3; ++c) out[3 * masses + c] = 0.0;
     for (std::size_t s = 0; s < springs; ++s) {
         const SpringJacobian& j = ws.jacobians[s];
         double difference[3];
-        for (int c = 0; c < 3; ++c)
-            difference[c] = (j.a != kHeld ? in[3 * j.a + c] : 0.0) - (j.b != kHeld ? in[3 * j.b + c] : 0.0);
+        for (int c = 0; c < 3; ++c) difference[c] = in[3 * j.a + c] - in[3 * j.b + c];
         const double along = j.axial * ((j.u[0] * difference[0] + j.u[1] * difference[1]) + j.u[2] * difference[2]);
         for (int c = 0; c < 3; ++c) {
             const double t = j.iso * difference[c] + along * j.u[c];
-            if (j.a != kHeld) out[3 * j.a + c] += t;
-            if (j.b != kHeld) out[3 * j.b + c] -= t;
+            out[3 * j.a + c] += t;
+            out[3 * j.b + c] -= t;
         }
     }
 }
@@ -178,6 +180,7 @@ int solve(std::size_t masses, std::size_t springs, const ImplicitSettings& setti
         z[i] = r[i] * inverseDiagonal[i];
         p[i] = z[i];
     }
+    for (std::size_t i = n; i < n + 3; ++i) p[i] = 0.0;  // the held slot: held masses do not move
     const double rhsNorm = std::sqrt(dot(n, r, r));
     relativeResidual = 0.0;
     if (!(rhsNorm > 0.0)) return 0;  // nothing acts: dv = 0 (or a NaN the divergence check reports)
