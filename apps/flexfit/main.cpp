@@ -25,7 +25,9 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        // --help prints and succeeds; a usage error (an unknown option, a value out of range)
+        // exits 2 like every other input error.
+        return app.exit(e) == 0 ? 0 : 2;
     } catch (const flexfit::InputError& e) {
         fmt::print(stderr, "error: {}\n", e.what());
         return 2;
