@@ -8,11 +8,14 @@ DEMO_OUT ?= out/demo
 deps:
 	@scripts/install-deps.sh
 
+# A build directory configured by another generator (before the presets chose Ninja) is remade.
 release: deps
+	@[ ! -f build/release/CMakeCache.txt ] || grep -qs 'CMAKE_GENERATOR:INTERNAL=Ninja' build/release/CMakeCache.txt || rm -rf build/release
 	@cmake --preset release >/dev/null
 	@cmake --build --preset release -j $(JOBS)
 
 asan: deps
+	@[ ! -f build/asan/CMakeCache.txt ] || grep -qs 'CMAKE_GENERATOR:INTERNAL=Ninja' build/asan/CMakeCache.txt || rm -rf build/asan
 	@cmake --preset asan >/dev/null
 	@cmake --build --preset asan -j $(JOBS)
 

@@ -6,6 +6,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config     # toolchain
+  ninja-build                          # builds every target's objects in parallel (CGAL's one TU alone takes 1-2 min)
   libeigen3-dev                        # linear algebra
   libassimp-dev                        # mesh import (OBJ, STL, PLY, OFF, glTF)
   libcli11-dev                         # command line
