@@ -63,15 +63,22 @@ PartModelSettings springsOf(const Material& material) {
     return settings;
 }
 
-MaterialRun runMaterial(const std::string& name, const Material& material, const ExperimentOptions& opt, std::ostream& series) {
+// torus1 of one material, full-deformable, anchor restoration, until restored or the time limit;
+// the caller adds the perturbation.
+PerturbationConfig torusRun(const Material& material, const ExperimentOptions& opt) {
     PerturbationConfig config;
     config.model = buildPartModel(makeTorus1(), springsOf(material));
     config.part.mode = PartMode::FullDeformable;
     config.part.simulation = anchorSettings(material, opt);
-    config.loads = {{opt.mass, Vec3(opt.force, 0.0, 0.0)}};
-    config.loadDuration = opt.loadDuration;
     config.duration = opt.maxDuration;
     config.stopWhenRestored = true;
+    return config;
+}
+
+MaterialRun runMaterial(const std::string& name, const Material& material, const ExperimentOptions& opt, std::ostream& series) {
+    PerturbationConfig config = torusRun(material, opt);
+    config.loads = {{opt.mass, Vec3(opt.force, 0.0, 0.0)}};
+    config.loadDuration = opt.loadDuration;
     const auto every = std::uint64_t(std::max(1.0, std::round(0.01 / opt.timeStep)));  // 10 ms samples
     auto observer = [&](const Part& part, const std::vector<ActivityTracker>& trackers) {
         if (part.state().stepCount % every == 0)
@@ -118,13 +125,8 @@ struct Calibration {
 PerturbationResult runKick(const Material& material, double kick, double timeStep, const ExperimentOptions& opt) {
     ExperimentOptions at = opt;
     at.timeStep = timeStep;
-    PerturbationConfig config;
-    config.model = buildPartModel(makeTorus1(), springsOf(material));
-    config.part.mode = PartMode::FullDeformable;
-    config.part.simulation = anchorSettings(material, at);
+    PerturbationConfig config = torusRun(material, at);
     config.kicks = {{opt.mass, Vec3(kick, 0.0, 0.0)}};
-    config.duration = opt.maxDuration;
-    config.stopWhenRestored = true;
     return runPerturbation(config);
 }
 
