@@ -17,6 +17,10 @@ packages=(
   libcgal-dev                          # simulation remeshing (Polygon Mesh Processing)
   libfcl-dev                           # FCL: reference for collision tests and benchmarks
   python3-matplotlib                   # plots of experiment results (/usr/bin/python3)
+  pybind11-dev python3-dev python3-numpy  # the Python module (NumPy views of the state)
+  python3-pytest                       # the Python tests
+  python3-distributed python3-pandas   # sweeps on a Dask cluster, their table as a DataFrame
+  python3-vtk9                         # the tests read our VTK frames with VTK's own reader
   libglfw3-dev libimgui-dev            # viewer: window, input, user interface
   libgl-dev libegl-dev libegl-mesa0    # viewer: OpenGL 3.3, EGL surfaceless
   libgl1-mesa-dri                      # viewer: Mesa software rendering (llvmpipe)

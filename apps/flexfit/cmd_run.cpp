@@ -14,12 +14,16 @@ void registerRun(CLI::App& app) {
         double duration = 0.0;
         bool noProgress = false;
         bool strict = false;
+        double objEvery = -1.0, vtkEvery = -1.0, glbEvery = -1.0;
     };
     auto opt = std::make_shared<Options>();
     cmd->add_option("scene", opt->scene, "Scene file (.toml)")->required();
     cmd->add_option("--duration", opt->duration, "Simulated seconds (default: the scene's [world] duration)")->check(CLI::PositiveNumber);
     cmd->add_option("--out", opt->out, "Directory for metrics.csv, summary.json and OBJ frames");
     cmd->add_flag("--no-progress", opt->noProgress, "No progress bar");
+    cmd->add_option("--obj-every", opt->objEvery, "Seconds between OBJ frames (default: the scene's [output]; 0: none)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--vtk-every", opt->vtkEvery, "Seconds between VTK frames for ParaView (frame_*.vtp, frames.pvd; 0: none)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--glb-every", opt->glbEvery, "Seconds between glTF binary frames for Blender (frame_*.glb; 0: none)")->check(CLI::NonNegativeNumber);
     cmd->add_flag("--strict", opt->strict, "Refuse mesh files with geometric defects instead of repairing them (every part)");
     cmd->callback([opt] {
         const Scene scene = loadScene(opt->scene, SceneReadOptions{opt->strict});
@@ -27,6 +31,9 @@ void registerRun(CLI::App& app) {
         RunOptions options;
         if (opt->duration > 0.0) options.duration = opt->duration;
         options.out = opt->out;
+        if (opt->objEvery >= 0.0) options.objEvery = opt->objEvery;
+        if (opt->vtkEvery >= 0.0) options.vtkEvery = opt->vtkEvery;
+        if (opt->glbEvery >= 0.0) options.glbEvery = opt->glbEvery;
         options.progress = !opt->noProgress;
         const RunSummary s = runScene(scene, options);
         fmt::print("{}: {} steps ({:.3f} s simulated) in {:.3f} s wall, {:.0f} steps/s", scene.source, s.steps, s.simulatedSeconds, s.wallSeconds,

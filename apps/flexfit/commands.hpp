@@ -14,6 +14,7 @@ void registerGen(CLI::App& app);
 void registerSimulate(CLI::App& app);
 void registerCollide(CLI::App& app);
 void registerRun(CLI::App& app);
+void registerSweep(CLI::App& app);
 void registerRemesh(CLI::App& app);
 void registerExperimentContact(CLI::App& experiment);
 void registerExperimentBallTorus(CLI::App& experiment);

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
     flexfit::cli::registerSimulate(app);
     flexfit::cli::registerCollide(app);
     flexfit::cli::registerRun(app);
+    flexfit::cli::registerSweep(app);
     flexfit::cli::registerRemesh(app);
     CLI::App* experiment = app.add_subcommand("experiment", "Reproduce the thesis's experiments");
     experiment->require_subcommand(1);

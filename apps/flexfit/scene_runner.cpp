@@ -122,7 +122,12 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         csv << csvHeader(scene);
     }
     RunSummary s;
-    const std::uint64_t objStride = scene.objEvery > 0.0 ? std::max<std::uint64_t>(1, std::llround(scene.objEvery / scene.world.timeStep)) : 0;
+    auto strideOf = [&](double every) { return every > 0.0 ? std::max<std::uint64_t>(1, std::llround(every / scene.world.timeStep)) : 0; };
+    const std::uint64_t objStride = strideOf(options.objEvery.value_or(scene.objEvery)), vtkStride = strideOf(options.vtkEvery.value_or(scene.vtkEvery)),
+                        glbStride = strideOf(options.glbEvery.value_or(scene.glbEvery));
+    std::vector<FramePart> frameParts;
+    for (BodyId id = 0; id < w.bodyCount(); ++id) frameParts.push_back({scene.parts[id].name, &w.part(id)});
+    std::vector<std::pair<double, std::string>> vtkFrames;
     ProgressBar bar("run " + std::filesystem::path(scene.source).filename().string(), options.progress);
     const auto start = Clock::now();
     for (std::uint64_t i = 0; i < steps; ++i) {
@@ -148,6 +153,12 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         if (csv.is_open() && (i + 1) % std::uint64_t(std::max(1, options.csvEvery)) == 0) csv << csvRow(scene, w);
         if (objStride && !options.out.empty() && (i + 1) % objStride == 0)
             writeObjFrame(files.add(options.out / fmt::format("frame_{:06d}.obj", i + 1)), w, scene);
+        if (vtkStride && !options.out.empty() && (i + 1) % vtkStride == 0) {
+            vtkFrames.emplace_back(w.time(), fmt::format("frame_{:06d}.vtp", i + 1));
+            writeVtkFrame(files.add(options.out / vtkFrames.back().second), frameParts);
+        }
+        if (glbStride && !options.out.empty() && (i + 1) % glbStride == 0)
+            writeGlbFrame(files.add(options.out / fmt::format("frame_{:06d}.glb", i + 1)), frameParts);
         bar.update(double(i + 1) / double(steps));
     }
     bar.finish();
@@ -160,6 +171,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     for (BodyId id = 0; id < w.bodyCount(); ++id) s.finalCentres.push_back(w.centreOfMass(id));
     if (!options.out.empty()) {
         writeTextFile(files.add(options.out / "summary.json"), summaryJson(scene, s));
+        if (!vtkFrames.empty()) writeVtkCollection(files.add(options.out / "frames.pvd"), vtkFrames);
         csv.close();
         if (!csv) throw InputError(csvPath.string(), 0, "write failed");
         files.commit();

@@ -16,6 +16,9 @@ struct RunOptions {
     std::filesystem::path out;           // empty: record nothing on disk
     bool progress = true;
     int csvEvery = 1;                    // write every k-th step to metrics.csv
+    // Seconds between frames (override the scene's [output]): OBJ, VTK (.vtp and frames.pvd)
+    // and glTF binary (frame_export.hpp).
+    std::optional<double> objEvery, vtkEvery, glbEvery;
 };
 
 struct RunSummary {

@@ -28,6 +28,8 @@
 #include "flexfit/scene.hpp"
 #include "flexfit/scene_file.hpp"
 #include "flexfit/scene_run.hpp"
+#include "flexfit/sweep.hpp"
+#include "flexfit/frame_export.hpp"
 #include "flexfit/simulation.hpp"
 #include "flexfit/topology.hpp"
 #include "flexfit/world.hpp"

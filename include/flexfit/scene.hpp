@@ -32,7 +32,7 @@
 //                angular_damping}; move {position, rotation, duration}; push {force,
 //                duration}; force {force, masses or faces, duration}; velocity {linear,
 //                angular}; kick {masses, velocity (each mass's velocity change, at once)}
-//   [output]     obj_every (s; 0 = no OBJ frames)
+//   [output]     obj_every, vtk_every, glb_every (s between OBJ, VTK and glTF frames; 0 = none)
 //
 // Loading builds every mesh and model up front: a scene either loads whole or throws
 // InputError, never half-built.
@@ -96,6 +96,8 @@ struct Scene {
     std::vector<AssemblyRule> assemblies;
     std::vector<SceneAction> actions;  // by time (stable: file order among equal times)
     double objEvery = 0.0;    // s between OBJ frames; 0: none
+    double vtkEvery = 0.0;    // s between VTK frames (frame_export.hpp); 0: none
+    double glbEvery = 0.0;    // s between glTF binary frames; 0: none
     std::vector<SceneWarning> warnings;
 
     // The part named `name`, or nullopt.

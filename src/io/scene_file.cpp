@@ -6,6 +6,8 @@
 #include "flexfit/generators.hpp"
 #include "flexfit/mesh_io.hpp"
 
+#include "io/scene_document.hpp"
+
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -545,6 +547,11 @@ Scene parseScene(std::string_view text, const std::string& source, const std::fi
     } catch (const toml::parse_error& e) {
         throw InputError(source, e.source().begin.line, "TOML syntax: " + std::string(e.description()));
     }
+    return detail::readSceneDocument(document, source, baseDirectory, options);
+}
+
+Scene detail::readSceneDocument(const toml::table& document, const std::string& source, const std::filesystem::path& baseDirectory,
+                                const SceneReadOptions& options) {
     Scene scene;
     scene.source = source;
     Table root(document, "scene", scene.source, scene.warnings);
@@ -569,6 +576,8 @@ Scene parseScene(std::string_view text, const std::string& source, const std::fi
     if (root.has("output")) {
         Table o = root.sub("output");
         scene.objEvery = o.nonNegative("obj_every", 0.0);
+        scene.vtkEvery = o.nonNegative("vtk_every", 0.0);
+        scene.glbEvery = o.nonNegative("glb_every", 0.0);
         o.finish();
     }
     root.finish();

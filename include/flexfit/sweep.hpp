@@ -1,0 +1,76 @@
+// Parameter sweeps: one base scene, the parameters to vary, every combination a run.
+//
+// A sweep file (TOML), paths relative to it:
+//
+//   scene = "ball_torus.toml"        # the base scene
+//   duration = 2.0                   # optional: overrides the scene's [world] duration
+//   [[parameter]]
+//   name = "friction"                # the column of the results table
+//   key = "part.ball.friction"       # a scene key: tables by name, [[part]] by its name,
+//   values = [0.0, 0.25, 0.5]        #   other arrays of tables by index (action.0.force)
+//   [[parameter]]
+//   name = "diameter"
+//   key = ["part.ball.generator.radius", "part.ball.position"]   # several keys move together
+//   values = [[7.0, [0, 5, 0]], [8.5, [0, 4.7, 0]]]              #   one value each, per case
+//   labels = ["14", "17"]            # optional: what the table shows for each case
+//   [[parameter]]
+//   name = "push"
+//   key = "action.0.force"
+//   range = { start = 1000, stop = 3000, count = 3 }             # count values, ends included
+//
+// Runs are the Cartesian product, the first parameter varying slowest. A run's id is a hash of
+// its parameters' names and values (not of its position), so it stays the same when other
+// values are added or reordered: a restarted sweep finds its finished runs by id.
+//
+// Every key must name an existing key of the base scene, or a new key in an existing table
+// (the scene reader then checks it like any other); errors name the sweep file, the line of
+// the parameter and the run.
+#pragma once
+
+#include "flexfit/scene.hpp"
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace flexfit {
+
+namespace detail {
+struct SweepDocument;
+}
+
+struct SweepParameter {
+    std::string name;
+    std::vector<std::string> keys;
+    std::vector<std::string> labels;  // one per case: the given labels, or the values as TOML
+    std::size_t line = 0;             // of its [[parameter]] in the sweep file
+};
+
+struct SweepRun {
+    std::string id;                   // 16 hex digits (FNV-1a of the names and values)
+    std::vector<std::size_t> cases;   // per parameter, the index of its value
+};
+
+struct Sweep {
+    std::filesystem::path file;       // the sweep file
+    std::filesystem::path scene;      // the base scene
+    std::optional<double> duration;
+    std::vector<SweepParameter> parameters;
+    std::vector<SweepRun> runs;       // in product order
+    std::shared_ptr<const detail::SweepDocument> document;  // the base scene and the values
+
+    // The run's label of each parameter, in order.
+    std::vector<std::string> labels(std::size_t run) const;
+};
+
+// Throws InputError naming the sweep file, the line and the problem; every run's scene is
+// built and checked once, so a sweep that loads has no bad run.
+Sweep loadSweep(const std::filesystem::path& file);
+
+// The scene of one run (its source names the sweep file and the run id).
+Scene sweepScene(const Sweep& sweep, std::size_t run);
+
+}  // namespace flexfit

@@ -1,0 +1,441 @@
+// flexfit._flexfit: the C++ API for Python (pybind11). The package's __init__.py re-exports it
+// and adds flexfit.sweep (Dask).
+//
+// Lifetimes: a Part or RigidBody obtained from a World (World.part(id)) is a view into it and
+// keeps the World alive; state arrays (positions, velocities, rest positions, moving masses)
+// are NumPy views without copies that keep their owner alive, read-only (the state changes
+// through the API: forces, zones, steps). Arrays computed on request (zone depths, world
+// positions) are fresh copies. Enum values are the scene file's names ("rigid-deformable").
+// World.step() and SceneRun.step() release the GIL. InputError and DivergenceError become
+// flexfit.InputError (a ValueError with .source, .line, .problem) and flexfit.DivergenceError
+// (a RuntimeError with .body, .time, .problem), carrying the C++ message.
+#include "flexfit/flexfit.hpp"
+#include "scene_runner.hpp"
+#include "sweep_runner.hpp"
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+namespace py = pybind11;
+using namespace flexfit;
+
+namespace {
+
+// A read-only NumPy view of n rows of `width` doubles at `data`, keeping `owner` alive.
+py::array rowsView(const double* data, std::size_t n, std::size_t width, py::handle owner) {
+    py::array a(py::dtype::of<double>(), {n, width}, {width * sizeof(double), sizeof(double)}, data, owner);
+    a.attr("flags").attr("writeable") = false;
+    return a;
+}
+
+py::array vec3View(const std::vector<Vec3>& v, py::handle owner) {
+    static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is three packed doubles");
+    return rowsView(v.empty() ? nullptr : v.front().data(), v.size(), 3, owner);
+}
+
+py::array indexView(std::span<const Index> s, py::handle owner) {
+    py::array a(py::dtype::of<Index>(), {s.size()}, {sizeof(Index)}, s.data(), owner);
+    a.attr("flags").attr("writeable") = false;
+    return a;
+}
+
+py::array_t<double> vec3Copy(const std::vector<Vec3>& v) {
+    py::array_t<double> a({v.size(), std::size_t(3)});
+    auto m = a.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < v.size(); ++i)
+        for (int k = 0; k < 3; ++k) m(py::ssize_t(i), k) = v[i][k];
+    return a;
+}
+
+template <class Enum>
+Enum enumFrom(const std::string& text, const char* what) {
+    const std::optional<Enum> value = parseName<Enum>(text);
+    if (!value) throw InputError(what, 0, "unknown value '" + text + "' (expected one of " + nameList<Enum>() + ")");
+    return *value;
+}
+
+// Pose from Python: position (3) and rotation as a quaternion (w, x, y, z).
+Pose makePose(const Vec3& position, const Eigen::Vector4d& wxyz) {
+    Pose p;
+    p.translation = position;
+    p.rotation = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
+    if (!(p.rotation.norm() > 0.0) || !position.allFinite() || !wxyz.allFinite()) throw InputError("pose", 0, "position and rotation must be finite, the rotation non-zero");
+    p.rotation.normalize();
+    return p;
+}
+
+py::dict poseDict(const Pose& p) {
+    py::dict d;
+    d["position"] = p.translation;
+    d["rotation_wxyz"] = Eigen::Vector4d(p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z());
+    return d;
+}
+
+py::dict contactDict(const Contact& c) {
+    py::dict d;
+    d["part_a"] = c.partA;
+    d["part_b"] = c.partB;
+    d["face_a"] = c.faceA;
+    d["face_b"] = c.faceB;
+    d["point"] = c.point;
+    d["normal"] = c.normal;
+    d["depth"] = c.depth;
+    d["mass_b"] = c.massB == kNoMass ? py::object(py::none()) : py::object(py::int_(c.massB));
+    return d;
+}
+
+py::dict profileDict(const Profile& p) {
+    py::dict last, total;
+    for (std::size_t i = 0; i < kStageCount; ++i) {
+        last[toString(Stage(i))] = p.lastSeconds[i];
+        total[toString(Stage(i))] = p.totalSeconds[i];
+    }
+    py::dict d;
+    d["last_seconds"] = last;
+    d["total_seconds"] = total;
+    d["last_step_seconds"] = p.lastStepSeconds;
+    d["total_step_seconds"] = p.totalStepSeconds;
+    d["steps"] = p.steps;
+    d["substeps"] = p.substeps;
+    d["cut_moves"] = p.cutMoves;
+    d["rigid_queries"] = p.rigidQueries;
+    d["face_queries"] = p.faceQueries;
+    d["face_traversals"] = p.faceTraversals;
+    return d;
+}
+
+py::dict eventDict(const AssemblyEvent& e) {
+    py::dict d;
+    d["rule"] = e.rule;
+    d["technique"] = toString(e.technique);
+    d["time"] = e.time;
+    d["from"] = poseDict(e.primaryPoseBefore);
+    d["to"] = poseDict(e.primaryPoseAfter);
+    return d;
+}
+
+std::vector<FramePart> frameParts(const World& world, const std::vector<std::string>& names) {
+    if (!names.empty() && names.size() != world.bodyCount())
+        throw InputError("names", 0, "one name per body (" + std::to_string(world.bodyCount()) + "), or none");
+    std::vector<FramePart> parts;
+    for (BodyId id = 0; id < world.bodyCount(); ++id) parts.push_back({names.empty() ? "part" + std::to_string(id) : names[id], &world.part(id)});
+    return parts;
+}
+
+TriMesh meshFromArrays(py::array_t<double, py::array::c_style | py::array::forcecast> vertices,
+                       py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> faces, const std::string& name) {
+    if (vertices.ndim() != 2 || vertices.shape(1) != 3) throw InputError("vertices", 0, "expected an (n, 3) array");
+    if (faces.ndim() != 2 || faces.shape(1) != 3) throw InputError("faces", 0, "expected an (m, 3) array of vertex indices");
+    TriMesh mesh;
+    mesh.name = name;
+    auto v = vertices.unchecked<2>();
+    for (py::ssize_t i = 0; i < v.shape(0); ++i) mesh.vertices.emplace_back(v(i, 0), v(i, 1), v(i, 2));
+    auto f = faces.unchecked<2>();
+    for (py::ssize_t i = 0; i < f.shape(0); ++i) {
+        Face face;
+        for (int k = 0; k < 3; ++k) {
+            if (f(i, k) < 0 || f(i, k) >= v.shape(0))
+                throw InputError("faces", 0, "face " + std::to_string(i) + " has vertex " + std::to_string(f(i, k)) + ", out of range");
+            face[std::size_t(k)] = Index(f(i, k));
+        }
+        mesh.faces.push_back(face);
+    }
+    return mesh;
+}
+
+py::object summaryObject(const Scene& scene, const cli::RunSummary& s) {
+    return py::module_::import("json").attr("loads")(cli::summaryJson(scene, s));
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_flexfit, m) {
+    m.doc() = "Flexfit: rigid-deformable parts for virtual assembly (C++ library bindings)";
+
+    // --- Errors ---
+    static py::exception<InputError> inputError(m, "InputError", PyExc_ValueError);
+    static py::exception<DivergenceError> divergenceError(m, "DivergenceError", PyExc_RuntimeError);
+    inputError.doc() = "Bad input: a file, a scene, a parameter. Attributes: source, line, problem.";
+    divergenceError.doc() = "A run diverged (non-finite state). Attributes: body (or None), time, problem.";
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const InputError& e) {
+            py::object error = py::handle(inputError)(e.what());
+            error.attr("source") = e.source();
+            error.attr("line") = e.line();
+            error.attr("problem") = e.problem();
+            PyErr_SetObject(inputError.ptr(), error.ptr());
+        } catch (const DivergenceError& e) {
+            py::object error = py::handle(divergenceError)(e.what());
+            error.attr("body") = e.body() ? py::object(py::int_(*e.body())) : py::object(py::none());
+            error.attr("time") = e.time();
+            error.attr("problem") = e.problem();
+            PyErr_SetObject(divergenceError.ptr(), error.ptr());
+        }
+    });
+
+    // --- Meshes ---
+    py::class_<TriMesh>(m, "Mesh", "A triangle mesh: vertices (n, 3) and faces (m, 3), counter-clockwise seen from outside.")
+        .def(py::init(&meshFromArrays), py::arg("vertices"), py::arg("faces"), py::arg("name") = "mesh",
+             "A mesh from arrays (copied); faces index the vertices from 0.")
+        .def_readwrite("name", &TriMesh::name)
+        .def_property_readonly("vertices", [](py::object self) { return vec3View(self.cast<const TriMesh&>().vertices, self); },
+                               "Vertex positions, a read-only (n, 3) view.")
+        .def_property_readonly("faces", [](py::object self) {
+            const auto& f = self.cast<const TriMesh&>().faces;
+            py::array a(py::dtype::of<Index>(), {f.size(), std::size_t(3)}, {3 * sizeof(Index), sizeof(Index)}, f.empty() ? nullptr : f.front().data(), self);
+            a.attr("flags").attr("writeable") = false;
+            return a;
+        }, "Vertex indices of each face, a read-only (m, 3) view.")
+        .def("__repr__", [](const TriMesh& mesh) { return "<flexfit.Mesh '" + mesh.name + "': " + std::to_string(mesh.vertices.size()) + " vertices, " + std::to_string(mesh.faces.size()) + " faces>"; });
+
+    m.def("read_mesh", [](const std::filesystem::path& path, bool strict, std::optional<double> weld) {
+        MeshReadOptions options;
+        options.repair = !strict;
+        options.weldTolerance = weld;
+        MeshReadResult r = readMesh(path, options);
+        return py::make_tuple(std::move(r.mesh), r.diagnostics.warnings);
+    }, py::arg("path"), py::arg("strict") = false, py::arg("weld") = py::none(),
+          "Reads a mesh (.tri, OBJ, STL, PLY, OFF, glTF, ...). Returns (mesh, warnings): geometric defects are repaired and listed, "
+          "or refused with strict=True. Raises InputError naming the file and line.");
+    m.def("write_mesh", &writeMesh, py::arg("mesh"), py::arg("path"), "Writes a mesh; the format follows the extension (.tri, .obj, ...).");
+    m.def("torus", &makeTorus, py::arg("major"), py::arg("minor"), py::arg("u"), py::arg("v"), "A torus of u x v vertices about the y axis.");
+    m.def("sphere", &makeIcoSphere, py::arg("radius"), py::arg("level"), "An icosphere subdivided `level` times.");
+    m.def("box", [](const Vec3& half, int divisions) { return makeBox(half, divisions); }, py::arg("half_extents"), py::arg("divisions") = 1,
+          "A box with each face divided into divisions x divisions squares.");
+    m.def("heart", &makeHeart, py::arg("size") = 20.0, py::arg("segments") = 93, py::arg("rings") = 80, "The thesis's heart.");
+    m.def("container_mouth", &makeContainerMouth, "The thesis's container mouth (a torus R = 10, r = 2.5, 64 x 24).");
+    m.def("remesh", [](const TriMesh& mesh, double edge) {
+        RemeshOptions options;
+        options.targetEdge = edge;
+        RemeshResult r = remeshForSimulation(mesh, options, mesh.name);
+        py::dict q;
+        q["min_angle_degrees"] = r.after.minAngle;
+        q["slivers"] = r.after.slivers;
+        q["edge_spread"] = r.after.edgeSpread;
+        q["hausdorff_share"] = r.hausdorffShare();
+        return py::make_tuple(std::move(r.mesh), q);
+    }, py::arg("mesh"), py::arg("edge"),
+          "Simulation remeshing (CGAL): near-uniform edges of length `edge`, sharp features kept. Returns (mesh, quality).");
+
+    // --- Models and parts ---
+    py::class_<PartModel, std::shared_ptr<PartModel>>(m, "PartModel", "A part's immutable model: its mesh, masses and springs.")
+        .def(py::init([](TriMesh mesh, std::optional<std::string> material, std::optional<std::pair<double, double>> springs, double vertexMass) {
+                 PartModelSettings s;
+                 if (material) {
+                     const auto preset = materialPreset(*material);
+                     if (!preset) throw InputError("material", 0, "unknown material preset '" + *material + "' (rigid, elastic, superelastic)");
+                     s.material = *preset;
+                 }
+                 if (springs) s.material = Material{springs->first, springs->second};
+                 s.vertexMass = vertexMass;
+                 return std::const_pointer_cast<PartModel>(buildPartModel(std::move(mesh), s));
+             }),
+             py::arg("mesh"), py::arg("material") = py::none(), py::arg("springs") = py::none(), py::arg("vertex_mass") = 1.0,
+             "Builds a model from a mesh: material a preset name ('elastic'), or springs=(stiffness, damping); vertex_mass in kg.")
+        .def_property_readonly("mass_count", &PartModel::massCount)
+        .def_property_readonly("spring_count", [](const PartModel& model) { return model.springCount(); })
+        .def_property_readonly("mesh", [](py::object self) { return py::cast(&self.cast<const PartModel&>().mesh, py::return_value_policy::reference_internal, self); },
+                               "The simulation mesh (rest shape, part frame).")
+        .def_property_readonly("rest_positions", [](py::object self) { return vec3View(self.cast<const PartModel&>().restPositions, self); },
+                               "Rest positions, a read-only (n, 3) view.");
+
+    py::class_<Part>(m, "Part", "A part: a rigid body until pressed, then mass-spring-damper zones around the contacts.")
+        .def(py::init([](std::shared_ptr<PartModel> model, const std::string& mode) {
+                 PartSettings s;
+                 s.mode = enumFrom<PartMode>(mode, "mode");
+                 return Part(model, s);
+             }),
+             py::arg("model"), py::arg("mode") = "rigid-deformable", "A part stepped on its own (without a world).")
+        .def_property_readonly("mode", [](const Part& p) { return std::string(toString(p.mode())); })
+        .def_property_readonly("model", [](const Part& p) { return std::const_pointer_cast<PartModel>(p.sharedModel()); })
+        .def_property_readonly("positions", [](py::object self) { return vec3View(self.cast<const Part&>().state().positions, self); },
+                               "Mass positions in the part frame, a read-only (n, 3) view of the state (non-moving masses at rest).")
+        .def_property_readonly("velocities", [](py::object self) { return vec3View(self.cast<const Part&>().state().velocities, self); },
+                               "Mass velocities (part frame), a read-only (n, 3) view.")
+        .def_property_readonly("moving_masses", [](py::object self) { return indexView(self.cast<const Part&>().movingMasses(), self); },
+                               "Indices of the masses the zones move, a read-only view (valid until the next step or zone change).")
+        .def_property_readonly("zone_depths", [](const Part& p) {
+            std::vector<int> depths;
+            p.zoneDepths(depths);
+            return py::array_t<int>(py::ssize_t(depths.size()), depths.data());
+        }, "Each mass's depth in the zones covering it (0 = seed, -1 = at rest), a new int array.")
+        .def("world_positions", [](const Part& p) {
+            std::vector<Vec3> w;
+            p.worldPositions(w);
+            return vec3Copy(w);
+        }, "Mass positions in the world, a new (n, 3) array.")
+        .def_property_readonly("zone_count", &Part::zoneCount)
+        .def_property_readonly("time", &Part::time)
+        .def_property_readonly("pose", [](const Part& p) { return poseDict(p.pose()); })
+        .def("open_zone", [](Part& p, Index mass, int level) { return p.openZone(ZoneSeed::mass(mass), level); }, py::arg("mass"), py::arg("level"),
+             "Opens a zone of `level` rings around a mass; returns its id.")
+        .def("apply_force", &Part::applyForce, py::arg("mass"), py::arg("force"), "A world-frame force on one mass for the next step.")
+        .def("kick_mass", &Part::kickMass, py::arg("mass"), py::arg("velocity_change"), "A velocity change on one mass, now.")
+        .def("step", [](Part& p) {
+            py::gil_scoped_release release;
+            p.step();
+        }, "One step of the part alone (its own time step).")
+        .def("state_hash", [](const Part& p) { return stateHash(p.state()); }, "64-bit hash of the state, bit for bit.");
+
+    // --- World ---
+    py::class_<World>(m, "World", "Parts with rigid-body motion, collisions, deformation and snapping; one step of named stages.")
+        .def(py::init([](double timeStep, const Vec3& gravity) {
+                 WorldSettings s;
+                 s.timeStep = timeStep;
+                 s.gravity = gravity;
+                 return std::make_unique<World>(s);
+             }),
+             py::arg("time_step") = 1e-3, py::arg("gravity") = Vec3(0.0, -9.81, 0.0))
+        .def("add", [](World& w, std::shared_ptr<PartModel> model, const std::string& mode, const std::string& motion, const Vec3& position,
+                       const Eigen::Vector4d& rotation, double density, double friction, int contactLevel) {
+            PartSettings part;
+            part.mode = enumFrom<PartMode>(mode, "mode");
+            part.zones.contactLevel = contactLevel;
+            BodySettings body;
+            body.motion = enumFrom<MotionType>(motion, "motion");
+            body.density = density;
+            body.staticFriction = body.kineticFriction = friction;
+            return w.add(model, part, body, makePose(position, rotation));
+        }, py::arg("model"), py::arg("mode") = "rigid", py::arg("motion") = "static", py::arg("position") = Vec3::Zero(),
+             py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0), py::arg("density") = 1.0, py::arg("friction") = 0.0, py::arg("contact_level") = 2,
+             "Adds a part; returns its body id. mode: rigid, rigid-deformable, full-deformable; motion: static, kinematic, dynamic.")
+        .def_property_readonly("body_count", &World::bodyCount)
+        .def("part", [](World& w, BodyId id) { return &w.part(id); }, py::arg("id"), py::return_value_policy::reference_internal,
+             "The body's part (a view that keeps the world alive).")
+        .def("step", [](World& w, int steps) {
+            py::gil_scoped_release release;
+            for (int i = 0; i < steps; ++i) w.step();
+        }, py::arg("steps") = 1, "Steps the world (the GIL is released meanwhile).")
+        .def_property_readonly("time", &World::time)
+        .def_property_readonly("step_count", &World::stepCount)
+        .def("contacts", [](const World& w) {
+            py::list out;
+            for (const Contact& c : w.contacts()) out.append(contactDict(c));
+            return out;
+        }, "The last step's contacts, as dicts (part_a, part_b, point, normal, depth, ...).")
+        .def("profile", [](const World& w) { return profileDict(w.profile()); }, "Per-stage times of the last step and in total (s).")
+        .def("state_hash", &World::stateHash, "64-bit FNV-1a of the whole state, bit for bit (equal hashes: the same run).")
+        .def("centre_of_mass", &World::centreOfMass, py::arg("id"))
+        .def("pose", [](const World& w, BodyId id) { return poseDict(w.part(id).pose()); }, py::arg("id"))
+        .def("apply_force", &World::applyForce, py::arg("id"), py::arg("force"), "A force at the centre of mass for the next step.")
+        .def("apply_mass_force", &World::applyMassForce, py::arg("id"), py::arg("mass"), py::arg("force"), "A world-frame force on one mass.")
+        .def("kick_mass", &World::kickMass, py::arg("id"), py::arg("mass"), py::arg("velocity_change"))
+        .def("set_velocity", &World::setVelocity, py::arg("id"), py::arg("linear"), py::arg("angular") = Vec3::Zero())
+        .def("open_zone", [](World& w, BodyId id, Index mass, int level) { return w.openZone(id, ZoneSeed::mass(mass), level); }, py::arg("id"),
+             py::arg("mass"), py::arg("level"))
+        .def("grab", [](World& w, BodyId id, double frequency) {
+            GrabSettings g;
+            g.frequency = frequency;
+            w.grab(id, g);
+        }, py::arg("id"), py::arg("frequency") = 10.0, "The operator grabs a body (a spring-damper coupling of that frequency).")
+        .def("set_grab_target", [](World& w, const Vec3& position, const Eigen::Vector4d& rotation) { w.setGrabTarget(makePose(position, rotation)); },
+             py::arg("position"), py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0))
+        .def("release", &World::release)
+        .def("coupling", [](const World& w) {
+            py::dict d;
+            d["active"] = w.coupling().active;
+            d["body"] = w.coupling().body;
+            d["force"] = w.coupling().force;
+            d["torque"] = w.coupling().torque;
+            return d;
+        }, "The operator coupling's force and torque on the grabbed body in the last step (the device feels their opposite).")
+        .def("assembly_events", [](const World& w) {
+            py::list out;
+            for (const AssemblyEvent& e : w.assemblyEvents()) out.append(eventDict(e));
+            return out;
+        })
+        .def("write_vtk", [](const World& w, const std::filesystem::path& path, const std::vector<std::string>& names) { writeVtkFrame(path, frameParts(w, names)); },
+             py::arg("path"), py::arg("names") = std::vector<std::string>{}, "One VTK PolyData frame (.vtp) with zone_depth, displacement, velocity.")
+        .def("write_glb", [](const World& w, const std::filesystem::path& path, const std::vector<std::string>& names) { writeGlbFrame(path, frameParts(w, names)); },
+             py::arg("path"), py::arg("names") = std::vector<std::string>{}, "One glTF 2 binary frame (.glb).");
+
+    py::class_<VtkSeries>(m, "VtkSeries", "VTK frames and their .pvd collection (ParaView opens the .pvd as a time series).")
+        .def(py::init<std::filesystem::path, std::string>(), py::arg("directory"), py::arg("stem") = "frames")
+        .def("write", [](VtkSeries& s, const World& w, const std::vector<std::string>& names) { return s.write(w.time(), frameParts(w, names)); },
+             py::arg("world"), py::arg("names") = std::vector<std::string>{}, "Writes the world's frame at its time; returns the .vtp path.")
+        .def_property_readonly("collection", &VtkSeries::collection);
+
+    // --- Scenes ---
+    py::class_<Scene>(m, "Scene", "A scene file's world, parts, assembly rules and actions.")
+        .def_readonly("source", &Scene::source)
+        .def_readwrite("duration", &Scene::duration)
+        .def_property_readonly("part_names", [](const Scene& s) {
+            std::vector<std::string> names;
+            for (const ScenePart& p : s.parts) names.push_back(p.name);
+            return names;
+        })
+        .def_property_readonly("time_step", [](const Scene& s) { return s.world.timeStep; })
+        .def_property_readonly("warnings", [](const Scene& s) {
+            std::vector<std::string> out;
+            for (const SceneWarning& w : s.warnings) out.push_back(w.message);
+            return out;
+        });
+    m.def("load_scene", [](const std::filesystem::path& path, bool strict) { return loadScene(path, SceneReadOptions{strict}); }, py::arg("path"),
+          py::arg("strict") = false, "Reads a scene file (TOML). Raises InputError naming the file, line and key.");
+
+    py::class_<SceneRun>(m, "SceneRun", "A scene's world driven by its scripted actions (what `flexfit run` steps).")
+        .def(py::init<const Scene&>(), py::arg("scene"))
+        .def("step", [](SceneRun& r, int steps) {
+            py::gil_scoped_release release;
+            for (int i = 0; i < steps; ++i) r.step();
+        }, py::arg("steps") = 1, "The actions due, then a world step (the GIL is released meanwhile).")
+        .def_property_readonly("world", [](SceneRun& r) { return &r.world(); }, py::return_value_policy::reference_internal)
+        .def("finished", &SceneRun::finished)
+        .def("body", [](const SceneRun& r, const std::string& name) {
+            const auto id = r.scene().find(name);
+            if (!id) throw InputError(r.scene().source, 0, "no part named '" + name + "'");
+            return *id;
+        }, py::arg("name"), "The body id of a part by its scene name.");
+
+    m.def("run_scene", [](const std::filesystem::path& path, std::optional<std::filesystem::path> out, std::optional<double> duration, std::optional<double> vtkEvery,
+                          std::optional<double> glbEvery) {
+        const Scene scene = loadScene(path);
+        cli::RunOptions options;
+        options.duration = duration;
+        options.out = out.value_or(std::filesystem::path());
+        options.progress = false;
+        options.vtkEvery = vtkEvery;
+        options.glbEvery = glbEvery;
+        cli::RunSummary s;
+        {
+            py::gil_scoped_release release;
+            s = cli::runScene(scene, options);
+        }
+        return summaryObject(scene, s);
+    }, py::arg("path"), py::arg("out") = py::none(), py::arg("duration") = py::none(), py::arg("vtk_every") = py::none(), py::arg("glb_every") = py::none(),
+          "Runs a scene file as `flexfit run` does; returns its summary (a dict, as summary.json), and with `out` writes the same files.");
+
+    // --- Sweeps ---
+    py::class_<Sweep>(m, "Sweep", "A sweep file: a base scene, the parameters to vary, every combination a run.")
+        .def_property_readonly("file", [](const Sweep& s) { return s.file; })
+        .def_property_readonly("scene", [](const Sweep& s) { return s.scene; })
+        .def_property_readonly("parameter_names", [](const Sweep& s) {
+            std::vector<std::string> names;
+            for (const SweepParameter& p : s.parameters) names.push_back(p.name);
+            return names;
+        })
+        .def_property_readonly("run_ids", [](const Sweep& s) {
+            std::vector<std::string> ids;
+            for (const SweepRun& r : s.runs) ids.push_back(r.id);
+            return ids;
+        })
+        .def("labels", &Sweep::labels, py::arg("run"), "The run's value label for each parameter.")
+        .def("scene_of", [](const Sweep& s, std::size_t run) { return sweepScene(s, run); }, py::arg("run"))
+        .def("__len__", [](const Sweep& s) { return s.runs.size(); });
+    m.def("load_sweep", &loadSweep, py::arg("path"), "Reads a sweep file and checks every run's scene.");
+    m.def("missing_sweep_runs", &cli::missingSweepRuns, py::arg("sweep"), py::arg("out"), "Indices of the runs without results under `out`.");
+    m.def("run_sweep_run", [](const Sweep& s, std::size_t run, const std::filesystem::path& out) {
+        py::gil_scoped_release release;
+        return cli::runSweepRun(s, run, out);
+    }, py::arg("sweep"), py::arg("run"), py::arg("out"), "Runs one run into out/runs/<id>/ (False: it was already done).");
+    m.def("write_sweep_table", &cli::writeSweepTable, py::arg("sweep"), py::arg("out"), "Writes out/results.csv from every run's row.");
+    m.def("run_sweep_threads", [](const Sweep& s, const std::filesystem::path& out, int jobs) {
+        py::gil_scoped_release release;
+        return cli::runSweep(s, out, jobs, false);
+    }, py::arg("sweep"), py::arg("out"), py::arg("jobs"), "What `flexfit sweep` does: the missing runs on threads, then the table.");
+}

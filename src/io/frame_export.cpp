@@ -1,0 +1,172 @@
+// VTK XML PolyData, .pvd collections and glTF binary frames (frame_export.hpp).
+#include "flexfit/frame_export.hpp"
+
+#include <assimp/Exporter.hpp>
+#include <assimp/scene.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace flexfit {
+namespace {
+
+// Writes `text` to `file` through a temporary beside it, renamed when whole.
+void writeWhole(const std::filesystem::path& file, const std::string& text) {
+    const std::filesystem::path temporary = file.string() + ".partial";
+    {
+        std::ofstream out(temporary, std::ios::binary);
+        out << text;
+        if (!out) {
+            std::error_code ec;
+            std::filesystem::remove(temporary, ec);
+            throw InputError(file.string(), 0, "cannot write the file");
+        }
+    }
+    std::error_code ec;
+    std::filesystem::rename(temporary, file, ec);
+    if (ec) throw InputError(file.string(), 0, "cannot write the file: " + ec.message());
+}
+
+void checkParts(const std::vector<FramePart>& parts, const std::filesystem::path& file) {
+    if (parts.empty()) throw InputError(file.string(), 0, "no parts to write");
+    for (const FramePart& p : parts)
+        if (!p.part) throw InputError(file.string(), 0, "part '" + p.name + "' is null");
+}
+
+std::string xmlEscaped(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        switch (c) {
+        case '&': out += "&amp;"; break;
+        case '<': out += "&lt;"; break;
+        case '>': out += "&gt;"; break;
+        case '"': out += "&quot;"; break;
+        default: out += c;
+        }
+    }
+    return out;
+}
+
+// %.17g: doubles written so they read back bit for bit.
+void appendVectors(std::ostringstream& out, const std::vector<Vec3>& values) {
+    char buffer[96];
+    for (const Vec3& v : values) {
+        std::snprintf(buffer, sizeof buffer, "%.17g %.17g %.17g\n", v.x(), v.y(), v.z());
+        out << buffer;
+    }
+}
+
+void appendPiece(std::ostringstream& out, const FramePart& named) {
+    const Part& part = *named.part;
+    const PartModel& model = part.model();
+    const std::size_t n = model.massCount();
+    const auto& faces = model.mesh.faces;
+    std::vector<Vec3> points, displacement(n), velocity(n);
+    part.worldPositions(points);
+    for (std::size_t m = 0; m < n; ++m) {
+        displacement[m] = part.pose().rotate(part.state().positions[m] - model.restPositions[m]);
+        velocity[m] = part.pose().rotate(part.state().velocities[m]);
+    }
+    std::vector<int> depth;
+    part.zoneDepths(depth);
+    out << "<Piece Name=\"" << xmlEscaped(named.name) << "\" NumberOfPoints=\"" << n << "\" NumberOfPolys=\"" << faces.size() << "\">\n";
+    out << "<PointData Scalars=\"zone_depth\" Vectors=\"displacement\">\n";
+    out << "<DataArray type=\"Int32\" Name=\"zone_depth\" format=\"ascii\">\n";
+    for (int d : depth) out << d << "\n";
+    out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    appendVectors(out, displacement);
+    out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    appendVectors(out, velocity);
+    out << "</DataArray>\n</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    appendVectors(out, points);
+    out << "</DataArray>\n</Points>\n<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+    for (const Face& f : faces) out << f[0] << " " << f[1] << " " << f[2] << "\n";
+    out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+    for (std::size_t i = 1; i <= faces.size(); ++i) out << 3 * i << "\n";
+    out << "</DataArray>\n</Polys>\n</Piece>\n";
+}
+
+}  // namespace
+
+void writeVtkFrame(const std::filesystem::path& file, const std::vector<FramePart>& parts) {
+    checkParts(parts, file);
+    std::ostringstream out;
+    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n";
+    for (const FramePart& p : parts) appendPiece(out, p);
+    out << "</PolyData>\n</VTKFile>\n";
+    writeWhole(file, out.str());
+}
+
+void writeGlbFrame(const std::filesystem::path& file, const std::vector<FramePart>& parts) {
+    checkParts(parts, file);
+    aiScene scene;  // owns everything below (its destructor frees meshes, materials and nodes)
+    scene.mRootNode = new aiNode("flexfit");
+    scene.mNumMaterials = 1;
+    scene.mMaterials = new aiMaterial*[1]{new aiMaterial()};
+    scene.mNumMeshes = unsigned(parts.size());
+    scene.mMeshes = new aiMesh*[parts.size()]{};
+    scene.mRootNode->mNumChildren = unsigned(parts.size());
+    scene.mRootNode->mChildren = new aiNode*[parts.size()]{};
+    std::vector<Vec3> world;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        const Part& part = *parts[i].part;
+        part.drawnWorldPositions(world);
+        const auto& faces = part.model().drawnMesh().faces;
+        auto* mesh = new aiMesh();
+        scene.mMeshes[i] = mesh;
+        mesh->mName = parts[i].name;
+        mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+        mesh->mNumVertices = unsigned(world.size());
+        mesh->mVertices = new aiVector3D[world.size()];
+        for (std::size_t v = 0; v < world.size(); ++v) mesh->mVertices[v] = aiVector3D(ai_real(world[v].x()), ai_real(world[v].y()), ai_real(world[v].z()));
+        mesh->mNumFaces = unsigned(faces.size());
+        mesh->mFaces = new aiFace[faces.size()];
+        for (std::size_t f = 0; f < faces.size(); ++f) {
+            mesh->mFaces[f].mNumIndices = 3;
+            mesh->mFaces[f].mIndices = new unsigned[3]{faces[f][0], faces[f][1], faces[f][2]};
+        }
+        auto* node = new aiNode(parts[i].name);
+        node->mParent = scene.mRootNode;
+        node->mNumMeshes = 1;
+        node->mMeshes = new unsigned[1]{unsigned(i)};
+        scene.mRootNode->mChildren[i] = node;
+    }
+    Assimp::Exporter exporter;
+    const std::filesystem::path temporary = file.string() + ".partial";
+    if (exporter.Export(&scene, "glb2", temporary.string()) != AI_SUCCESS) {
+        std::error_code ec;
+        std::filesystem::remove(temporary, ec);
+        throw InputError(file.string(), 0, std::string("cannot write the glTF file: ") + exporter.GetErrorString());
+    }
+    std::error_code ec;
+    std::filesystem::rename(temporary, file, ec);
+    if (ec) throw InputError(file.string(), 0, "cannot write the file: " + ec.message());
+}
+
+void writeVtkCollection(const std::filesystem::path& file, const std::vector<std::pair<double, std::string>>& frames) {
+    std::ostringstream pvd;
+    pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n<Collection>\n";
+    char line[64];
+    for (const auto& [t, f] : frames) {
+        std::snprintf(line, sizeof line, "%.17g", t);
+        pvd << "<DataSet timestep=\"" << line << "\" part=\"0\" file=\"" << xmlEscaped(f) << "\"/>\n";
+    }
+    pvd << "</Collection>\n</VTKFile>\n";
+    writeWhole(file, pvd.str());
+}
+
+VtkSeries::VtkSeries(std::filesystem::path directory, std::string stem)
+    : directory_(std::move(directory)), collection_(directory_ / (stem + ".pvd")), stem_(std::move(stem)) {}
+
+std::filesystem::path VtkSeries::write(double time, const std::vector<FramePart>& parts) {
+    char name[64];
+    std::snprintf(name, sizeof name, "_%06zu.vtp", frames_.size());
+    const std::string file = stem_ + name;
+    writeVtkFrame(directory_ / file, parts);
+    frames_.emplace_back(time, file);
+    writeVtkCollection(collection_, frames_);
+    return directory_ / file;
+}
+
+}  // namespace flexfit

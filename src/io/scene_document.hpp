@@ -1,0 +1,16 @@
+// The scene reader on a parsed TOML document (scene_file.cpp), for callers that build or edit
+// the document first: the sweeps (sweep.cpp) set their parameters' values in a copy of the
+// base scene's document. A value without a source region (one set by a sweep) is reported at
+// line 0; the sweep names its own line instead.
+#pragma once
+
+#include "flexfit/scene_file.hpp"
+
+#include <toml++/toml.h>
+
+namespace flexfit::detail {
+
+Scene readSceneDocument(const toml::table& document, const std::string& source, const std::filesystem::path& baseDirectory,
+                        const SceneReadOptions& options);
+
+}  // namespace flexfit::detail

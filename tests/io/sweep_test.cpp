@@ -1,0 +1,157 @@
+// Sweep files (src/io/sweep.cpp): the product of the parameters, each run's scene, stable ids,
+// and errors that name the sweep file and line.
+#include "flexfit/scene_file.hpp"
+#include "flexfit/sweep.hpp"
+#include "temp_dir.hpp"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+namespace flexfit {
+namespace {
+
+using testing::TempDir;
+
+constexpr const char* kScene = R"(
+[world]
+time_step = 0.001
+duration = 1.0
+
+[[part]]
+name = "mouth"
+generator = { type = "torus", major = 10, minor = 2.5, u = 12, v = 8 }
+mode = "rigid-deformable"
+static_friction = 0.1
+
+[[part]]
+name = "ball"
+generator = { type = "sphere", radius = 3, level = 1 }
+motion = "dynamic"
+position = [0, 6, 0]
+
+[[action]]
+time = 0.0
+type = "push"
+part = "ball"
+force = [0, -10, 0]
+duration = 0.5
+)";
+
+std::string sweepText(const std::string& parameters) { return "scene = \"scene.toml\"\nduration = 0.25\n" + parameters; }
+
+Sweep load(TempDir& dir, const std::string& parameters) {
+    dir.write("scene.toml", kScene);
+    return loadSweep(dir.write("sweep.toml", sweepText(parameters)));
+}
+
+TEST(Sweep, RunsAreTheProductFirstParameterSlowest) {
+    TempDir dir;
+    const Sweep s = load(dir, R"(
+[[parameter]]
+name = "radius"
+key = "part.ball.generator.radius"
+values = [2.0, 3.0]
+[[parameter]]
+name = "push"
+key = "action.0.force.1"
+range = { start = -10, stop = -30, count = 3 }
+)");
+    ASSERT_EQ(s.runs.size(), 6u);
+    EXPECT_EQ(s.labels(0), (std::vector<std::string>{"2.0", "-10.0"}));
+    EXPECT_EQ(s.labels(1), (std::vector<std::string>{"2.0", "-20.0"}));
+    EXPECT_EQ(s.labels(5), (std::vector<std::string>{"3.0", "-30.0"}));
+    std::set<std::string> ids;
+    for (const SweepRun& r : s.runs) ids.insert(r.id);
+    EXPECT_EQ(ids.size(), 6u);
+    const Scene fifth = sweepScene(s, 4);  // radius 3, push -20 (an element of the force array)
+    EXPECT_EQ(fifth.actions[0].force, Vec3(0, -20, 0));
+}
+
+TEST(Sweep, EachRunsSceneHoldsItsValuesAndTheRestOfTheBase) {
+    TempDir dir;
+    const Sweep s = load(dir, R"(
+[[parameter]]
+name = "friction"
+key = ["part.ball.static_friction", "part.mouth.static_friction"]
+values = [[0.0, 0.0], [0.5, 0.7]]
+labels = ["none", "some"]
+[[parameter]]
+name = "mode"
+key = "part.1.mode"
+values = ["rigid", "full-deformable"]
+)");
+    ASSERT_EQ(s.runs.size(), 4u);
+    const Scene base = loadScene(dir.path() / "scene.toml");
+    const Scene last = sweepScene(s, 3);
+    EXPECT_DOUBLE_EQ(last.parts[1].body.staticFriction, 0.5);
+    EXPECT_DOUBLE_EQ(last.parts[0].body.staticFriction, 0.7);
+    EXPECT_EQ(last.parts[1].part.mode, PartMode::FullDeformable);
+    EXPECT_DOUBLE_EQ(last.duration, 0.25);  // the sweep's
+    EXPECT_EQ(last.parts[0].part.mode, base.parts[0].part.mode);
+    EXPECT_EQ(last.parts[1].pose.translation, base.parts[1].pose.translation);
+    EXPECT_EQ(last.actions.size(), base.actions.size());
+    const Scene first = sweepScene(s, 0);
+    EXPECT_DOUBLE_EQ(first.parts[1].body.staticFriction, 0.0);
+    EXPECT_EQ(first.parts[1].part.mode, PartMode::Rigid);
+    EXPECT_EQ(s.labels(2), (std::vector<std::string>{"some", "rigid"}));
+}
+
+TEST(Sweep, IdsDependOnValuesNotOnPositions) {
+    TempDir dir;
+    const Sweep small = load(dir, "[[parameter]]\nname = \"r\"\nkey = \"part.ball.generator.radius\"\nvalues = [2.0, 3.0]\n");
+    const Sweep large = load(dir, "[[parameter]]\nname = \"r\"\nkey = \"part.ball.generator.radius\"\nvalues = [1.5, 3.0, 2.0]\n");
+    EXPECT_EQ(small.runs[0].id, large.runs[2].id);  // radius 2
+    EXPECT_EQ(small.runs[1].id, large.runs[1].id);  // radius 3
+    const Sweep renamed = load(dir, "[[parameter]]\nname = \"radius\"\nkey = \"part.ball.generator.radius\"\nvalues = [2.0, 3.0]\n");
+    EXPECT_NE(small.runs[0].id, renamed.runs[0].id);
+}
+
+void expectError(const std::string& parameters, std::size_t line, const std::string& words) {
+    TempDir dir;
+    try {
+        load(dir, parameters);
+        FAIL() << "no error for: " << parameters;
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.line(), line) << e.what();
+        EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+        EXPECT_NE(e.source().find("sweep.toml"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Sweep, ErrorsNameTheSweepFileAndLine) {
+    // The sweep text starts with two lines (scene, duration): [[parameter]] is on line 3.
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"part.nobody.density\"\nvalues = [1.0]\n", 3, "no element 'nobody'");
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"world.nothing.deeper\"\nvalues = [1.0]\n", 3, "has no 'nothing'");
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"part.ball.density\"\nvalues = [-1.0]\n", 3, "density");
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"part.ball.densty\"\nvalues = [1.0]\n", 3, "densty");
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"part.ball.density\"\nvalues = [1.0, 1.0]\n", 3, "listed twice");
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"part.ball.density\"\nvalues = [1.0]\nlabels = [\"a\", \"b\"]\n", 7, "2 labels for 1 values");
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"part.ball.density\"\nrange = { start = 1, stop = 2, count = 0 }\n", 6, "count");
+    expectError("[[parameter]]\nname = \"x\"\nkey = [\"part.ball.density\", \"part.mouth.density\"]\nvalues = [1.0]\n", 3, "one per key");
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"part.ball.density\"\n", 3, "either 'values'");
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"part.ball.density\"\nvalues = [1.0]\nstep = 2\n", 7, "unknown key 'step'");
+    expectError("[[parameter]]\nname = \"x\"\nkey = \"part.ball.density\"\nvalues = [1.0]\n[[parameter]]\nname = \"x\"\nkey = \"world.duration\"\nvalues = [1.0]\n",
+                7, "used twice");
+    expectError("bogus = 1\n", 3, "unknown key 'bogus'");
+}
+
+TEST(Sweep, MissingBaseSceneIsAnError) {
+    TempDir dir;
+    try {
+        loadSweep(dir.write("sweep.toml", "scene = \"absent.toml\"\n"));
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("absent.toml"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Sweep, NoParametersIsOneRunOfTheBase) {
+    TempDir dir;
+    const Sweep s = load(dir, "");
+    ASSERT_EQ(s.runs.size(), 1u);
+    EXPECT_EQ(sweepScene(s, 0).parts.size(), 2u);
+}
+
+}  // namespace
+}  // namespace flexfit

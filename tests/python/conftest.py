@@ -1,0 +1,28 @@
+"""The module under test comes from the build tree (PYTHONPATH, set by ctest); the command's
+path and the examples' directory come from the environment too."""
+
+import os
+import pathlib
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture
+def examples():
+    return ROOT / "examples"
+
+
+@pytest.fixture
+def flexfit_exe():
+    exe = os.environ.get("FLEXFIT_EXE")
+    if not exe:
+        pytest.skip("FLEXFIT_EXE not set (run through ctest)")
+    return exe
+
+
+def pytest_configure(config):
+    # Dask's local cluster starts tornado's loop the way tornado 6.2 deprecates (Debian 12's
+    # python3-distributed 2022.12): not ours to fix.
+    config.addinivalue_line("filterwarnings", "ignore:make_current is deprecated:DeprecationWarning")

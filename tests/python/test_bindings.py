@@ -1,0 +1,155 @@
+"""The bindings against the C++ library: every binding used at least once, NumPy views alias
+the C++ state, errors carry file and line, step() releases the GIL."""
+
+import gc
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import flexfit
+
+
+def ball_on_torus():
+    world = flexfit.World(time_step=1e-3, gravity=[0, -9.81, 0])
+    mouth = flexfit.PartModel(flexfit.torus(10, 2.5, 32, 12), material="elastic")
+    ball = flexfit.PartModel(flexfit.sphere(8.5, 2))
+    m = world.add(mouth, mode="rigid-deformable", motion="static", contact_level=3)
+    b = world.add(ball, mode="rigid", motion="dynamic", position=[0, 4.7, 0], density=0.01)
+    return world, m, b
+
+
+def test_meshes_from_arrays_files_and_generators(tmp_path):
+    mesh = flexfit.Mesh(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]]), np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]), "tet")
+    assert mesh.vertices.shape == (4, 3) and mesh.faces.shape == (4, 3) and mesh.name == "tet"
+    flexfit.write_mesh(mesh, str(tmp_path / "tet.obj"))
+    back, warnings = flexfit.read_mesh(str(tmp_path / "tet.obj"))
+    assert back.faces.shape == (4, 3) and warnings == []
+    np.testing.assert_allclose(np.sort(back.vertices, axis=0), np.sort(mesh.vertices, axis=0))
+    for m, vertices in [(flexfit.box([1, 2, 3], 2), 26), (flexfit.heart(), 7349), (flexfit.container_mouth(), 64 * 24)]:
+        assert m.vertices.shape == (vertices, 3)
+    remeshed, quality = flexfit.remesh(flexfit.torus(10, 2.5, 64, 24), 1.5)
+    assert quality["min_angle_degrees"] > 20 and quality["hausdorff_share"] < 0.01
+    assert "Mesh" in repr(remeshed)
+    with pytest.raises(flexfit.InputError):
+        flexfit.Mesh(np.zeros((3, 3)), np.array([[0, 1, 5]]))
+
+
+def test_part_alone_views_alias_the_state():
+    model = flexfit.PartModel(flexfit.torus(2, 0.5, 12, 8), springs=(0.1, 0.01), vertex_mass=1.0)
+    assert model.mass_count == 96 and model.spring_count == 288
+    np.testing.assert_array_equal(model.rest_positions, model.mesh.vertices)
+    part = flexfit.Part(model, mode="rigid-deformable")
+    positions = part.positions
+    assert not positions.flags.writeable and positions.flags.c_contiguous is True
+    with pytest.raises(ValueError):
+        positions[0, 0] = 1.0
+    address = positions.__array_interface__["data"][0]
+    before = positions[5].copy()
+    zone = part.open_zone(5, 2)
+    part.apply_force(5, [0, 0.5, 0])
+    part.kick_mass(6, [0, 0.1, 0])
+    for _ in range(10):
+        part.step()
+    # The same memory, now holding the moved mass: a view, not a copy.
+    assert part.positions.__array_interface__["data"][0] == address
+    assert positions[5, 1] > before[1]
+    assert zone >= 0 and part.zone_count == 1 and part.time == pytest.approx(0.01)
+    depths = part.zone_depths
+    assert depths[5] == 0 and depths.max() >= 1 and (depths >= 0).sum() == len(part.moving_masses)
+    assert set(part.moving_masses) == set(np.nonzero(depths >= 0)[0])
+    assert np.abs(part.velocities).max() > 0
+    np.testing.assert_allclose(part.world_positions(), part.positions)  # identity pose
+    assert part.mode == "rigid-deformable" and part.model.mass_count == 96
+    assert isinstance(part.state_hash(), int) and part.pose["rotation_wxyz"][0] == 1
+
+
+def test_views_keep_their_owner_alive():
+    world, m, _ = ball_on_torus()
+    positions = world.part(m).positions
+    expected = positions.copy()
+    del world
+    gc.collect()
+    np.testing.assert_array_equal(positions, expected)  # the world lives while its view does
+
+
+def test_world_contacts_grab_coupling_and_events(tmp_path):
+    world, m, b = ball_on_torus()
+    assert world.body_count == 2
+    for _ in range(250):  # a force lasts one step
+        world.apply_force(b, [0, -2500, 0])
+        world.step()
+    assert world.step_count == 250 and world.time == pytest.approx(0.25)
+    contacts = world.contacts()
+    assert contacts and {"point", "normal", "depth", "mass_b"} <= set(contacts[0])
+    assert world.part(m).zone_count > 0
+    world.grab(b, frequency=10.0)
+    world.set_grab_target([0, 8, 0])
+    world.step(50)
+    coupling = world.coupling()
+    assert coupling["active"] and coupling["body"] == b and np.linalg.norm(coupling["force"]) > 0
+    world.release()
+    world.set_velocity(b, [0, 0, 0])
+    world.apply_mass_force(m, 3, [0, 1, 0])
+    world.kick_mass(m, 4, [0, 0.1, 0])
+    assert world.open_zone(m, 7, 1) >= 0
+    world.step()
+    profile = world.profile()
+    assert set(profile["last_seconds"]) >= {"narrow_phase", "zone_dynamics"} and profile["steps"] == 301
+    assert world.pose(b)["position"].shape == (3,) and world.centre_of_mass(b).shape == (3,)
+    assert world.assembly_events() == []
+    assert isinstance(world.state_hash(), int)
+    world.write_vtk(str(tmp_path / "w.vtp"), ["mouth", "ball"])
+    world.write_glb(str(tmp_path / "w.glb"))
+    assert (tmp_path / "w.vtp").stat().st_size > 0 and (tmp_path / "w.glb").stat().st_size > 0
+    with pytest.raises(flexfit.InputError):
+        world.write_vtk(str(tmp_path / "x.vtp"), ["only one name"])
+
+
+def test_scene_errors_carry_file_and_line(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[world]\ntime_step = 0.001\n\n[[part]]\nname = "p"\ngenerator = "torus1"\nmodee = "rigid"\n')
+    with pytest.raises(flexfit.InputError) as error:
+        flexfit.load_scene(str(bad))
+    assert error.value.source == str(bad) and error.value.line == 7 and "modee" in error.value.problem
+    assert str(bad) in str(error.value) and ":7:" in str(error.value)
+    assert isinstance(error.value, ValueError)
+    with pytest.raises(flexfit.InputError):
+        flexfit.World(time_step=-1.0)
+    with pytest.raises(flexfit.InputError):
+        flexfit.World().add(flexfit.PartModel(flexfit.sphere(1, 1)), mode="bendy")
+
+
+def test_divergence_is_an_exception():
+    world = flexfit.World()
+    torus = world.add(flexfit.PartModel(flexfit.torus(10, 2.5, 24, 24)), mode="rigid-deformable")
+    with pytest.raises(flexfit.DivergenceError) as error:
+        for _ in range(10):
+            world.apply_mass_force(torus, 100, [0, 1e300, 0])
+            world.step()
+    assert error.value.body == torus and error.value.time >= 0
+    assert "diverged" in str(error.value) and error.value.problem
+
+
+def test_step_releases_the_gil(examples):
+    runs = [flexfit.SceneRun(flexfit.load_scene(str(examples / "ball_torus.toml"))) for _ in range(2)]
+    # While one thread is inside step(), this thread keeps running Python: with the GIL held it
+    # would be blocked for the whole call and count next to nothing.
+    worker = threading.Thread(target=runs[0].step, args=(1500,))
+    worker.start()
+    count = 0
+    while worker.is_alive():
+        count += 1
+    worker.join()
+    assert count > 1000, count
+    # Two threads stepping two worlds at once give the same run as one alone.
+    threads = [threading.Thread(target=r.step, args=(600,)) for r in runs]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    alone = flexfit.SceneRun(flexfit.load_scene(str(examples / "ball_torus.toml")))
+    alone.step(2100)
+    assert runs[0].world.state_hash() == alone.world.state_hash()
+    assert runs[1].world.step_count == 600
