@@ -182,7 +182,7 @@ PYBIND11_MODULE(_flexfit, m) {
     py::class_<TriMesh>(m, "Mesh", "A triangle mesh: vertices (n, 3) and faces (m, 3), counter-clockwise seen from outside.")
         .def(py::init(&meshFromArrays), py::arg("vertices"), py::arg("faces"), py::arg("name") = "mesh",
              "A mesh from arrays (copied); faces index the vertices from 0.")
-        .def_readwrite("name", &TriMesh::name)
+        .def_readwrite("name", &TriMesh::name, "The mesh's name (from its file, or given).")
         .def_property_readonly("vertices", [](py::object self) { return vec3View(self.cast<const TriMesh&>().vertices, self); },
                                "Vertex positions, a read-only (n, 3) view.")
         .def_property_readonly("faces", [](py::object self) {
@@ -237,8 +237,8 @@ PYBIND11_MODULE(_flexfit, m) {
              }),
              py::arg("mesh"), py::arg("material") = py::none(), py::arg("springs") = py::none(), py::arg("vertex_mass") = 1.0,
              "Builds a model from a mesh: material a preset name ('elastic'), or springs=(stiffness, damping); vertex_mass in kg.")
-        .def_property_readonly("mass_count", &PartModel::massCount)
-        .def_property_readonly("spring_count", [](const PartModel& model) { return model.springCount(); })
+        .def_property_readonly("mass_count", &PartModel::massCount, "Number of masses (the mesh's vertices).")
+        .def_property_readonly("spring_count", [](const PartModel& model) { return model.springCount(); }, "Number of springs (edges, and bending springs of a physical material).")
         .def_property_readonly("mesh", [](py::object self) { return py::cast(&self.cast<const PartModel&>().mesh, py::return_value_policy::reference_internal, self); },
                                "The simulation mesh (rest shape, part frame).")
         .def_property_readonly("rest_positions", [](py::object self) { return vec3View(self.cast<const PartModel&>().restPositions, self); },
@@ -251,8 +251,8 @@ PYBIND11_MODULE(_flexfit, m) {
                  return Part(model, s);
              }),
              py::arg("model"), py::arg("mode") = "rigid-deformable", "A part stepped on its own (without a world).")
-        .def_property_readonly("mode", [](const Part& p) { return std::string(toString(p.mode())); })
-        .def_property_readonly("model", [](const Part& p) { return std::const_pointer_cast<PartModel>(p.sharedModel()); })
+        .def_property_readonly("mode", [](const Part& p) { return std::string(toString(p.mode())); }, "rigid, rigid-deformable or full-deformable.")
+        .def_property_readonly("model", [](const Part& p) { return std::const_pointer_cast<PartModel>(p.sharedModel()); }, "The part's model (shared, immutable).")
         .def_property_readonly("positions", [](py::object self) { return vec3View(self.cast<const Part&>().state().positions, self); },
                                "Mass positions in the part frame, a read-only (n, 3) view of the state (non-moving masses at rest).")
         .def_property_readonly("velocities", [](py::object self) { return vec3View(self.cast<const Part&>().state().velocities, self); },
@@ -269,9 +269,9 @@ PYBIND11_MODULE(_flexfit, m) {
             p.worldPositions(w);
             return vec3Copy(w);
         }, "Mass positions in the world, a new (n, 3) array.")
-        .def_property_readonly("zone_count", &Part::zoneCount)
-        .def_property_readonly("time", &Part::time)
-        .def_property_readonly("pose", [](const Part& p) { return poseDict(p.pose()); })
+        .def_property_readonly("zone_count", &Part::zoneCount, "Zones open on the part.")
+        .def_property_readonly("time", &Part::time, "The part's simulated time (s).")
+        .def_property_readonly("pose", [](const Part& p) { return poseDict(p.pose()); }, "The part's pose: {'position', 'rotation_wxyz'} (part frame to world).")
         .def("open_zone", [](Part& p, Index mass, int level) { return p.openZone(ZoneSeed::mass(mass), level); }, py::arg("mass"), py::arg("level"),
              "Opens a zone of `level` rings around a mass; returns its id.")
         .def("apply_force", &Part::applyForce, py::arg("mass"), py::arg("force"), "A world-frame force on one mass for the next step.")
@@ -304,15 +304,15 @@ PYBIND11_MODULE(_flexfit, m) {
         }, py::arg("model"), py::arg("mode") = "rigid", py::arg("motion") = "static", py::arg("position") = Vec3::Zero(),
              py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0), py::arg("density") = 1.0, py::arg("friction") = 0.0, py::arg("contact_level") = 2,
              "Adds a part; returns its body id. mode: rigid, rigid-deformable, full-deformable; motion: static, kinematic, dynamic.")
-        .def_property_readonly("body_count", &World::bodyCount)
+        .def_property_readonly("body_count", &World::bodyCount, "Bodies in the world (ids 0 .. body_count - 1).")
         .def("part", [](World& w, BodyId id) { return &w.part(id); }, py::arg("id"), py::return_value_policy::reference_internal,
              "The body's part (a view that keeps the world alive).")
         .def("step", [](World& w, int steps) {
             py::gil_scoped_release release;
             for (int i = 0; i < steps; ++i) w.step();
         }, py::arg("steps") = 1, "Steps the world (the GIL is released meanwhile).")
-        .def_property_readonly("time", &World::time)
-        .def_property_readonly("step_count", &World::stepCount)
+        .def_property_readonly("time", &World::time, "Simulated time (s).")
+        .def_property_readonly("step_count", &World::stepCount, "Steps taken.")
         .def("contacts", [](const World& w) {
             py::list out;
             for (const Contact& c : w.contacts()) out.append(contactDict(c));
@@ -320,22 +320,24 @@ PYBIND11_MODULE(_flexfit, m) {
         }, "The last step's contacts, as dicts (part_a, part_b, point, normal, depth, ...).")
         .def("profile", [](const World& w) { return profileDict(w.profile()); }, "Per-stage times of the last step and in total (s).")
         .def("state_hash", &World::stateHash, "64-bit FNV-1a of the whole state, bit for bit (equal hashes: the same run).")
-        .def("centre_of_mass", &World::centreOfMass, py::arg("id"))
-        .def("pose", [](const World& w, BodyId id) { return poseDict(w.part(id).pose()); }, py::arg("id"))
+        .def("centre_of_mass", &World::centreOfMass, py::arg("id"), "World position of a body's centre of mass.")
+        .def("pose", [](const World& w, BodyId id) { return poseDict(w.part(id).pose()); }, py::arg("id"), "A body's pose: {'position', 'rotation_wxyz'}.")
         .def("apply_force", &World::applyForce, py::arg("id"), py::arg("force"), "A force at the centre of mass for the next step.")
         .def("apply_mass_force", &World::applyMassForce, py::arg("id"), py::arg("mass"), py::arg("force"), "A world-frame force on one mass.")
-        .def("kick_mass", &World::kickMass, py::arg("id"), py::arg("mass"), py::arg("velocity_change"))
-        .def("set_velocity", &World::setVelocity, py::arg("id"), py::arg("linear"), py::arg("angular") = Vec3::Zero())
+        .def("kick_mass", &World::kickMass, py::arg("id"), py::arg("mass"), py::arg("velocity_change"),
+             "A velocity change on one mass of a deforming part; on a rigid dynamic body, the same momentum as an impulse.")
+        .def("set_velocity", &World::setVelocity, py::arg("id"), py::arg("linear"), py::arg("angular") = Vec3::Zero(),
+             "Sets a dynamic body's velocity (world frame; rad/s for the angular one).")
         .def("open_zone", [](World& w, BodyId id, Index mass, int level) { return w.openZone(id, ZoneSeed::mass(mass), level); }, py::arg("id"),
-             py::arg("mass"), py::arg("level"))
+             py::arg("mass"), py::arg("level"), "Opens a zone on a body's part around a mass (ahead of a contact); returns its id.")
         .def("grab", [](World& w, BodyId id, double frequency) {
             GrabSettings g;
             g.frequency = frequency;
             w.grab(id, g);
         }, py::arg("id"), py::arg("frequency") = 10.0, "The operator grabs a body (a spring-damper coupling of that frequency).")
         .def("set_grab_target", [](World& w, const Vec3& position, const Eigen::Vector4d& rotation) { w.setGrabTarget(makePose(position, rotation)); },
-             py::arg("position"), py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0))
-        .def("release", &World::release)
+             py::arg("position"), py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0), "Moves the pose the operator wants the grabbed body at.")
+        .def("release", &World::release, "The operator lets go of the grabbed body.")
         .def("coupling", [](const World& w) {
             py::dict d;
             d["active"] = w.coupling().active;
@@ -348,7 +350,7 @@ PYBIND11_MODULE(_flexfit, m) {
             py::list out;
             for (const AssemblyEvent& e : w.assemblyEvents()) out.append(eventDict(e));
             return out;
-        })
+        }, "The snaps so far, as dicts (rule, technique, time, from and to poses).")
         .def("write_vtk", [](const World& w, const std::filesystem::path& path, const std::vector<std::string>& names) { writeVtkFrame(path, frameParts(w, names)); },
              py::arg("path"), py::arg("names") = std::vector<std::string>{}, "One VTK PolyData frame (.vtp) with zone_depth, displacement, velocity.")
         .def("write_glb", [](const World& w, const std::filesystem::path& path, const std::vector<std::string>& names) { writeGlbFrame(path, frameParts(w, names)); },
@@ -358,23 +360,23 @@ PYBIND11_MODULE(_flexfit, m) {
         .def(py::init<std::filesystem::path, std::string>(), py::arg("directory"), py::arg("stem") = "frames")
         .def("write", [](VtkSeries& s, const World& w, const std::vector<std::string>& names) { return s.write(w.time(), frameParts(w, names)); },
              py::arg("world"), py::arg("names") = std::vector<std::string>{}, "Writes the world's frame at its time; returns the .vtp path.")
-        .def_property_readonly("collection", &VtkSeries::collection);
+        .def_property_readonly("collection", &VtkSeries::collection, "Path of the .pvd collection.");
 
     // --- Scenes ---
     py::class_<Scene>(m, "Scene", "A scene file's world, parts, assembly rules and actions.")
-        .def_readonly("source", &Scene::source)
-        .def_readwrite("duration", &Scene::duration)
+        .def_readonly("source", &Scene::source, "The scene file (for messages).")
+        .def_readwrite("duration", &Scene::duration, "Seconds a run lasts (the scene's [world] duration).")
         .def_property_readonly("part_names", [](const Scene& s) {
             std::vector<std::string> names;
             for (const ScenePart& p : s.parts) names.push_back(p.name);
             return names;
-        })
-        .def_property_readonly("time_step", [](const Scene& s) { return s.world.timeStep; })
+        }, "Part names in body-id order.")
+        .def_property_readonly("time_step", [](const Scene& s) { return s.world.timeStep; }, "The world's time step (s).")
         .def_property_readonly("warnings", [](const Scene& s) {
             std::vector<std::string> out;
             for (const SceneWarning& w : s.warnings) out.push_back(w.message);
             return out;
-        });
+        }, "The scene's warnings (old spellings, mesh repairs).");
     m.def("load_scene", [](const std::filesystem::path& path, bool strict) { return loadScene(path, SceneReadOptions{strict}); }, py::arg("path"),
           py::arg("strict") = false, "Reads a scene file (TOML). Raises InputError naming the file, line and key.");
 
@@ -384,8 +386,8 @@ PYBIND11_MODULE(_flexfit, m) {
             py::gil_scoped_release release;
             for (int i = 0; i < steps; ++i) r.step();
         }, py::arg("steps") = 1, "The actions due, then a world step (the GIL is released meanwhile).")
-        .def_property_readonly("world", [](SceneRun& r) { return &r.world(); }, py::return_value_policy::reference_internal)
-        .def("finished", &SceneRun::finished)
+        .def_property_readonly("world", [](SceneRun& r) { return &r.world(); }, py::return_value_policy::reference_internal, "The run's world (a view that keeps the run alive).")
+        .def("finished", &SceneRun::finished, "True once every scripted action has run.")
         .def("body", [](const SceneRun& r, const std::string& name) {
             const auto id = r.scene().find(name);
             if (!id) throw InputError(r.scene().source, 0, "no part named '" + name + "'");
@@ -412,21 +414,21 @@ PYBIND11_MODULE(_flexfit, m) {
 
     // --- Sweeps ---
     py::class_<Sweep>(m, "Sweep", "A sweep file: a base scene, the parameters to vary, every combination a run.")
-        .def_property_readonly("file", [](const Sweep& s) { return s.file; })
-        .def_property_readonly("scene", [](const Sweep& s) { return s.scene; })
+        .def_property_readonly("file", [](const Sweep& s) { return s.file; }, "The sweep file.")
+        .def_property_readonly("scene", [](const Sweep& s) { return s.scene; }, "The base scene file.")
         .def_property_readonly("parameter_names", [](const Sweep& s) {
             std::vector<std::string> names;
             for (const SweepParameter& p : s.parameters) names.push_back(p.name);
             return names;
-        })
+        }, "The parameters' names (the table's columns).")
         .def_property_readonly("run_ids", [](const Sweep& s) {
             std::vector<std::string> ids;
             for (const SweepRun& r : s.runs) ids.push_back(r.id);
             return ids;
-        })
+        }, "Every run's id, in the sweep's order.")
         .def("labels", &Sweep::labels, py::arg("run"), "The run's value label for each parameter.")
-        .def("scene_of", [](const Sweep& s, std::size_t run) { return sweepScene(s, run); }, py::arg("run"))
-        .def("__len__", [](const Sweep& s) { return s.runs.size(); });
+        .def("scene_of", [](const Sweep& s, std::size_t run) { return sweepScene(s, run); }, py::arg("run"), "The scene of one run (the base with its values).")
+        .def("__len__", [](const Sweep& s) { return s.runs.size(); }, "Number of runs.");
     m.def("load_sweep", &loadSweep, py::arg("path"), "Reads a sweep file and checks every run's scene.");
     m.def("missing_sweep_runs", &cli::missingSweepRuns, py::arg("sweep"), py::arg("out"), "Indices of the runs without results under `out`.");
     m.def("run_sweep_run", [](const Sweep& s, std::size_t run, const std::filesystem::path& out) {

@@ -4,6 +4,7 @@
 //
 //   scene = "ball_torus.toml"        # the base scene
 //   duration = 2.0                   # optional: overrides the scene's [world] duration
+//   set = { "world.rigid_deformable_query" = "faces" }   # optional: values every run shares
 //   [[parameter]]
 //   name = "friction"                # the column of the results table
 //   key = "part.ball.friction"       # a scene key: tables by name, [[part]] by its name,

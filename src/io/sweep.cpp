@@ -253,7 +253,7 @@ Sweep loadSweep(const std::filesystem::path& file) {
     const std::string name = file.string();
     const toml::table root = parseFile(file, "sweep file");
     for (const auto& [k, v] : root)
-        if (k != "scene" && k != "duration" && k != "parameter") throw InputError(name, lineOf(v), "unknown key '" + std::string(k.str()) + "'");
+        if (k != "scene" && k != "duration" && k != "set" && k != "parameter") throw InputError(name, lineOf(v), "unknown key '" + std::string(k.str()) + "'");
     Sweep sweep;
     sweep.file = file;
     const auto scene = root["scene"].value<std::string>();
@@ -266,6 +266,18 @@ Sweep loadSweep(const std::filesystem::path& file) {
     }
     auto document = std::make_shared<SweepDocument>();
     document->scene = parseFile(sweep.scene, "base scene file");
+    // Values every run shares: set once in the base.
+    if (const toml::node* set = root.get("set")) {
+        const toml::table* t = set->as_table();
+        if (!t) throw InputError(name, lineOf(*set), "'set' must be a table of \"dotted.key\" = value");
+        for (const auto& [key, value] : *t) {
+            try {
+                setKey(document->scene, std::string(key.str()), value);
+            } catch (const std::invalid_argument& e) {
+                throw InputError(name, lineOf(value), std::string("set: ") + e.what());
+            }
+        }
+    }
     std::vector<ParsedParameter> parsed;
     if (const toml::node* list = root.get("parameter")) {
         const toml::array* a = list->as_array();

@@ -20,3 +20,13 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "consumer failed with status '${rc}'")
 endif()
 message("${out}")
+# The installed Python module, when built: importable from the prefix's dist-packages alone.
+if(PYTHON AND PYTHON_SITE)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${WORK_DIR}/prefix/${PYTHON_SITE} PYTHONDONTWRITEBYTECODE=1
+                          ${PYTHON} -c "import flexfit; m = flexfit.PartModel(flexfit.torus(10, 2.5, 24, 24)); print('python consumer:', m.spring_count, 'springs from', flexfit.__file__)"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "python consumer: 1728 springs from ${WORK_DIR}/prefix/")
+    message(FATAL_ERROR "the installed Python module failed (status '${rc}'):\n${out}\n${err}")
+  endif()
+  message("${out}")
+endif()

@@ -136,6 +136,31 @@ TEST(Sweep, ErrorsNameTheSweepFileAndLine) {
     expectError("bogus = 1\n", 3, "unknown key 'bogus'");
 }
 
+TEST(Sweep, SetGivesEveryRunTheSameValues) {
+    TempDir dir;
+    dir.write("scene.toml", kScene);
+    const Sweep s = loadSweep(dir.write("sweep.toml", R"(scene = "scene.toml"
+set = { "world.time_step" = 0.0005, "part.mouth.static_friction" = 0.3 }
+[[parameter]]
+name = "density"
+key = "part.ball.density"
+values = [1.0, 2.0]
+)"));
+    for (std::size_t r = 0; r < 2; ++r) {
+        const Scene scene = sweepScene(s, r);
+        EXPECT_EQ(scene.world.timeStep, 0.0005);
+        EXPECT_EQ(scene.parts[0].body.staticFriction, 0.3);
+        EXPECT_EQ(scene.parts[1].body.density, r == 0 ? 1.0 : 2.0);
+    }
+    try {
+        loadSweep(dir.write("bad.toml", "scene = \"scene.toml\"\n\nset = { \"part.nobody.x\" = 1 }\n"));
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.line(), 3u) << e.what();
+        EXPECT_NE(std::string(e.what()).find("set: no element 'nobody'"), std::string::npos) << e.what();
+    }
+}
+
 TEST(Sweep, MissingBaseSceneIsAnError) {
     TempDir dir;
     try {

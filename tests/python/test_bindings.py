@@ -153,3 +153,56 @@ def test_step_releases_the_gil(examples):
     alone.step(2100)
     assert runs[0].world.state_hash() == alone.world.state_hash()
     assert runs[1].world.step_count == 600
+
+
+def described(obj):
+    """A docstring beyond pybind11's generated signature."""
+    doc = getattr(obj, "__doc__", None) or ""
+    lines = [line for line in doc.splitlines() if line.strip()]
+    if isinstance(obj, (property, type)):
+        return bool(lines)
+    return len(lines) >= 2 or (len(lines) == 1 and "(" not in lines[0])
+
+
+def test_every_binding_has_a_docstring():
+    missing = []
+    for name in dir(flexfit._flexfit):
+        if name.startswith("_"):
+            continue
+        obj = getattr(flexfit._flexfit, name)
+        if not described(obj):
+            missing.append(name)
+        if isinstance(obj, type):
+            for member, value in vars(obj).items():
+                if member.startswith("_") and member != "__len__":
+                    continue
+                if (callable(value) or isinstance(value, property)) and not described(value):
+                    missing.append(f"{name}.{member}")
+    assert missing == []
+
+
+def test_sweep_bindings(tmp_path, examples):
+    sweep = flexfit.load_sweep(str(examples / "sweeps" / "ball_torus_friction.toml"))
+    assert len(sweep) == 12 and sweep.parameter_names == ["diameter", "rim", "friction"]
+    assert sweep.labels(0) == ["14", "rigid", "0"] and len(set(sweep.run_ids)) == 12
+    assert sweep.file.name == "ball_torus_friction.toml" and sweep.scene.name == "ball_torus.toml"
+    scene = sweep.scene_of(11)
+    assert scene.part_names == ["mouth", "ball"] and scene.duration == 2.0 and scene.time_step == 0.001 and scene.warnings == []
+    assert "run " + sweep.run_ids[11] in scene.source
+    out = tmp_path / "out"
+    assert flexfit.missing_sweep_runs(sweep, str(out)) == list(range(12))
+    assert flexfit.run_sweep_run(sweep, 3, str(out)) is True
+    assert flexfit.run_sweep_run(sweep, 3, str(out)) is False  # already done
+    with pytest.raises(flexfit.InputError):
+        flexfit.write_sweep_table(sweep, str(out))  # runs missing
+    ran = flexfit.run_sweep_threads(sweep, str(out), 2)
+    assert ran == [r for r in range(12) if r != 3]
+    table = flexfit.write_sweep_table(sweep, str(out))
+    assert table.read_text().count("\n") == 13
+    series = flexfit.VtkSeries(str(tmp_path / "vtk"), "ball")
+    (tmp_path / "vtk").mkdir()
+    run = flexfit.SceneRun(scene)
+    run.step(10)
+    assert not run.finished()
+    first = series.write(run.world, ["mouth", "ball"])
+    assert first.name == "ball_000000.vtp" and series.collection.name == "ball.pvd"
