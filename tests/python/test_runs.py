@@ -62,8 +62,14 @@ def test_sweep_is_the_same_table_on_one_or_two_workers_and_from_the_command(tmp_
     two = flexfit.sweep(sweep, tmp_path / "two", workers=2)
     one = flexfit.sweep(sweep, tmp_path / "one", workers=1)
     subprocess.run([flexfit_exe, "sweep", str(sweep), "--out", str(tmp_path / "cmd"), "--no-progress"], check=True, capture_output=True)
-    tables = [(tmp_path / d / "results.csv").read_bytes() for d in ("two", "one", "cmd")]
-    assert tables[0] == tables[1] == tables[2]
+    # Any scheduler by its address: here a cluster started apart, as a user's would be.
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        remote = flexfit.sweep(sweep, tmp_path / "remote", scheduler=cluster.scheduler_address)
+    assert len(remote.attrs["ran"]) == 12
+    tables = [(tmp_path / d / "results.csv").read_bytes() for d in ("two", "one", "cmd", "remote")]
+    assert tables[0] == tables[1] == tables[2] == tables[3]
     assert len(two) == 12 and len(two.attrs["ran"]) == 12
     assert list(two.columns[:4]) == ["run", "diameter", "rim", "friction"]
     assert (two["status"] == "ok").all() and two["state_hash"].str.len().eq(16).all()
