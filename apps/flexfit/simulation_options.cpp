@@ -21,7 +21,14 @@ void SimulationOptions::addTo(CLI::App& cmd) {
     auto* t = cmd.add_option("--thickness", shell.thickness, "Physical material: shell thickness (m)")->check(CLI::PositiveNumber);
     auto* rho = cmd.add_option("--density", shell.density, "Physical material: density (kg/m^3)")->check(CLI::PositiveNumber);
     auto* nu = cmd.add_option("--poisson-ratio", shell.poissonRatio, "Physical material: Poisson's ratio [0, 0.5) (bending rigidity)")
-                   ->check(CLI::Range(0.0, 0.4999999))->capture_default_str();
+                   ->check(CLI::Validator(
+                       [](std::string& text) {
+                           double v = 0.0;
+                           if (!CLI::detail::lexical_cast(text, v) || !(v >= 0.0 && v < 0.5)) return std::string("must be in [0, 0.5)");
+                           return std::string();
+                       },
+                       "FLOAT in [0, 0.5)"))
+                   ->capture_default_str();
     auto* zeta = cmd.add_option("--damping-ratio", shell.dampingRatio, "Physical material: damping ratio of each spring")
                      ->check(CLI::NonNegativeNumber)->capture_default_str();
     auto* bend = cmd.add_flag("--bending-springs", shell.bendingSprings, "Physical material: a spring across each interior edge");
