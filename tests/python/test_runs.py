@@ -129,3 +129,17 @@ def test_vtk_frames_load_with_vtks_reader_and_glb_with_assimp(tmp_path, examples
     mesh, _ = flexfit.read_mesh(str(glbs[0]))  # assimp's glTF 2 importer
     assert mesh.faces.shape[0] == sum(flexfit.SceneRun(scene).world.part(i).model.mesh.faces.shape[0] for i in range(len(masses)))
     assert summary["steps"] == 800
+
+
+def test_a_diverged_run_is_a_row_and_the_sweep_goes_on(tmp_path, flexfit_exe):
+    import pandas
+
+    data = pathlib.Path(__file__).resolve().parents[1] / "apps" / "data"
+    subprocess.run([flexfit_exe, "sweep", str(data / "diverging_sweep.toml"), "--out", str(tmp_path), "--no-progress"], check=True,
+                   capture_output=True)
+    table = pandas.read_csv(tmp_path / "results.csv", dtype={"state_hash": str})
+    assert list(table["status"]) == ["ok", "diverged"]
+    assert len(table.columns) == 18 and table["state_hash"].isna().tolist() == [False, True]
+    assert "diverged at t = " in table["message"][1] and "stability bound" in table["message"][1]
+    # The diverged run left only its row (the run's own files are written all or none).
+    assert [p.name for p in (tmp_path / "runs" / table["run"][1]).iterdir()] == ["row.csv"]
