@@ -150,6 +150,67 @@ py::object summaryObject(const Scene& scene, const cli::RunSummary& s) {
     return py::module_::import("json").attr("loads")(cli::summaryJson(scene, s));
 }
 
+
+// A part's and body's settings from keyword arguments named as the scene file's [[part]] keys
+// (scene.hpp); `body` is null for a part alone (it takes `time_step` instead). An unknown key is
+// an InputError naming it; the values are checked where the C++ API checks them.
+void applyPartKeywords(const py::kwargs& keywords, PartSettings& part, BodySettings* body) {
+    SimulationSettings& sim = part.simulation;
+    ZoneSettings& zones = part.zones;
+    std::optional<double> kinetic;
+    for (const auto& [key, value] : keywords) {
+        const std::string k = py::str(key);
+        auto number = [&] { return value.cast<double>(); };
+        auto integer = [&] { return value.cast<int>(); };
+        if (k == "mode") part.mode = enumFrom<PartMode>(value.cast<std::string>(), "mode");
+        else if (k == "integrator") sim.integrator = enumFrom<Integrator>(value.cast<std::string>(), "integrator");
+        else if (k == "implicit_iterations") sim.implicit.maxIterations = integer();
+        else if (k == "implicit_tolerance") sim.implicit.tolerance = number();
+        else if (k == "global_damping") sim.globalDamping = number();
+        else if (k == "restoration") sim.restoration.method = enumFrom<RestorationMethod>(value.cast<std::string>(), "restoration");
+        else if (k == "constraint_fraction") sim.restoration.constraintFraction = number();
+        else if (k == "constraint_rate") sim.restoration.constraintRate = number();
+        else if (k == "anchor_stiffness") sim.restoration.anchorStiffness = number();
+        else if (k == "anchor_damping") sim.restoration.anchorDamping = number();
+        else if (k == "default_level") zones.defaultLevel = integer();
+        else if (k == "contact_level") zones.contactLevel = integer();
+        else if (k == "activity_threshold") zones.activityThreshold = number();
+        else if (k == "rest_speed") zones.restSpeed = number();
+        else if (!body && k == "time_step") sim.timeStep = number();
+        else if (body && k == "motion") body->motion = enumFrom<MotionType>(value.cast<std::string>(), "motion");
+        else if (body && k == "density") body->density = number();
+        else if (body && k == "velocity") body->linearVelocity = value.cast<Vec3>();
+        else if (body && k == "angular_velocity") body->angularVelocity = value.cast<Vec3>();
+        else if (body && k == "thickness") body->thickness = number();
+        else if (body && k == "static_friction") body->staticFriction = number();
+        else if (body && k == "kinetic_friction") kinetic = number();
+        else if (body && k == "restitution") body->restitution = number();
+        else throw InputError(k, 0, "unknown keyword (the scene file's [[part]] keys: mode, motion, density, restoration, anchor_stiffness, ...)");
+    }
+    if (body) body->kineticFriction = kinetic.value_or(body->staticFriction);  // as in scene files
+}
+
+PartModelSettings modelSettings(std::optional<std::string> material, std::optional<std::pair<double, double>> springs, double vertexMass,
+                                std::optional<double> youngsModulus, std::optional<double> thickness, std::optional<double> density,
+                                double poissonRatio, double dampingRatio, bool bendingSprings) {
+    PartModelSettings s;
+    if (int(bool(material)) + int(bool(springs)) + int(bool(youngsModulus)) > 1)
+        throw InputError("material", 0, "give one of material (a preset), springs (stiffness, damping) or youngs_modulus (a physical material)");
+    if (material) {
+        const auto preset = materialPreset(*material);
+        if (!preset) throw InputError("material", 0, "unknown material preset '" + *material + "' (rigid, elastic, superelastic)");
+        s.material = *preset;
+    }
+    if (springs) s.material = Material{springs->first, springs->second};
+    s.vertexMass = vertexMass;
+    if (youngsModulus) {
+        if (!thickness || !density) throw InputError("youngs_modulus", 0, "a physical material needs thickness and density too");
+        s.shell = ShellMaterial{*youngsModulus, poissonRatio, *thickness, *density, dampingRatio, bendingSprings};
+    } else if (thickness || density) {
+        throw InputError(thickness ? "thickness" : "density", 0, "belongs to a physical material: give youngs_modulus too");
+    }
+    return s;
+}
 }  // namespace
 
 PYBIND11_MODULE(_flexfit, m) {
@@ -224,19 +285,17 @@ PYBIND11_MODULE(_flexfit, m) {
 
     // --- Models and parts ---
     py::class_<PartModel, std::shared_ptr<PartModel>>(m, "PartModel", "A part's immutable model: its mesh, masses and springs.")
-        .def(py::init([](TriMesh mesh, std::optional<std::string> material, std::optional<std::pair<double, double>> springs, double vertexMass) {
-                 PartModelSettings s;
-                 if (material) {
-                     const auto preset = materialPreset(*material);
-                     if (!preset) throw InputError("material", 0, "unknown material preset '" + *material + "' (rigid, elastic, superelastic)");
-                     s.material = *preset;
-                 }
-                 if (springs) s.material = Material{springs->first, springs->second};
-                 s.vertexMass = vertexMass;
-                 return std::const_pointer_cast<PartModel>(buildPartModel(std::move(mesh), s));
+        .def(py::init([](TriMesh mesh, std::optional<std::string> material, std::optional<std::pair<double, double>> springs, double vertexMass,
+                         std::optional<double> youngsModulus, std::optional<double> thickness, std::optional<double> density, double poissonRatio,
+                         double dampingRatio, bool bendingSprings) {
+                 return std::const_pointer_cast<PartModel>(buildPartModel(
+                     std::move(mesh), modelSettings(material, springs, vertexMass, youngsModulus, thickness, density, poissonRatio, dampingRatio, bendingSprings)));
              }),
-             py::arg("mesh"), py::arg("material") = py::none(), py::arg("springs") = py::none(), py::arg("vertex_mass") = 1.0,
-             "Builds a model from a mesh: material a preset name ('elastic'), or springs=(stiffness, damping); vertex_mass in kg.")
+             py::arg("mesh"), py::arg("material") = py::none(), py::arg("springs") = py::none(), py::arg("vertex_mass") = 1.0, py::kw_only(),
+             py::arg("youngs_modulus") = py::none(), py::arg("thickness") = py::none(), py::arg("density") = py::none(), py::arg("poisson_ratio") = 0.35,
+             py::arg("damping_ratio") = 0.1, py::arg("bending_springs") = false,
+             "Builds a model from a mesh: material a preset name ('elastic'), or springs=(stiffness, damping) with vertex_mass in kg, or a "
+             "physical material (SI units): youngs_modulus, thickness, density, poisson_ratio, damping_ratio, bending_springs.")
         .def_property_readonly("mass_count", &PartModel::massCount, "Number of masses (the mesh's vertices).")
         .def_property_readonly("spring_count", [](const PartModel& model) { return model.springCount(); }, "Number of springs (edges, and bending springs of a physical material).")
         .def_property_readonly("mesh", [](py::object self) { return py::cast(&self.cast<const PartModel&>().mesh, py::return_value_policy::reference_internal, self); },
@@ -245,12 +304,14 @@ PYBIND11_MODULE(_flexfit, m) {
                                "Rest positions, a read-only (n, 3) view.");
 
     py::class_<Part>(m, "Part", "A part: a rigid body until pressed, then mass-spring-damper zones around the contacts.")
-        .def(py::init([](std::shared_ptr<PartModel> model, const std::string& mode) {
+        .def(py::init([](std::shared_ptr<PartModel> model, const py::kwargs& settings) {
                  PartSettings s;
-                 s.mode = enumFrom<PartMode>(mode, "mode");
+                 applyPartKeywords(settings, s, nullptr);
                  return Part(model, s);
              }),
-             py::arg("model"), py::arg("mode") = "rigid-deformable", "A part stepped on its own (without a world).")
+             py::arg("model"),
+             "A part stepped on its own (without a world). Settings as keywords named as the scene file's [[part]] keys "
+             "(mode='rigid-deformable', restoration, anchor_stiffness, global_damping, integrator, contact_level, ...) and time_step.")
         .def_property_readonly("mode", [](const Part& p) { return std::string(toString(p.mode())); }, "rigid, rigid-deformable or full-deformable.")
         .def_property_readonly("model", [](const Part& p) { return std::const_pointer_cast<PartModel>(p.sharedModel()); }, "The part's model (shared, immutable).")
         .def_property_readonly("positions", [](py::object self) { return vec3View(self.cast<const Part&>().state().positions, self); },
@@ -291,19 +352,16 @@ PYBIND11_MODULE(_flexfit, m) {
                  return std::make_unique<World>(s);
              }),
              py::arg("time_step") = 1e-3, py::arg("gravity") = Vec3(0.0, -9.81, 0.0))
-        .def("add", [](World& w, std::shared_ptr<PartModel> model, const std::string& mode, const std::string& motion, const Vec3& position,
-                       const Eigen::Vector4d& rotation, double density, double friction, int contactLevel) {
+        .def("add", [](World& w, std::shared_ptr<PartModel> model, const Vec3& position, const Eigen::Vector4d& rotation, const py::kwargs& settings) {
             PartSettings part;
-            part.mode = enumFrom<PartMode>(mode, "mode");
-            part.zones.contactLevel = contactLevel;
             BodySettings body;
-            body.motion = enumFrom<MotionType>(motion, "motion");
-            body.density = density;
-            body.staticFriction = body.kineticFriction = friction;
+            applyPartKeywords(settings, part, &body);
             return w.add(model, part, body, makePose(position, rotation));
-        }, py::arg("model"), py::arg("mode") = "rigid", py::arg("motion") = "static", py::arg("position") = Vec3::Zero(),
-             py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0), py::arg("density") = 1.0, py::arg("friction") = 0.0, py::arg("contact_level") = 2,
-             "Adds a part; returns its body id. mode: rigid, rigid-deformable, full-deformable; motion: static, kinematic, dynamic.")
+        }, py::arg("model"), py::arg("position") = Vec3::Zero(), py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0),
+             "Adds a part at a pose (rotation as a quaternion w, x, y, z); returns its body id. Settings as keywords named as the scene "
+             "file's [[part]] keys, with the same defaults: mode ('rigid-deformable'; 'rigid', 'full-deformable'), motion ('static'; "
+             "'kinematic', 'dynamic'), density, velocity, static_friction, kinetic_friction, restitution, restoration, anchor_stiffness, "
+             "anchor_damping, constraint_rate, global_damping, integrator, contact_level, default_level, ...")
         .def_property_readonly("body_count", &World::bodyCount, "Bodies in the world (ids 0 .. body_count - 1).")
         .def("part", [](World& w, BodyId id) { return &w.part(id); }, py::arg("id"), py::return_value_policy::reference_internal,
              "The body's part (a view that keeps the world alive).")

@@ -209,3 +209,87 @@ def test_sweep_bindings(tmp_path, examples):
     assert not run.finished()
     first = series.write(run.world, ["mouth", "ball"])
     assert first.name == "ball_000000.vtp" and series.collection.name == "ball.pvd"
+
+
+PUSHED_BALL = """
+[world]
+time_step = 0.001
+gravity = [0, -9.81, 0]
+duration = 0.6
+
+[[part]]
+name = "mouth"
+generator = "container-mouth"
+mode = "rigid-deformable"
+material = "elastic"
+restoration = "anchors"
+anchor_stiffness = 10.0
+anchor_damping = 6.0
+global_damping = 1.0
+contact_level = 3
+static_friction = 0.4
+kinetic_friction = 0.3
+
+[[part]]
+name = "ball"
+generator = { type = "sphere", radius = 8.5, level = 2 }
+mode = "rigid"
+motion = "dynamic"
+density = 0.01
+position = [0, 4.7, 0]
+static_friction = 0.4
+
+[[action]]
+time = 0.0
+type = "push"
+part = "ball"
+force = [0, -2500, 0]
+duration = 0.5
+"""
+
+
+def test_keyword_settings_build_the_world_a_scene_file_builds(tmp_path):
+    """The keywords are the scene file's keys: the same world from both, the same run bit for bit."""
+    path = tmp_path / "pushed.toml"
+    path.write_text(PUSHED_BALL)
+    scene_run = flexfit.SceneRun(flexfit.load_scene(str(path)))
+    scene_run.step(600)
+
+    world = flexfit.World(time_step=0.001, gravity=[0, -9.81, 0])
+    mouth = flexfit.PartModel(flexfit.container_mouth(), material="elastic")
+    ball = flexfit.PartModel(flexfit.sphere(8.5, 2))
+    world.add(mouth, mode="rigid-deformable", restoration="anchors", anchor_stiffness=10.0, anchor_damping=6.0, global_damping=1.0,
+              contact_level=3, static_friction=0.4, kinetic_friction=0.3)
+    b = world.add(ball, position=[0, 4.7, 0], mode="rigid", motion="dynamic", density=0.01, static_friction=0.4)
+    for step in range(600):
+        if step < 500:
+            world.apply_force(b, [0, -2500, 0])
+        world.step()
+    assert world.state_hash() == scene_run.world.state_hash()
+    assert world.part(0).zone_count > 0 or len(world.assembly_events()) == 0
+
+    with pytest.raises(flexfit.InputError, match="anchor_stifness"):
+        world.add(ball, anchor_stifness=1.0)
+    with pytest.raises(flexfit.InputError):
+        world.add(ball, restoration="elastic-band")
+    with pytest.raises(flexfit.InputError):
+        world.add(ball, motion="dynamic", static_friction=0.1, kinetic_friction=0.5)  # kinetic above static
+
+
+def test_physical_material_and_a_part_alone_with_its_own_settings():
+    mesh = flexfit.torus(0.05, 0.01, 24, 12)
+    plain = flexfit.PartModel(mesh, youngs_modulus=2e9, thickness=0.001, density=1200)
+    bent = flexfit.PartModel(mesh, youngs_modulus=2e9, thickness=0.001, density=1200, bending_springs=True)
+    assert plain.spring_count == 3 * 24 * 12 and bent.spring_count == 2 * plain.spring_count
+    with pytest.raises(flexfit.InputError, match="thickness and density"):
+        flexfit.PartModel(mesh, youngs_modulus=2e9)
+    with pytest.raises(flexfit.InputError, match="one of"):
+        flexfit.PartModel(mesh, material="elastic", youngs_modulus=2e9, thickness=0.001, density=1200)
+    part = flexfit.Part(bent, integrator="implicit", implicit_iterations=30, time_step=1e-3, restoration="constraint", constraint_rate=20.0)
+    part.open_zone(0, 3)
+    part.apply_force(0, [0, 0.5, 0])
+    for _ in range(20):
+        part.step()
+    assert np.isfinite(part.positions).all() and part.positions[0, 1] > bent.rest_positions[0, 1]
+    with pytest.raises(flexfit.InputError):
+        flexfit.Part(bent, density=1.0)  # a body's key: not for a part alone
