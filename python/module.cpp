@@ -36,12 +36,6 @@ py::array vec3View(const std::vector<Vec3>& v, py::handle owner) {
     return rowsView(v.empty() ? nullptr : v.front().data(), v.size(), 3, owner);
 }
 
-py::array indexView(std::span<const Index> s, py::handle owner) {
-    py::array a(py::dtype::of<Index>(), {s.size()}, {sizeof(Index)}, s.data(), owner);
-    a.attr("flags").attr("writeable") = false;
-    return a;
-}
-
 py::array_t<double> vec3Copy(const std::vector<Vec3>& v) {
     py::array_t<double> a({v.size(), std::size_t(3)});
     auto m = a.mutable_unchecked<2>();
@@ -160,6 +154,7 @@ void applyPartKeywords(const py::kwargs& keywords, PartSettings& part, BodySetti
     std::optional<double> kinetic;
     for (const auto& [key, value] : keywords) {
         const std::string k = py::str(key);
+        try {
         auto number = [&] { return value.cast<double>(); };
         auto integer = [&] { return value.cast<int>(); };
         if (k == "mode") part.mode = enumFrom<PartMode>(value.cast<std::string>(), "mode");
@@ -186,6 +181,9 @@ void applyPartKeywords(const py::kwargs& keywords, PartSettings& part, BodySetti
         else if (body && k == "kinetic_friction") kinetic = number();
         else if (body && k == "restitution") body->restitution = number();
         else throw InputError(k, 0, "unknown keyword (the scene file's [[part]] keys: mode, motion, density, restoration, anchor_stiffness, ...)");
+        } catch (const py::cast_error&) {
+            throw InputError(k, 0, "a value of the wrong type: " + std::string(py::str(py::repr(value))));
+        }
     }
     if (body) body->kineticFriction = kinetic.value_or(body->staticFriction);  // as in scene files
 }
@@ -210,6 +208,43 @@ PartModelSettings modelSettings(std::optional<std::string> material, std::option
         throw InputError(thickness ? "thickness" : "density", 0, "belongs to a physical material: give youngs_modulus too");
     }
     return s;
+}
+
+// A world's part, read-only in Python: its state changes only through the World.
+struct PartView {
+    const Part* part = nullptr;
+};
+
+// What Part and PartView both read. `get` gives the part of a Python object; arrays that are
+// views keep that object (and so the part's owner) alive.
+template <class Class, class Get>
+void addPartReaders(Class& c, Get get) {
+    c.def_property_readonly("mode", [get](py::object self) { return std::string(toString(get(self).mode())); }, "rigid, rigid-deformable or full-deformable.")
+        .def_property_readonly("model", [get](py::object self) { return std::const_pointer_cast<PartModel>(get(self).sharedModel()); },
+                               "The part's model (shared, immutable).")
+        .def_property_readonly("positions", [get](py::object self) { return vec3View(get(self).state().positions, self); },
+                               "Mass positions in the part frame, a read-only (n, 3) view of the state (non-moving masses at rest).")
+        .def_property_readonly("velocities", [get](py::object self) { return vec3View(get(self).state().velocities, self); },
+                               "Mass velocities (part frame), a read-only (n, 3) view.")
+        .def_property_readonly("moving_masses", [get](py::object self) {
+            const auto masses = get(self).movingMasses();
+            return py::array_t<Index>(py::ssize_t(masses.size()), masses.data());
+        }, "Indices of the masses the zones move, a new array (the list changes with every zone).")
+        .def_property_readonly("zone_depths", [get](py::object self) {
+            std::vector<int> depths;
+            get(self).zoneDepths(depths);
+            return py::array_t<int>(py::ssize_t(depths.size()), depths.data());
+        }, "Each mass's depth in the zones covering it (0 = seed, -1 = at rest), a new int array.")
+        .def("world_positions", [get](py::object self) {
+            std::vector<Vec3> w;
+            get(self).worldPositions(w);
+            return vec3Copy(w);
+        }, "Mass positions in the world, a new (n, 3) array.")
+        .def_property_readonly("zone_count", [get](py::object self) { return get(self).zoneCount(); }, "Zones open on the part.")
+        .def_property_readonly("time", [get](py::object self) { return get(self).time(); }, "The part's simulated time (s).")
+        .def_property_readonly("pose", [get](py::object self) { return poseDict(get(self).pose()); },
+                               "The part's pose: {'position', 'rotation_wxyz'} (part frame to world).")
+        .def("state_hash", [get](py::object self) { return stateHash(get(self).state()); }, "64-bit hash of the state, bit for bit.");
 }
 }  // namespace
 
@@ -303,8 +338,8 @@ PYBIND11_MODULE(_flexfit, m) {
         .def_property_readonly("rest_positions", [](py::object self) { return vec3View(self.cast<const PartModel&>().restPositions, self); },
                                "Rest positions, a read-only (n, 3) view.");
 
-    py::class_<Part>(m, "Part", "A part: a rigid body until pressed, then mass-spring-damper zones around the contacts.")
-        .def(py::init([](std::shared_ptr<PartModel> model, const py::kwargs& settings) {
+    py::class_<Part> partClass(m, "Part", "A part: a rigid body until pressed, then mass-spring-damper zones around the contacts.");
+    partClass.def(py::init([](std::shared_ptr<PartModel> model, const py::kwargs& settings) {
                  PartSettings s;
                  applyPartKeywords(settings, s, nullptr);
                  return Part(model, s);
@@ -312,27 +347,6 @@ PYBIND11_MODULE(_flexfit, m) {
              py::arg("model"),
              "A part stepped on its own (without a world). Settings as keywords named as the scene file's [[part]] keys "
              "(mode='rigid-deformable', restoration, anchor_stiffness, global_damping, integrator, contact_level, ...) and time_step.")
-        .def_property_readonly("mode", [](const Part& p) { return std::string(toString(p.mode())); }, "rigid, rigid-deformable or full-deformable.")
-        .def_property_readonly("model", [](const Part& p) { return std::const_pointer_cast<PartModel>(p.sharedModel()); }, "The part's model (shared, immutable).")
-        .def_property_readonly("positions", [](py::object self) { return vec3View(self.cast<const Part&>().state().positions, self); },
-                               "Mass positions in the part frame, a read-only (n, 3) view of the state (non-moving masses at rest).")
-        .def_property_readonly("velocities", [](py::object self) { return vec3View(self.cast<const Part&>().state().velocities, self); },
-                               "Mass velocities (part frame), a read-only (n, 3) view.")
-        .def_property_readonly("moving_masses", [](py::object self) { return indexView(self.cast<const Part&>().movingMasses(), self); },
-                               "Indices of the masses the zones move, a read-only view (valid until the next step or zone change).")
-        .def_property_readonly("zone_depths", [](const Part& p) {
-            std::vector<int> depths;
-            p.zoneDepths(depths);
-            return py::array_t<int>(py::ssize_t(depths.size()), depths.data());
-        }, "Each mass's depth in the zones covering it (0 = seed, -1 = at rest), a new int array.")
-        .def("world_positions", [](const Part& p) {
-            std::vector<Vec3> w;
-            p.worldPositions(w);
-            return vec3Copy(w);
-        }, "Mass positions in the world, a new (n, 3) array.")
-        .def_property_readonly("zone_count", &Part::zoneCount, "Zones open on the part.")
-        .def_property_readonly("time", &Part::time, "The part's simulated time (s).")
-        .def_property_readonly("pose", [](const Part& p) { return poseDict(p.pose()); }, "The part's pose: {'position', 'rotation_wxyz'} (part frame to world).")
         .def("open_zone", [](Part& p, Index mass, int level) { return p.openZone(ZoneSeed::mass(mass), level); }, py::arg("mass"), py::arg("level"),
              "Opens a zone of `level` rings around a mass; returns its id.")
         .def("apply_force", &Part::applyForce, py::arg("mass"), py::arg("force"), "A world-frame force on one mass for the next step.")
@@ -340,8 +354,12 @@ PYBIND11_MODULE(_flexfit, m) {
         .def("step", [](Part& p) {
             py::gil_scoped_release release;
             p.step();
-        }, "One step of the part alone (its own time step).")
-        .def("state_hash", [](const Part& p) { return stateHash(p.state()); }, "64-bit hash of the state, bit for bit.");
+        }, "One step of the part alone (its own time step).");
+    addPartReaders(partClass, [](py::handle self) -> const Part& { return self.cast<const Part&>(); });
+
+    // A world's part, read-only: the world changes it (forces, zones and steps go through World).
+    py::class_<PartView> view(m, "PartView", "A world's part, read-only (World.part): forces, zones and steps go through the World. Keeps the world alive.");
+    addPartReaders(view, [](py::handle self) -> const Part& { return *self.cast<const PartView&>().part; });
 
     // --- World ---
     py::class_<World>(m, "World", "Parts with rigid-body motion, collisions, deformation and snapping; one step of named stages.")
@@ -363,8 +381,8 @@ PYBIND11_MODULE(_flexfit, m) {
              "'kinematic', 'dynamic'), density, velocity, static_friction, kinetic_friction, restitution, restoration, anchor_stiffness, "
              "anchor_damping, constraint_rate, global_damping, integrator, contact_level, default_level, ...")
         .def_property_readonly("body_count", &World::bodyCount, "Bodies in the world (ids 0 .. body_count - 1).")
-        .def("part", [](World& w, BodyId id) { return &w.part(id); }, py::arg("id"), py::return_value_policy::reference_internal,
-             "The body's part (a view that keeps the world alive).")
+        .def("part", [](const World& w, BodyId id) { return PartView{&w.part(id)}; }, py::arg("id"), py::keep_alive<0, 1>(),
+             "The body's part, read-only (a PartView that keeps the world alive).")
         .def("step", [](World& w, int steps) {
             py::gil_scoped_release release;
             for (int i = 0; i < steps; ++i) w.step();
@@ -487,7 +505,8 @@ PYBIND11_MODULE(_flexfit, m) {
         .def("labels", &Sweep::labels, py::arg("run"), "The run's value label for each parameter.")
         .def("scene_of", [](const Sweep& s, std::size_t run) { return sweepScene(s, run); }, py::arg("run"), "The scene of one run (the base with its values).")
         .def("__len__", [](const Sweep& s) { return s.runs.size(); }, "Number of runs.");
-    m.def("load_sweep", &loadSweep, py::arg("path"), "Reads a sweep file and checks every run's scene.");
+    m.def("load_sweep", &loadSweep, py::arg("path"), py::arg("check_runs") = true,
+          "Reads a sweep file; with check_runs, builds and checks every run's scene first.");
     m.def("missing_sweep_runs", &cli::missingSweepRuns, py::arg("sweep"), py::arg("out"), "Indices of the runs without results under `out`.");
     m.def("run_sweep_run", [](const Sweep& s, std::size_t run, const std::filesystem::path& out) {
         py::gil_scoped_release release;

@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
 
 namespace flexfit::cli {
@@ -122,6 +123,9 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         csv << csvHeader(scene);
     }
     RunSummary s;
+    for (const auto& [every, what] : {std::pair{options.objEvery, "OBJ"}, std::pair{options.vtkEvery, "VTK"}, std::pair{options.glbEvery, "glTF"}})
+        if (every && !(*every >= 0.0 && std::isfinite(*every)))
+            throw InputError(scene.source, 0, std::string("seconds between ") + what + " frames must be finite and >= 0");
     auto strideOf = [&](double every) { return every > 0.0 ? std::max<std::uint64_t>(1, std::llround(every / scene.world.timeStep)) : 0; };
     const std::uint64_t objStride = strideOf(options.objEvery.value_or(scene.objEvery)), vtkStride = strideOf(options.vtkEvery.value_or(scene.vtkEvery)),
                         glbStride = strideOf(options.glbEvery.value_or(scene.glbEvery));

@@ -21,7 +21,9 @@
 //
 // Runs are the Cartesian product, the first parameter varying slowest. A run's id is a hash of
 // its parameters' names and values (not of its position), so it stays the same when other
-// values are added or reordered: a restarted sweep finds its finished runs by id.
+// values are added or reordered: a restarted sweep finds its finished runs by id. The base
+// scene's text, `set`, `duration` and the keys are hashed in too: editing them makes every run
+// new. `set` takes quoted dotted keys, TOML's dotted keys or [set.<table>] alike.
 //
 // Every key must name an existing key of the base scene, or a new key in an existing table
 // (the scene reader then checks it like any other); errors name the sweep file, the line of
@@ -67,9 +69,10 @@ struct Sweep {
     std::vector<std::string> labels(std::size_t run) const;
 };
 
-// Throws InputError naming the sweep file, the line and the problem; every run's scene is
-// built and checked once, so a sweep that loads has no bad run.
-Sweep loadSweep(const std::filesystem::path& file);
+// Throws InputError naming the sweep file (or the base scene), the line and the problem. With
+// checkRuns, every run's scene is built and checked once (meshes and all), so a sweep that loads
+// has no bad run; a worker that runs runs of a sweep checked elsewhere can skip it.
+Sweep loadSweep(const std::filesystem::path& file, bool checkRuns = true);
 
 // The scene of one run (its source names the sweep file and the run id).
 Scene sweepScene(const Sweep& sweep, std::size_t run);

@@ -19,21 +19,27 @@ import pathlib
 _loaded = {}
 
 
-def _load(path):
-    """The sweep, loaded once per worker process."""
+def _load(path, run, run_id):
+    """The sweep on a worker, loaded once per version of the file (a worker that outlives a
+    sweep, on a long-lived cluster, reloads an edited file); checks the run is the one meant."""
     from . import _flexfit
 
-    if path not in _loaded:
-        _loaded[path] = _flexfit.load_sweep(path)
-    return _loaded[path]
+    stat = os.stat(path)
+    key = (path, stat.st_mtime_ns, stat.st_size)
+    if key not in _loaded:
+        _loaded.clear()
+        _loaded[key] = _flexfit.load_sweep(path, check_runs=False)  # the client checked them
+    s = _loaded[key]
+    if run >= len(s) or s.run_ids[run] != run_id:
+        raise RuntimeError(f"{path} changed while its sweep was running (run {run_id} is no longer run {run})")
+    return s
 
 
-def _run_one(path, run, out):
+def _run_one(path, run, run_id, out):
     """One run on a worker; returns (its id, whether it ran now)."""
     from . import _flexfit
 
-    s = _load(path)
-    return s.run_ids[run], _flexfit.run_sweep_run(s, run, out)
+    return run_id, _flexfit.run_sweep_run(_load(path, run, run_id), run, out)
 
 
 def sweep(path, out, scheduler=None, workers=2, table=True):
@@ -66,7 +72,8 @@ def sweep(path, out, scheduler=None, workers=2, table=True):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(cluster if cluster is not None else scheduler)
         try:
-            futures = client.map(_run_one, [path] * len(missing), missing, [out] * len(missing), pure=False)
+            ids = [s.run_ids[r] for r in missing]
+            futures = client.map(_run_one, [path] * len(missing), missing, ids, [out] * len(missing), pure=False)
             ran = [run_id for run_id, now in client.gather(futures) if now]
         finally:
             client.close()

@@ -42,7 +42,7 @@ std::string xmlEscaped(const std::string& s) {
         case '<': out += "&lt;"; break;
         case '>': out += "&gt;"; break;
         case '"': out += "&quot;"; break;
-        default: out += c;
+        default: out += static_cast<unsigned char>(c) < 0x20 ? '?' : c;  // XML 1.0 allows no control characters
         }
     }
     return out;

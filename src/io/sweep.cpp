@@ -17,7 +17,9 @@ using NodePtr = std::unique_ptr<toml::node>;
 
 namespace detail {
 struct SweepDocument {
-    toml::table scene;                                  // the base scene
+    std::string sceneText;  // the base scene, parsed again for each run (a copied toml++ node loses its lines)
+    std::vector<std::pair<std::string, NodePtr>> set;       // values every run shares, by dotted key
+    std::vector<std::size_t> setLines;
     std::vector<std::vector<std::vector<NodePtr>>> values;  // [parameter][case][key]
 };
 }  // namespace detail
@@ -26,13 +28,17 @@ namespace {
 
 using detail::SweepDocument;
 
-toml::table parseFile(const std::filesystem::path& file, const char* what) {
+std::string readText(const std::filesystem::path& file, const char* what) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file.string(), 0, std::string("cannot open the ") + what);
     std::ostringstream text;
     text << in.rdbuf();
+    return text.str();
+}
+
+toml::table parseText(const std::string& text, const std::filesystem::path& file) {
     try {
-        return toml::parse(text.str(), file.string());
+        return toml::parse(text, file.string());
     } catch (const toml::parse_error& e) {
         throw InputError(file.string(), e.source().begin.line, "TOML syntax: " + std::string(e.description()));
     }
@@ -48,6 +54,20 @@ std::string tomlText(const toml::node& node) {
     std::ostringstream out;
     node.visit([&](const auto& v) { out << v; });
     return out.str();
+}
+
+// The `set` table's values by dotted key: quoted keys ("world.duration" = 1) and TOML's own
+// dotted keys or [set.world] sub-tables alike; an inline table is a value.
+void flattenSet(const toml::table& t, const std::string& prefix, SweepDocument& d) {
+    for (const auto& [key, value] : t) {
+        const std::string path = prefix + std::string(key.str());
+        if (const toml::table* sub = value.as_table(); sub && !sub->is_inline()) {
+            flattenSet(*sub, path + ".", d);
+            continue;
+        }
+        d.set.emplace_back(path, clone(value));
+        d.setLines.push_back(lineOf(value));
+    }
 }
 
 // The parsed [[parameter]] with its cases' values (one node per key).
@@ -185,8 +205,25 @@ void setKey(toml::table& scene, const std::string& key, const toml::node& value)
     }
 }
 
-std::string runId(const std::vector<ParsedParameter>& parameters, const std::vector<std::size_t>& cases) {
+// What every run's results depend on besides its values: the base scene's text, the shared
+// values, the duration, each parameter's keys. A run's id mixes it in, so editing any of them
+// makes every run new (finished runs of the old sweep are not reused).
+std::uint64_t sweepFingerprint(const SweepDocument& d, const std::optional<double>& duration, const std::vector<ParsedParameter>& parameters) {
     detail::Fnv1a h;
+    h.mix(d.sceneText.data(), d.sceneText.size() + 1);
+    for (const auto& [key, value] : d.set) {
+        const std::string text = key + "=" + tomlText(*value);
+        h.mix(text.data(), text.size() + 1);
+    }
+    if (duration) h.mix(&*duration, sizeof(double));
+    for (const ParsedParameter& p : parameters)
+        for (const std::string& k : p.parameter.keys) h.mix(k.data(), k.size() + 1);
+    return h.value();
+}
+
+std::string runId(std::uint64_t fingerprint, const std::vector<ParsedParameter>& parameters, const std::vector<std::size_t>& cases) {
+    detail::Fnv1a h;
+    h.mix(&fingerprint, sizeof fingerprint);
     for (std::size_t p = 0; p < parameters.size(); ++p) {
         const std::string& name = parameters[p].parameter.name;
         const std::string& value = parameters[p].valueTexts[cases[p]];
@@ -199,9 +236,17 @@ std::string runId(const std::vector<ParsedParameter>& parameters, const std::vec
 }
 
 toml::table runDocument(const Sweep& sweep, std::size_t run) {
-    toml::table scene = sweep.document->scene;
+    const SweepDocument& d = *sweep.document;
+    toml::table scene = parseText(d.sceneText, sweep.scene);
+    for (std::size_t i = 0; i < d.set.size(); ++i) {
+        try {
+            setKey(scene, d.set[i].first, *d.set[i].second);
+        } catch (const std::invalid_argument& e) {
+            throw InputError(sweep.file.string(), d.setLines[i], std::string("set: ") + e.what());
+        }
+    }
     for (std::size_t p = 0; p < sweep.parameters.size(); ++p) {
-        const auto& values = sweep.document->values[p][sweep.runs[run].cases[p]];
+        const auto& values = d.values[p][sweep.runs[run].cases[p]];
         for (std::size_t k = 0; k < values.size(); ++k) {
             try {
                 setKey(scene, sweep.parameters[p].keys[k], *values[k]);
@@ -249,9 +294,9 @@ Scene sweepScene(const Sweep& sweep, std::size_t run) {
     return scene;
 }
 
-Sweep loadSweep(const std::filesystem::path& file) {
+Sweep loadSweep(const std::filesystem::path& file, bool checkRuns) {
     const std::string name = file.string();
-    const toml::table root = parseFile(file, "sweep file");
+    const toml::table root = parseText(readText(file, "sweep file"), file);
     for (const auto& [k, v] : root)
         if (k != "scene" && k != "duration" && k != "set" && k != "parameter") throw InputError(name, lineOf(v), "unknown key '" + std::string(k.str()) + "'");
     Sweep sweep;
@@ -265,18 +310,12 @@ Sweep loadSweep(const std::filesystem::path& file) {
         sweep.duration = d;
     }
     auto document = std::make_shared<SweepDocument>();
-    document->scene = parseFile(sweep.scene, "base scene file");
-    // Values every run shares: set once in the base.
+    document->sceneText = readText(sweep.scene, "base scene file");
+    (void)parseText(document->sceneText, sweep.scene);  // its syntax errors name its own lines
     if (const toml::node* set = root.get("set")) {
         const toml::table* t = set->as_table();
         if (!t) throw InputError(name, lineOf(*set), "'set' must be a table of \"dotted.key\" = value");
-        for (const auto& [key, value] : *t) {
-            try {
-                setKey(document->scene, std::string(key.str()), value);
-            } catch (const std::invalid_argument& e) {
-                throw InputError(name, lineOf(value), std::string("set: ") + e.what());
-            }
-        }
+        flattenSet(*t, "", *document);
     }
     std::vector<ParsedParameter> parsed;
     if (const toml::node* list = root.get("parameter")) {
@@ -290,9 +329,10 @@ Sweep loadSweep(const std::filesystem::path& file) {
         }
     }
     // The runs: the product, the first parameter slowest.
+    const std::uint64_t fingerprint = sweepFingerprint(*document, sweep.duration, parsed);
     std::vector<std::size_t> cases(parsed.size(), 0);
     for (;;) {
-        sweep.runs.push_back({runId(parsed, cases), cases});
+        sweep.runs.push_back({runId(fingerprint, parsed, cases), cases});
         std::size_t p = parsed.size();
         while (p > 0 && ++cases[p - 1] == parsed[p - 1].cases.size()) cases[--p] = 0;
         if (p == 0) break;
@@ -303,7 +343,16 @@ Sweep loadSweep(const std::filesystem::path& file) {
         document->values.push_back(std::move(p.cases));
     }
     sweep.document = std::move(document);
-    for (std::size_t r = 0; r < sweep.runs.size(); ++r) (void)sweepScene(sweep, r);  // every run checked before any runs
+    if (!checkRuns) return sweep;
+    // Every run checked before any runs, and every run with the same parts (the table's columns).
+    std::vector<std::string> parts;
+    for (std::size_t r = 0; r < sweep.runs.size(); ++r) {
+        const Scene runScene = sweepScene(sweep, r);
+        std::vector<std::string> names;
+        for (const ScenePart& p : runScene.parts) names.push_back(p.name);
+        if (r == 0) parts = names;
+        else if (names != parts) throw InputError(name, sweep.parameters.front().line, "run " + sweep.runs[r].id + " has other parts than the first run (a parameter renames or adds parts)");
+    }
     return sweep;
 }
 

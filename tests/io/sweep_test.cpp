@@ -161,6 +161,45 @@ values = [1.0, 2.0]
     }
 }
 
+TEST(Sweep, AnErrorInTheBaseSceneNamesItsOwnLine) {
+    TempDir dir;
+    std::string bad = kScene;
+    bad.replace(bad.find("static_friction = 0.1"), 21, "static_friction = -0.1");  // line 10 of the base scene
+    dir.write("scene.toml", bad);
+    try {
+        loadSweep(dir.write("sweep.toml", sweepText("[[parameter]]\nname = \"r\"\nkey = \"part.ball.density\"\nvalues = [1.0]\n")));
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(e.source().find("scene.toml"), std::string::npos) << e.what();
+        EXPECT_EQ(e.line(), 10u) << e.what();
+        EXPECT_NE(std::string(e.what()).find("sweep.toml"), std::string::npos) << e.what();  // and which sweep ran it
+    }
+}
+
+TEST(Sweep, SetTakesTomlsOwnDottedKeysWithoutReplacingTables) {
+    TempDir dir;
+    dir.write("scene.toml", kScene);
+    const Sweep s = loadSweep(dir.write("sweep.toml", "scene = \"scene.toml\"\n[set]\nworld.duration = 0.5\npart.ball.density = 3.0\n"));
+    const Scene scene = sweepScene(s, 0);
+    EXPECT_EQ(scene.duration, 0.5);
+    EXPECT_EQ(scene.world.timeStep, 0.001);  // the rest of [world] kept
+    EXPECT_EQ(scene.parts[1].body.density, 3.0);
+    EXPECT_EQ(scene.parts[1].pose.translation, Vec3(0, 6, 0));
+}
+
+TEST(Sweep, IdsChangeWithWhatTheRunsShare) {
+    TempDir dir;
+    const std::string parameter = "[[parameter]]\nname = \"r\"\nkey = \"part.ball.density\"\nvalues = [1.0]\n";
+    dir.write("scene.toml", kScene);
+    const std::string base = loadSweep(dir.write("a.toml", sweepText(parameter))).runs[0].id;
+    EXPECT_EQ(loadSweep(dir.write("b.toml", sweepText(parameter))).runs[0].id, base);  // the same sweep, another file
+    EXPECT_NE(loadSweep(dir.write("c.toml", "scene = \"scene.toml\"\nduration = 0.5\n" + parameter)).runs[0].id, base);
+    EXPECT_NE(loadSweep(dir.write("d.toml", sweepText(parameter) + "[set]\n\"world.time_step\" = 0.002\n")).runs[0].id, base);
+    EXPECT_NE(loadSweep(dir.write("e.toml", sweepText("[[parameter]]\nname = \"r\"\nkey = \"part.mouth.density\"\nvalues = [1.0]\n"))).runs[0].id, base);
+    dir.write("scene.toml", std::string(kScene) + "\n# edited\n");
+    EXPECT_NE(loadSweep(dir.path() / "a.toml").runs[0].id, base);
+}
+
 TEST(Sweep, MissingBaseSceneIsAnError) {
     TempDir dir;
     try {

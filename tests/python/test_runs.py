@@ -139,7 +139,27 @@ def test_a_diverged_run_is_a_row_and_the_sweep_goes_on(tmp_path, flexfit_exe):
                    capture_output=True)
     table = pandas.read_csv(tmp_path / "results.csv", dtype={"state_hash": str})
     assert list(table["status"]) == ["ok", "diverged"]
-    assert len(table.columns) == 18 and table["state_hash"].isna().tolist() == [False, True]
+    assert len(table.columns) == 21 and table["state_hash"].isna().tolist() == [False, True]
     assert "diverged at t = " in table["message"][1] and "stability bound" in table["message"][1]
     # The diverged run left only its row (the run's own files are written all or none).
     assert [p.name for p in (tmp_path / "runs" / table["run"][1]).iterdir()] == ["row.csv"]
+
+
+def test_a_parameter_may_change_a_parts_motion_and_editing_the_sweep_reruns_it(tmp_path, examples):
+    sweep = tmp_path / "motion.toml"
+    text = f"""scene = "{examples / 'ball_torus.toml'}"
+duration = 0.3
+[[parameter]]
+name = "motion"
+key = "part.ball.motion"
+values = ["static", "dynamic"]
+"""
+    sweep.write_text(text)
+    table = flexfit.sweep(sweep, tmp_path / "out", workers=1)
+    assert list(table["motion"]) == ["static", "dynamic"]
+    assert table.loc[0, "ball_y"] == 4.7 and table.loc[1, "ball_y"] < 4.7  # the static ball stays, the pushed one falls
+    # Another duration: every run is new (its results would differ), none reused.
+    sweep.write_text(text.replace("duration = 0.3", "duration = 0.2"))
+    again = flexfit.sweep(sweep, tmp_path / "out", workers=1)
+    assert len(again.attrs["ran"]) == 2 and set(again["run"]).isdisjoint(table["run"])
+    assert (again["simulated_seconds"] == 0.2).all()
