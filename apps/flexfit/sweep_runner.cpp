@@ -26,21 +26,13 @@ std::string csvField(const std::string& s) {
 
 std::string optional(const std::optional<double>& v) { return v ? fmt::format("{:.6f}", *v) : ""; }
 
-// Every part's final centre is in the table (a parameter may change a part's motion; the
-// sweep's runs all have the same parts, loadSweep checks it).
-std::vector<std::size_t> partIndices(const Scene& scene) {
-    std::vector<std::size_t> parts(scene.parts.size());
-    for (std::size_t i = 0; i < parts.size(); ++i) parts[i] = i;
-    return parts;
-}
-
 std::string header(const Sweep& sweep, const Scene& scene) {
     std::string h = "run";
     for (const SweepParameter& p : sweep.parameters) h += "," + csvField(p.name);
     h += ",status,steps,simulated_seconds,contact_steps,max_contacts,max_zones,max_moving_masses,max_computed_springs,max_deformation,"
          "last_contact,restored_at,max_coupling_force,assembled_at,assembly_events";
-    for (std::size_t i : partIndices(scene)) {
-        const std::string& n = scene.parts[i].name;
+    for (const ScenePart& part : scene.parts) {  // every part's final centre (loadSweep: the same parts in every run)
+        const std::string& n = part.name;
         h += "," + csvField(n + "_x") + "," + csvField(n + "_y") + "," + csvField(n + "_z");
     }
     return h + ",state_hash,message\n";
@@ -57,14 +49,14 @@ std::string resultRow(const Sweep& sweep, std::size_t run, const Scene& scene, c
     row += fmt::format(",ok,{},{:.6f},{},{},{},{},{},{:.9g},{},{},{:.9g},{},{}", s.steps, s.simulatedSeconds, s.contactSteps, s.maxContacts, s.maxZones,
                        s.maxMovingMasses, s.maxComputedSprings, s.maxDeformation, optional(s.lastContact), optional(s.restored),
                        s.maxCouplingForce, s.events.empty() ? std::string() : fmt::format("{:.6f}", s.events.front().time), s.events.size());
-    for (std::size_t i : partIndices(scene))
+    for (std::size_t i = 0; i < scene.parts.size(); ++i)
         row += fmt::format(",{:.9g},{:.9g},{:.9g}", s.finalCentres[i].x(), s.finalCentres[i].y(), s.finalCentres[i].z());
     return row + fmt::format(",{:016x},\n", s.stateHash);
 }
 
 std::string failedRow(const Sweep& sweep, std::size_t run, const Scene& scene, const std::string& status, const std::string& message) {
     std::string row = rowStart(sweep, run) + "," + status + std::string(13, ',');
-    row += std::string(3 * partIndices(scene).size(), ',');
+    row += std::string(3 * scene.parts.size(), ',');
     return row + ",," + csvField(message) + "\n";  // no state hash
 }
 

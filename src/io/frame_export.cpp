@@ -11,21 +11,26 @@
 namespace flexfit {
 namespace {
 
-// Writes `text` to `file` through a temporary beside it, renamed when whole.
-void writeWhole(const std::filesystem::path& file, const std::string& text) {
-    const std::filesystem::path temporary = file.string() + ".partial";
-    {
-        std::ofstream out(temporary, std::ios::binary);
-        out << text;
-        if (!out) {
-            std::error_code ec;
-            std::filesystem::remove(temporary, ec);
-            throw InputError(file.string(), 0, "cannot write the file");
-        }
-    }
+// `file`'s temporary beside it; moveIntoPlace renames it once whole (or removes it and throws).
+std::filesystem::path temporaryOf(const std::filesystem::path& file) { return file.string() + ".partial"; }
+
+void moveIntoPlace(const std::filesystem::path& file, bool written, const std::string& problem = "cannot write the file") {
     std::error_code ec;
-    std::filesystem::rename(temporary, file, ec);
-    if (ec) throw InputError(file.string(), 0, "cannot write the file: " + ec.message());
+    if (written) std::filesystem::rename(temporaryOf(file), file, ec);
+    if (!written || ec) {
+        std::filesystem::remove(temporaryOf(file), ec);
+        throw InputError(file.string(), 0, problem);
+    }
+}
+
+void writeWhole(const std::filesystem::path& file, const std::string& text) {
+    bool written = false;
+    {
+        std::ofstream out(temporaryOf(file), std::ios::binary);
+        out << text;
+        written = bool(out);
+    }
+    moveIntoPlace(file, written);
 }
 
 void checkParts(const std::vector<FramePart>& parts, const std::filesystem::path& file) {
@@ -133,15 +138,8 @@ void writeGlbFrame(const std::filesystem::path& file, const std::vector<FramePar
         scene.mRootNode->mChildren[i] = node;
     }
     Assimp::Exporter exporter;
-    const std::filesystem::path temporary = file.string() + ".partial";
-    if (exporter.Export(&scene, "glb2", temporary.string()) != AI_SUCCESS) {
-        std::error_code ec;
-        std::filesystem::remove(temporary, ec);
-        throw InputError(file.string(), 0, std::string("cannot write the glTF file: ") + exporter.GetErrorString());
-    }
-    std::error_code ec;
-    std::filesystem::rename(temporary, file, ec);
-    if (ec) throw InputError(file.string(), 0, "cannot write the file: " + ec.message());
+    const bool written = exporter.Export(&scene, "glb2", temporaryOf(file).string()) == AI_SUCCESS;
+    moveIntoPlace(file, written, written ? "cannot write the file" : std::string("cannot write the glTF file: ") + exporter.GetErrorString());
 }
 
 void writeVtkCollection(const std::filesystem::path& file, const std::vector<std::pair<double, std::string>>& frames) {
