@@ -7,6 +7,11 @@
 #include <limits>
 #include <stdexcept>
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#define FLEXFIT_SDF_AVX2 1
+#include <immintrin.h>
+#endif
+
 namespace flexfit {
 namespace {
 
@@ -171,6 +176,100 @@ SignedDistanceField::Interpolated SignedDistanceField::sample(Grid& grid, const 
 
 SignedDistanceField::Interpolated SignedDistanceField::sample(const Vec3& p) const { return sample(fine_, p); }
 
+#if defined(FLEXFIT_SDF_AVX2)
+namespace {
+
+#define FLEXFIT_AVX2 __attribute__((target("avx2")))
+
+// What the vector sampler needs of a grid, as lanes.
+struct GridLanes {
+    __m256d min[3], hi[3], cell;
+    __m128i dx, dy;
+    const float* values;
+};
+
+FLEXFIT_AVX2 __m256d lanesOf(const Vec3* p, int d) { return _mm256_set_pd(p[3][d], p[2][d], p[1][d], p[0][d]); }
+
+// std::clamp(v, lo, hi) for v not NaN and lo <= hi.
+FLEXFIT_AVX2 __m256d clampLanes(__m256d v, __m256d lo, __m256d hi) {
+    return _mm256_blendv_pd(_mm256_blendv_pd(v, hi, _mm256_cmp_pd(hi, v, _CMP_LT_OQ)), lo, _mm256_cmp_pd(v, lo, _CMP_LT_OQ));
+}
+
+// w0 a + w1 b, the products rounded, then the sum.
+FLEXFIT_AVX2 inline __m256d mix(__m256d w0, __m256d a, __m256d w1, __m256d b) {
+    return _mm256_add_pd(_mm256_mul_pd(w0, a), _mm256_mul_pd(w1, b));
+}
+
+// Four points' samples as sample(Grid&, p) computes them, lane by lane; false (nothing
+// written) when a corner is not computed yet.
+FLEXFIT_AVX2 bool sampleFour(const GridLanes& g, const Vec3* p, SignedDistanceField::Interpolated* out) {
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+    __m256d t[3];
+    __m128i base[3];
+    for (int d = 0; d < 3; ++d) {
+        const __m256d x = _mm256_div_pd(_mm256_sub_pd(lanesOf(p, d), g.min[d]), g.cell);
+        const __m256d b = clampLanes(_mm256_floor_pd(x), zero, g.hi[d]);
+        base[d] = _mm256_cvttpd_epi32(b);
+        t[d] = clampLanes(_mm256_sub_pd(x, b), zero, one);
+    }
+    const __m128i node =
+        _mm_add_epi32(_mm_mullo_epi32(_mm_add_epi32(_mm_mullo_epi32(base[2], g.dy), base[1]), g.dx), base[0]);
+    const __m128i sy = g.dx, sz = _mm_mullo_epi32(g.dx, g.dy), sx = _mm_set1_epi32(1);
+    const __m128i offset[8] = {_mm_setzero_si128(), sx, sy, _mm_add_epi32(sx, sy), sz, _mm_add_epi32(sz, sx), _mm_add_epi32(sz, sy),
+                               _mm_add_epi32(_mm_add_epi32(sz, sx), sy)};
+    __m256d v[8];
+    __m256d unknown = zero;
+    for (int n = 0; n < 8; ++n) {
+        v[n] = _mm256_cvtps_pd(_mm_i32gather_ps(g.values, _mm_add_epi32(node, offset[n]), 4));
+        unknown = _mm256_or_pd(unknown, _mm256_cmp_pd(v[n], v[n], _CMP_UNORD_Q));
+    }
+    if (_mm256_movemask_pd(unknown) != 0) return false;
+    const __m256d x0 = _mm256_sub_pd(one, t[0]), y0 = _mm256_sub_pd(one, t[1]), z0 = _mm256_sub_pd(one, t[2]);
+    const __m256d a00 = mix(x0, v[0], t[0], v[1]), a10 = mix(x0, v[2], t[0], v[3]);
+    const __m256d a01 = mix(x0, v[4], t[0], v[5]), a11 = mix(x0, v[6], t[0], v[7]);
+    const __m256d b0 = mix(y0, a00, t[1], a10), b1 = mix(y0, a01, t[1], a11);
+    const __m256d distance = mix(z0, b0, t[2], b1);
+    const __m256d dx00 = _mm256_sub_pd(v[1], v[0]), dx10 = _mm256_sub_pd(v[3], v[2]);
+    const __m256d dx01 = _mm256_sub_pd(v[5], v[4]), dx11 = _mm256_sub_pd(v[7], v[6]);
+    const __m256d gx = _mm256_div_pd(mix(z0, mix(y0, dx00, t[1], dx10), t[2], mix(y0, dx01, t[1], dx11)), g.cell);
+    const __m256d gy = _mm256_div_pd(mix(z0, _mm256_sub_pd(a10, a00), t[2], _mm256_sub_pd(a11, a01)), g.cell);
+    const __m256d gz = _mm256_div_pd(_mm256_sub_pd(b1, b0), g.cell);
+    alignas(32) double lanes[4][4];
+    _mm256_store_pd(lanes[0], distance);
+    _mm256_store_pd(lanes[1], gx);
+    _mm256_store_pd(lanes[2], gy);
+    _mm256_store_pd(lanes[3], gz);
+    for (int i = 0; i < 4; ++i) {
+        out[i].distance = lanes[0][i];
+        out[i].gradient = Vec3(lanes[1][i], lanes[2][i], lanes[3][i]);
+    }
+    return true;
+}
+
+// The whole groups of four of `points`, by sampleFour; a group with a corner not computed
+// yet goes to one(k) point by point. Returns the points done.
+template <class One>
+FLEXFIT_AVX2 std::size_t sampleFours(const Vec3& min, const std::array<int, 3>& dims, double cell, const float* values,
+                                     std::span<const Vec3> points, std::span<SignedDistanceField::Interpolated> out, One one) {
+    GridLanes g;
+    for (int d = 0; d < 3; ++d) {
+        g.min[d] = _mm256_set1_pd(min[d]);
+        g.hi[d] = _mm256_set1_pd(double(dims[std::size_t(d)] - 2));
+    }
+    g.cell = _mm256_set1_pd(cell);
+    g.dx = _mm_set1_epi32(dims[0]);
+    g.dy = _mm_set1_epi32(dims[1]);
+    g.values = values;
+    std::size_t i = 0;
+    for (; i + 4 <= points.size(); i += 4)
+        if (!sampleFour(g, &points[i], &out[i]))
+            for (std::size_t k = i; k < i + 4; ++k) one(k);
+    return i;
+}
+
+}  // namespace
+#endif
+
 bool SignedDistanceField::clearOf(Grid& grid, const Vec3& centre, double radius, double slack) const {
     const Vec3 clamped = centre.cwiseMax(grid.box.min).cwiseMin(grid.box.max);
     const double outside = (centre - clamped).norm();
@@ -189,6 +288,17 @@ bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
     // means "outside the fine one".
     if (radius > 2.0 * fine_.cell && clearOf(coarse_, centre, radius, std::sqrt(3.0) * (coarse_.cell + fine_.cell))) return true;
     return clearOf(fine_, centre, radius, 0.0);
+}
+
+void SignedDistanceField::sampleMany(std::span<const Vec3> points, std::span<Interpolated> out) const {
+    std::size_t i = 0;
+#if defined(FLEXFIT_SDF_AVX2)
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    if (avx2)
+        i = sampleFours(fine_.box.min, fine_.dims, fine_.cell, fine_.values.data(), points, out,
+                        [&](std::size_t k) { out[k] = sample(fine_, points[k]); });
+#endif
+    for (; i < points.size(); ++i) out[i] = sample(fine_, points[i]);
 }
 
 }  // namespace flexfit

@@ -9,35 +9,72 @@ namespace flexfit {
 using namespace detail;
 namespace {
 
-// One mass's sample: a contact when the field is <= 0 there. Returns the sampled distance
-// (infinity outside the grid or for a free vertex, where no contact can be).
+// The masses a query samples, gathered first and sampled together (SignedDistanceField::
+// sampleMany: four a vector), then turned into contacts in the order they were gathered, so
+// the contacts come in the same order as sampling them one at a time.
 class MassSampler {
 public:
     MassSampler(std::uint32_t idA, const Part& a, const SignedDistanceField& field, std::uint32_t idB, const Part& b,
                 const RelativePose& bInA, std::vector<Contact>& contacts, QueryStats& stats)
         : idA_(idA), idB_(idB), a_(a), field_(field), b_(b), bInA_(bInA), ra_(a.pose().rotation.toRotationMatrix()),
-          contacts_(contacts), stats_(stats) {}
+          contacts_(contacts), stats_(stats), batch_(scratch()) {
+        batch_.masses.clear();
+        batch_.points.clear();
+    }
 
     Vec3 pointOf(Index m) const { return bInA_.apply(b_.state().positions[m]); }
 
-    double operator()(Index m, const Vec3& p) {
-        const Topology& topology = b_.model().topology;
-        if (topology.facesOf(m).empty()) return std::numeric_limits<double>::infinity();  // a free vertex: no surface to push
+    // Queues mass m at p (A's frame) for sampling; returns false, queuing nothing, when it
+    // cannot touch: a free vertex (no surface to push) or outside the grid.
+    bool queue(Index m, const Vec3& p) {
+        if (b_.model().topology.facesOf(m).empty()) return false;
         ++stats_.candidatePairs;
-        if (!field_.inGrid(p)) return std::numeric_limits<double>::infinity();
+        if (!field_.inGrid(p)) return false;
         ++stats_.exactTests;
-        const SignedDistanceField::Interpolated s = field_.sample(p);
-        if (s.distance > 0.0) return s.distance;
+        batch_.masses.push_back(m);
+        batch_.points.push_back(p);
+        return true;
+    }
+
+    // Samples the queued masses; a contact for each at <= 0. done(k, distance) sees the k-th
+    // queued mass's sampled distance, in queuing order.
+    template <class Done>
+    void sampleQueued(Done done) {
+        const std::size_t n = batch_.masses.size();
+        batch_.samples.resize(n);
+        field_.sampleMany(batch_.points, batch_.samples);
+        for (std::size_t k = 0; k < n; ++k) {
+            const SignedDistanceField::Interpolated& s = batch_.samples[k];
+            if (s.distance <= 0.0) addContact(batch_.masses[k], batch_.points[k], s);
+            done(k, s.distance);
+        }
+    }
+
+    std::size_t queuedCount() const { return batch_.masses.size(); }
+    Index queuedMass(std::size_t k) const { return batch_.masses[k]; }
+    const Vec3& queuedPoint(std::size_t k) const { return batch_.points[k]; }
+
+private:
+    struct Batch {
+        std::vector<Index> masses;
+        std::vector<Vec3> points;
+        std::vector<SignedDistanceField::Interpolated> samples;
+    };
+    // This thread's batch, kept between queries so its capacity stays.
+    static Batch& scratch() {
+        thread_local Batch batch;
+        return batch;
+    }
+
+    void addContact(Index m, const Vec3& p, const SignedDistanceField::Interpolated& s) {
         // The gradient is the outward normal (zero only on a symmetry plane of the field,
         // where the exact closest point decides).
         const double g = s.gradient.norm();
         const Vec3 outward = g > 1e-9 ? Vec3(s.gradient / g) : field_.query(p).normal;
         ++stats_.contacts;
-        contacts_.push_back({idA_, idB_, 0, topology.facesOf(m)[0], a_.pose().apply(p), -(ra_ * outward), -s.distance, m});
-        return s.distance;
+        contacts_.push_back({idA_, idB_, 0, b_.model().topology.facesOf(m)[0], a_.pose().apply(p), -(ra_ * outward), -s.distance, m});
     }
 
-private:
     std::uint32_t idA_, idB_;
     const Part& a_;
     const SignedDistanceField& field_;
@@ -46,6 +83,7 @@ private:
     Eigen::Matrix3d ra_;
     std::vector<Contact>& contacts_;
     QueryStats& stats_;
+    Batch& batch_;
 };
 
 // Walks B's rest-point tree depth first from `stack` (the root to begin), at most `budget`
@@ -123,21 +161,23 @@ void takeWalk(PointShellCoherence& c) {
 void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField& fieldA, std::uint32_t idB, const Part& b,
                      const Bvh<Aabb>& restPointsB, std::vector<Contact>& contacts, QueryStats& stats) {
     const RelativePose bInA = relativePose(a, b);
-    MassSampler sample(idA, a, fieldA, idB, b, bInA, contacts, stats);
-    for (Index m : b.movingMasses()) sample(m, sample.pointOf(m));
+    MassSampler sampler(idA, a, fieldA, idB, b, bInA, contacts, stats);
+    for (Index m : b.movingMasses()) sampler.queue(m, sampler.pointOf(m));
     // The masses at rest, through the tree of rest positions (their current positions).
-    if (restPointsB.empty()) return;
-    std::vector<std::int32_t> stack(1, 0);
-    stats.volumeTests += walkRestPoints(fieldA, restPointsB, bInA, 0.0, stack, std::numeric_limits<std::size_t>::max(), [&](Index m) {
-        if (!b.isMoving(m)) sample(m, sample.pointOf(m));
-    });
+    if (!restPointsB.empty()) {
+        std::vector<std::int32_t> stack(1, 0);
+        stats.volumeTests += walkRestPoints(fieldA, restPointsB, bInA, 0.0, stack, std::numeric_limits<std::size_t>::max(), [&](Index m) {
+            if (!b.isMoving(m)) sampler.queue(m, sampler.pointOf(m));
+        });
+    }
+    sampler.sampleQueued([](std::size_t, double) {});
 }
 
 void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDistanceField& fieldA, std::uint32_t idB, const Part& b,
                              const Bvh<Aabb>& restPointsB, const Sphere& restSphereB, PointShellCoherence& c,
                              std::vector<Contact>& contacts, QueryStats& stats) {
     const RelativePose bInA = relativePose(a, b);
-    MassSampler sample(idA, a, fieldA, idB, b, bInA, contacts, stats);
+    MassSampler sampler(idA, a, fieldA, idB, b, bInA, contacts, stats);
     const std::size_t massCount = b.model().massCount();
     if (c.lastDistance.size() != massCount) {
         c.lastDistance.assign(massCount, -1.0);  // none yet
@@ -146,15 +186,23 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
     // Moving masses: skipped while they stay closer to their last sample than it was far from
     // the surface (slope sqrt(3)); any other is sampled, and that sample kept.
     for (Index m : b.movingMasses()) {
-        const Vec3 p = sample.pointOf(m);
+        const Vec3 p = sampler.pointOf(m);
         if (c.lastDistance[m] > 0.0 && fieldA.staysClear(c.lastDistance[m], (p - c.lastPoint[m]).norm())) continue;
-        c.lastDistance[m] = sample(m, p);
-        c.lastPoint[m] = p;
+        if (!sampler.queue(m, p)) {
+            c.lastDistance[m] = std::numeric_limits<double>::infinity();  // nothing there can touch
+            c.lastPoint[m] = p;
+        }
     }
+    const std::size_t movingQueued = sampler.queuedCount();
     // Masses at rest: those the list's walk reached with the margin, while B's rest sphere has
     // moved less than it since that walk's pose; each skipped while its sample there stays
     // clear over that motion.
-    if (restPointsB.empty()) return;
+    const auto keepMovingSamples = [&](std::size_t k, double distance) {
+        if (k >= movingQueued) return;
+        c.lastDistance[sampler.queuedMass(k)] = distance;
+        c.lastPoint[sampler.queuedMass(k)] = sampler.queuedPoint(k);
+    };
+    if (restPointsB.empty()) return sampler.sampleQueued(keepMovingSamples);
     const double margin = kMarginCells * fieldA.cellSize();
     auto motionSince = [&](const RelativePose& pose) { return relativeMotion(pose, bInA, restSphereB); };
     double motion = c.valid ? motionSince(c.pose) : std::numeric_limits<double>::infinity();
@@ -178,8 +226,9 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
     for (const auto& [m, distance] : c.restMasses) {
         if (b.isMoving(m)) continue;
         if (fieldA.staysClear(distance, motion)) continue;
-        sample(m, sample.pointOf(m));
+        sampler.queue(m, sampler.pointOf(m));
     }
+    sampler.sampleQueued(keepMovingSamples);
 }
 
 }  // namespace flexfit
