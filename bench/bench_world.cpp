@@ -5,6 +5,7 @@
 // and the mean time per step of each stage and of the whole World::step, in microseconds (the
 // world's own profile over the timed steps), and the whole step's 99th percentile (nearest rank,
 // over every timed step of every iteration): a haptic loop's worst steps, not its mean.
+#include "collision/sampling_kernel.hpp"
 #include "flexfit/scene_file.hpp"
 #include "flexfit/scene_run.hpp"
 
@@ -66,6 +67,11 @@ void stepInContact(benchmark::State& state, const char* file, bool push, int set
 // while the rim is being pushed open (the deepest contact of the run). The scene's point-shell
 // query, and beside it the face-face query it replaces for this pair.
 void BM_HapticMouthPushed(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", true, 20); }
+// The same with the point shell's masses sampled one by one (the distance field's scalar path).
+void BM_HapticMouthPushedScalarSampling(benchmark::State& s) {
+    const flexfit::detail::ScopedScalarSampling scalar;
+    stepInContact(s, "ball_torus_haptic.toml", true, 20);
+}
 void BM_HapticMouthPushedFaceQuery(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", true, 20, true); }
 // Resting on the rim under its weight, 500 steps after the first contact.
 void BM_HapticMouthResting(benchmark::State& s) { stepInContact(s, "ball_torus_haptic.toml", false, 500); }
@@ -81,6 +87,7 @@ void BM_RigidMouthResting(benchmark::State& s) { stepInContact(s, "ball_torus_ri
 }  // namespace
 
 BENCHMARK(BM_HapticMouthPushed)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_HapticMouthPushedScalarSampling)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_HapticMouthPushedFaceQuery)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_HapticMouthResting)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_HapticMouthRestingFaceQuery)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);

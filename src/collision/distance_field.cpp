@@ -1,5 +1,6 @@
 #include "flexfit/distance_field.hpp"
 #include "flexfit/collision.hpp"
+#include "collision/sampling_kernel.hpp"
 #include "collision/triangle_queries.hpp"
 
 #include <algorithm>
@@ -290,11 +291,28 @@ bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
     return clearOf(fine_, centre, radius, 0.0);
 }
 
+namespace detail {
+namespace {
+bool scalarSamplingChosen = false;  // ScopedScalarSampling
+}  // namespace
+
+bool vectorSamplingEnabled() {
+#if defined(FLEXFIT_SDF_AVX2)
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    return avx2 && !scalarSamplingChosen;
+#else
+    return false;
+#endif
+}
+
+ScopedScalarSampling::ScopedScalarSampling() { scalarSamplingChosen = true; }
+ScopedScalarSampling::~ScopedScalarSampling() { scalarSamplingChosen = false; }
+}  // namespace detail
+
 void SignedDistanceField::sampleMany(std::span<const Vec3> points, std::span<Interpolated> out) const {
     std::size_t i = 0;
 #if defined(FLEXFIT_SDF_AVX2)
-    static const bool avx2 = __builtin_cpu_supports("avx2");
-    if (avx2)
+    if (detail::vectorSamplingEnabled())
         i = sampleFours(fine_.box.min, fine_.dims, fine_.cell, fine_.values.data(), points, out,
                         [&](std::size_t k) { out[k] = sample(fine_, points[k]); });
 #endif

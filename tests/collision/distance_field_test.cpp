@@ -1,6 +1,7 @@
 // The signed distance field against independent references: the analytic distance to a box,
 // brute force over every face of a sphere mesh, the stated interpolation error, and the
 // pruning bound against dense sampling.
+#include "collision/sampling_kernel.hpp"
 #include "collision/triangle_queries.hpp"
 #include "flexfit/flexfit.hpp"
 
@@ -148,7 +149,9 @@ TEST(SignedDistanceField, OpenFlippedOrInsideOutMeshIsRefused) {
 // second field of the same mesh, bit for bit: points near the surface (corners computed when
 // built) and far from it (corners computed on first reading, by whichever field reads first),
 // in batches of every length, so whole vectors and the scalar tail both run.
-TEST(SignedDistanceField, SampleManyEqualsSampleBitForBit) {
+namespace {
+
+void expectSampleManyEqualsSample() {
     const TriMesh sphere = makeIcoSphere(1.0, 2);
     const SignedDistanceField batched = fieldOf(sphere), single = fieldOf(sphere);
     std::mt19937 rng(7);
@@ -171,4 +174,17 @@ TEST(SignedDistanceField, SampleManyEqualsSampleBitForBit) {
         }
     }
     EXPECT_GT(compared, 3500u);
+}
+
+}  // namespace
+
+TEST(SignedDistanceField, SampleManyEqualsSampleBitForBit) {
+    if (!detail::vectorSamplingEnabled()) GTEST_SKIP() << "no AVX2 on this CPU: sampleMany is sample() point by point";
+    expectSampleManyEqualsSample();
+}
+
+TEST(SignedDistanceField, SampleManyScalarPathEqualsSample) {
+    const detail::ScopedScalarSampling scalar;
+    ASSERT_FALSE(detail::vectorSamplingEnabled());
+    expectSampleManyEqualsSample();
 }
