@@ -113,6 +113,17 @@ void applyReactionForces(const StepContext& step, double dampingRatio, Bodies& b
     }
 }
 
+// Which sides of a pair's contacts make reactions: side A (A presses B) when A is dynamic, B
+// deforms and the contact solver did not answer the pair; side B the other way round.
+struct ReactingSides {
+    bool bodyA = false, bodyB = false;
+    ReactingSides(const Bodies& bodies, BodyId a, BodyId b)
+        : bodyA(reacts(bodies, a, b)), bodyB(reacts(bodies, b, a)) {}
+    static bool reacts(const Bodies& bodies, BodyId body, BodyId part) {
+        return bodies.dynamic(body) && bodies.parts[part]->deforms() && !solvedByImpulses(bodies, body, part);
+    }
+};
+
 // Each (body, contacted mass) once, in first-contact order (deterministic); then each body
 // feels its masses' reactions, for the next step.
 void applyDeformableReactions(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
@@ -122,20 +133,27 @@ void applyDeformableReactions(const StepContext& step, double dampingRatio, std:
     r.reacting.clear();
     for (const ContactResponse::Reaction& reaction : r.reactions) bodies.rigid[reaction.body].deformableContactForce.setZero();  // last step's
     r.reactions.clear();
-    for (const Contact& c : contacts)
-        for (const auto& [body, part, face, mass] :
-             {std::tuple{c.partA, c.partB, c.faceB, c.massB}, std::tuple{c.partB, c.partA, c.faceA, kNoMass}}) {
-            if (!bodies.dynamic(body) || !bodies.parts[part]->deforms()) continue;
-            if (solvedByImpulses(bodies, body, part)) continue;  // the contact solver answered it
-            // Contacts come grouped by pair, so a mass pressed by two bodies counts once for each.
-            for (Index m : pressedMasses(bodies.parts[part]->model().mesh.faces[face], mass)) {
-                const Index key = bodies.worldMass(part, m);
-                if (r.reacting.insert(key) || r.reactionOwner[key] != body) {
-                    r.reactionOwner[key] = body;
-                    r.reactions.push_back({body, part, m});
-                }
+    // Contacts come grouped by pair, so a mass pressed by two bodies counts once for each.
+    auto react = [&](BodyId body, BodyId part, Index face, Index mass) {
+        for (Index m : pressedMasses(bodies.parts[part]->model().mesh.faces[face], mass)) {
+            const Index key = bodies.worldMass(part, m);
+            if (r.reacting.insert(key) || r.reactionOwner[key] != body) {
+                r.reactionOwner[key] = body;
+                r.reactions.push_back({body, part, m});
             }
         }
+    };
+    std::optional<ReactingSides> sides;
+    BodyId a = 0, b = 0;
+    for (const Contact& c : contacts) {
+        if (!sides || c.partA != a || c.partB != b) {  // the pair's sides, once per run of its contacts
+            a = c.partA;
+            b = c.partB;
+            sides.emplace(bodies, a, b);
+        }
+        if (sides->bodyA) react(a, b, c.faceB, c.massB);
+        if (sides->bodyB) react(b, a, c.faceA, kNoMass);
+    }
     applyReactionForces(step, dampingRatio, bodies, r);
 }
 
