@@ -10,6 +10,7 @@
 // flexfit.InputError (a ValueError with .source, .line, .problem) and flexfit.DivergenceError
 // (a RuntimeError with .body, .time, .problem), carrying the C++ message.
 #include "flexfit/flexfit.hpp"
+#include "io/scene_document.hpp"
 #include "scene_runner.hpp"
 #include "sweep_runner.hpp"
 
@@ -186,6 +187,52 @@ void applyPartKeywords(const py::kwargs& keywords, PartSettings& part, BodySetti
         }
     }
     if (body) body->kineticFriction = kinetic.value_or(body->staticFriction);  // as in scene files
+}
+
+// A Python value as a TOML node: bool, int, float, str, a dict (table) or a sequence (array),
+// nested; `key` names it in the error for anything else.
+std::unique_ptr<toml::node> tomlValue(const py::handle& value, const std::string& key) {
+    if (py::isinstance<py::bool_>(value)) return std::make_unique<toml::value<bool>>(value.cast<bool>());
+    if (py::isinstance<py::int_>(value)) return std::make_unique<toml::value<std::int64_t>>(value.cast<std::int64_t>());
+    if (py::isinstance<py::float_>(value)) return std::make_unique<toml::value<double>>(value.cast<double>());
+    if (py::isinstance<py::str>(value)) return std::make_unique<toml::value<std::string>>(value.cast<std::string>());
+    if (py::isinstance<py::dict>(value)) {
+        auto table = std::make_unique<toml::table>();
+        for (const auto& [k, v] : value.cast<py::dict>()) {
+            const std::string name = py::str(k);
+            table->insert(name, std::move(*tomlValue(v, key + "." + name)));
+        }
+        return table;
+    }
+    if (py::isinstance<py::sequence>(value) || py::hasattr(value, "tolist")) {
+        const py::handle items = py::hasattr(value, "tolist") ? value.attr("tolist")().release() : value.inc_ref();
+        const py::object list = py::reinterpret_steal<py::object>(items);
+        auto array = std::make_unique<toml::array>();
+        for (const py::handle item : list) array->push_back(std::move(*tomlValue(item, key)));
+        return array;
+    }
+    throw InputError(key, 0, "a value of a type a scene file cannot hold: " + std::string(py::str(py::repr(value))));
+}
+
+// An assembly rule from keywords named as the scene file's [[assembly]] keys, read by the
+// scene reader itself (so the same keys, defaults and checks); bodies by id.
+AssemblyRule assemblyRule(const World& w, BodyId primary, BodyId secondary, const py::kwargs& keywords, std::size_t ruleCount) {
+    for (const auto& [role, id] : {std::pair{"primary", primary}, std::pair{"secondary", secondary}})
+        if (id >= w.bodyCount())
+            throw InputError("add_assembly", 0, std::string(role) + ": no body " + std::to_string(id) + " (the world has " +
+                                                    std::to_string(w.bodyCount()) + ")");
+    toml::table table;
+    for (const auto& [key, value] : keywords) {
+        const std::string k = py::str(key);
+        if (k == "primary" || k == "secondary") throw InputError("add_assembly", 0, "key '" + k + "': give the body id as the argument");
+        table.insert(k, std::move(*tomlValue(value, k)));
+    }
+    std::vector<std::string> names;
+    for (BodyId id = 0; id < w.bodyCount(); ++id) names.push_back("body " + std::to_string(id));
+    table.insert("primary", names[primary]);
+    table.insert("secondary", names[secondary]);
+    if (!table.contains("name")) table.insert("name", "assembly " + std::to_string(ruleCount));
+    return detail::readAssemblyTable(table, "add_assembly", names);
 }
 
 PartModelSettings modelSettings(std::optional<std::string> material, std::optional<std::pair<double, double>> springs, double vertexMass,
@@ -406,11 +453,18 @@ PYBIND11_MODULE(_flexfit, m) {
              "Sets a dynamic body's velocity (world frame; rad/s for the angular one).")
         .def("open_zone", [](World& w, BodyId id, Index mass, int level) { return w.openZone(id, ZoneSeed::mass(mass), level); }, py::arg("id"),
              py::arg("mass"), py::arg("level"), "Opens a zone on a body's part around a mass (ahead of a contact); returns its id.")
-        .def("grab", [](World& w, BodyId id, double frequency) {
+        .def("grab", [](World& w, BodyId id, double frequency, double stiffness, double damping, double angularStiffness, double angularDamping) {
             GrabSettings g;
             g.frequency = frequency;
+            g.stiffness = stiffness;
+            g.damping = damping;
+            g.angularStiffness = angularStiffness;
+            g.angularDamping = angularDamping;
             w.grab(id, g);
-        }, py::arg("id"), py::arg("frequency") = 10.0, "The operator grabs a body (a spring-damper coupling of that frequency).")
+        }, py::arg("id"), py::arg("frequency") = 10.0, py::arg("stiffness") = 0.0, py::arg("damping") = -1.0,
+             py::arg("angular_stiffness") = 0.0, py::arg("angular_damping") = -1.0,
+             "The operator grabs a body: a spring-damper coupling of that frequency, or of the stiffnesses given (N/m, N m/rad; "
+             "0: from the frequency) and dampings (N s/m, N m s/rad; negative: critical), as the scene file's grab action.")
         .def("set_grab_target", [](World& w, const Vec3& position, const Eigen::Vector4d& rotation) { w.setGrabTarget(makePose(position, rotation)); },
              py::arg("position"), py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0), "Moves the pose the operator wants the grabbed body at.")
         .def("release", &World::release, "The operator lets go of the grabbed body.")
@@ -422,6 +476,24 @@ PYBIND11_MODULE(_flexfit, m) {
             d["torque"] = w.coupling().torque;
             return d;
         }, "The operator coupling's force and torque on the grabbed body in the last step (the device feels their opposite).")
+        .def("add_assembly", [](World& w, BodyId primary, BodyId secondary, const py::kwargs& keys) {
+            return w.addAssembly(assemblyRule(w, primary, secondary, keys, w.assemblyCount()));
+        }, py::arg("primary"), py::arg("secondary"),
+             "Adds a snapping rule between two bodies; returns its index. Keywords as the scene file's [[assembly]] keys, with the "
+             "same defaults and checks: name, technique ('zone'; 'collision', 'proximity', 'vector'), final_position, "
+             "final_rotation, snap_duration, distance_tolerance, angle_tolerance (degrees), primary_vector / secondary_vector "
+             "({'origin': ..., 'end': ...}), vector_tolerance, area ({'shape': 'box' | 'sphere' | 'cylinder', 'position', "
+             "'rotation', 'half_extents', 'radius', 'half_height'}).")
+        .def("assembled", &World::assembled, py::arg("rule"), "Whether the rule has snapped its primary into place.")
+        .def_property_readonly("assembly_count", &World::assemblyCount, "Assembly rules added (indices 0 .. assembly_count - 1).")
+        .def("apply_force_at", &World::applyForceAt, py::arg("id"), py::arg("force"), py::arg("point"),
+             "A world-frame force at a world point for the next step (dynamic bodies): the force and its torque.")
+        .def("apply_face_force", &World::applyFaceForce, py::arg("id"), py::arg("face"), py::arg("force"),
+             "A world-frame force for the next step spread over a face's three masses.")
+        .def("set_kinematic_target", [](World& w, BodyId id, const Vec3& position, const Eigen::Vector4d& rotation) {
+            w.setKinematicTarget(id, makePose(position, rotation));
+        }, py::arg("id"), py::arg("position"), py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0),
+             "A kinematic body's pose to reach by the end of the next step (its velocity follows).")
         .def("assembly_events", [](const World& w) {
             py::list out;
             for (const AssemblyEvent& e : w.assemblyEvents()) out.append(eventDict(e));

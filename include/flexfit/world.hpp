@@ -145,6 +145,7 @@ public:
     // pose over the snap duration, and then stays attached to the secondary. Throws InputError
     // for unknown bodies or a negative duration.
     std::size_t addAssembly(const AssemblyRule& rule);
+    std::size_t assemblyCount() const;  // rules added
     const std::vector<AssemblyEvent>& assemblyEvents() const;
     bool assembled(std::size_t rule) const;
 

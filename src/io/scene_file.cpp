@@ -550,6 +550,17 @@ Scene parseScene(std::string_view text, const std::string& source, const std::fi
     return detail::readSceneDocument(document, source, baseDirectory, options);
 }
 
+AssemblyRule detail::readAssemblyTable(const toml::table& table, const std::string& source, const std::vector<std::string>& partNames) {
+    Scene scene;  // only the parts' names: readAssembly looks the rule's bodies up by name
+    scene.source = source;
+    for (const std::string& name : partNames) {
+        scene.parts.emplace_back();
+        scene.parts.back().name = name;
+    }
+    Table t(table, "assembly", scene.source, scene.warnings);
+    return readAssembly(t, scene);
+}
+
 Scene detail::readSceneDocument(const toml::table& document, const std::string& source, const std::filesystem::path& baseDirectory,
                                 const SceneReadOptions& options) {
     Scene scene;

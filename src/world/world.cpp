@@ -173,6 +173,7 @@ void World::applyFaceForce(BodyId id, Index face, const Vec3& worldForce) {
 // --- Assembly ---
 
 std::size_t World::addAssembly(const AssemblyRule& rule) { return detail::addRule(rule, data_->bodies.size(), data_->assembly); }
+std::size_t World::assemblyCount() const { return data_->assembly.rules.size(); }
 const std::vector<AssemblyEvent>& World::assemblyEvents() const { return data_->assembly.events; }
 bool World::assembled(std::size_t rule) const {
     if (rule >= data_->assembly.rules.size()) throw InputError(kSource, 0, "assembled: no rule " + std::to_string(rule));

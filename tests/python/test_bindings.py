@@ -312,3 +312,120 @@ def test_physical_material_and_a_part_alone_with_its_own_settings():
     assert np.isfinite(part.positions).all() and part.positions[0, 1] > bent.rest_positions[0, 1]
     with pytest.raises(flexfit.InputError):
         flexfit.Part(bent, density=1.0)  # a body's key: not for a part alone
+
+
+SNAPPED_BALL = PUSHED_BALL.replace("duration = 0.6", "duration = 0.3") + """
+[[assembly]]
+name = "ball into the container"
+primary = "ball"
+secondary = "mouth"
+technique = "zone"
+primary_vector = { origin = [0, -8.5, 0], end = [0, 8.5, 0] }
+area = { shape = "cylinder", position = [0, 0, 0], radius = 7.5, half_height = 14 }
+final_position = [0, -12, 0]
+snap_duration = 0.1
+"""
+
+
+def pushed_ball_world():
+    world = flexfit.World(time_step=0.001, gravity=[0, -9.81, 0])
+    mouth = flexfit.PartModel(flexfit.container_mouth(), material="elastic")
+    ball = flexfit.PartModel(flexfit.sphere(8.5, 2))
+    m = world.add(mouth, mode="rigid-deformable", restoration="anchors", anchor_stiffness=10.0, anchor_damping=6.0, global_damping=1.0,
+                  contact_level=3, static_friction=0.4, kinetic_friction=0.3)
+    b = world.add(ball, position=[0, 4.7, 0], mode="rigid", motion="dynamic", density=0.01, static_friction=0.4)
+    return world, m, b
+
+
+def test_assembly_keywords_are_the_scene_files_keys(tmp_path):
+    """A rule from keywords snaps as the same rule read from a scene file: the same event, the same run bit for bit."""
+    path = tmp_path / "snapped.toml"
+    path.write_text(SNAPPED_BALL)
+    scene_run = flexfit.SceneRun(flexfit.load_scene(str(path)))
+    scene_run.step(300)
+    assert scene_run.world.assembly_events(), "the ball starts inside the area: the rule snaps"
+
+    world, m, b = pushed_ball_world()
+    rule = world.add_assembly(b, m, name="ball into the container", technique="zone",
+                              primary_vector={"origin": [0, -8.5, 0], "end": [0, 8.5, 0]},
+                              area={"shape": "cylinder", "position": np.array([0.0, 0.0, 0.0]), "radius": 7.5, "half_height": 14},
+                              final_position=(0, -12, 0), snap_duration=0.1)
+    assert rule == 0 and world.assembly_count == 1 and not world.assembled(rule)
+    for step in range(300):
+        world.apply_force(b, [0, -2500, 0])
+        world.step()
+    assert world.assembled(rule)
+    assert [e["time"] for e in world.assembly_events()] == [e["time"] for e in scene_run.world.assembly_events()]
+    assert world.state_hash() == scene_run.world.state_hash()
+    np.testing.assert_array_equal(world.pose(b)["position"], [0, -12, 0])
+
+    with pytest.raises(flexfit.InputError, match="snap_duraton"):
+        world.add_assembly(b, m, snap_duraton=0.1)  # unknown keys are refused as in scene files
+    with pytest.raises(flexfit.InputError, match="radius"):
+        world.add_assembly(b, m, area={"shape": "sphere", "radius": -1})
+    with pytest.raises(flexfit.InputError, match="no body 9"):
+        world.add_assembly(b, 9)
+    with pytest.raises(flexfit.InputError, match="technique"):
+        world.add_assembly(b, m, technique="glue")
+    with pytest.raises(flexfit.InputError):
+        world.assembled(5)
+    assert world.assembly_count == 1  # nothing half-added
+
+
+def test_forces_at_points_faces_and_kinematic_targets():
+    world = flexfit.World(time_step=0.01, gravity=[0, 0, 0])
+    box = flexfit.PartModel(flexfit.box([1, 1, 1], 1))
+    b = world.add(box, mode="rigid", motion="dynamic", density=1.0)
+    mass = 8.0  # a 2 x 2 x 2 box of density 1
+    centre = world.centre_of_mass(b)
+    # A force at a point off the centre: the body's momentum changes by F h, its angular
+    # momentum by (r x F) h (the analytic impulse; the box's inertia is diagonal, (m/6) a^2).
+    force, arm = np.array([0.0, 6.0, 0.0]), np.array([1.0, 0.0, 0.0])
+    world.apply_force_at(b, force, centre + arm)
+    world.step()
+    velocity = (world.centre_of_mass(b) - centre) / 0.01
+    np.testing.assert_allclose(velocity, force / mass * 0.01, rtol=1e-9, atol=1e-12)
+    inertia = mass * (2.0**2 + 2.0**2) / 12.0
+    spin = np.cross(arm, force) * 0.01 / inertia  # rad/s, about z
+    angle = np.linalg.norm(spin) * 0.01
+    np.testing.assert_allclose(world.pose(b)["rotation_wxyz"], [np.cos(angle / 2), 0, 0, np.sin(angle / 2)], atol=1e-9)
+
+    # A face force is the same as a third of it on each of the face's three masses.
+    def mouth_with(load):
+        w = flexfit.World(time_step=1e-3, gravity=[0, 0, 0])
+        mouth = flexfit.PartModel(flexfit.container_mouth(), material="elastic")
+        m = w.add(mouth, mode="full-deformable")
+        load(w, m, mouth)
+        w.step(20)
+        return w.state_hash()
+    f = np.array([0.3, -0.9, 0.6])
+    face = 17
+    by_face = mouth_with(lambda w, m, model: w.apply_face_force(m, face, f))
+    by_masses = mouth_with(lambda w, m, model: [w.apply_mass_force(m, int(v), f / 3.0) for v in model.mesh.faces[face]])
+    assert by_face == by_masses
+    with pytest.raises(flexfit.InputError, match="face"):
+        world.apply_face_force(b, 10**6, f)
+
+    # A kinematic body reaches its target by the end of the next step.
+    k = world.add(box, mode="rigid", motion="kinematic", position=[5, 0, 0])
+    world.set_kinematic_target(k, [5, 1, 0], [np.cos(0.1), 0, np.sin(0.1), 0])
+    world.step()
+    np.testing.assert_allclose(world.pose(k)["position"], [5, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(world.pose(k)["rotation_wxyz"], [np.cos(0.1), 0, np.sin(0.1), 0], atol=1e-12)
+    with pytest.raises(flexfit.InputError):
+        world.set_kinematic_target(k, [np.nan, 0, 0])
+
+
+def test_grab_with_explicit_coupling_stiffness():
+    """Stiffness and damping as the scene's grab action takes them: the coupling force is k (target - position) at rest."""
+    world = flexfit.World(time_step=1e-3, gravity=[0, 0, 0])
+    ball = flexfit.PartModel(flexfit.sphere(1.0, 2))
+    b = world.add(ball, mode="rigid", motion="dynamic", density=1.0)
+    world.grab(b, stiffness=200.0, damping=0.0, angular_stiffness=5.0, angular_damping=0.0)
+    world.set_grab_target([0.01, 0, 0])
+    world.step()
+    coupling = world.coupling()
+    np.testing.assert_allclose(coupling["force"], [200.0 * 0.01, 0, 0], rtol=1e-6)
+    world.release()
+    with pytest.raises(flexfit.InputError):
+        world.grab(b, stiffness=1e12, damping=0.0)  # a coupling the time step cannot integrate

@@ -134,3 +134,23 @@ TEST(Assembly, SnappingTakesThePartFromTheOperator) {
     EXPECT_FALSE(world.grabbed());
     EXPECT_NEAR(world.assemblyEvents()[0].primaryPoseBefore.translation.x(), 5.5, 0.05);  // within 0.5 of the goal
 }
+
+TEST(Assembly, RulesAreCountedAndARefusedRuleIsNotAdded) {
+    World world(WorldSettings{1e-3, Vec3::Zero(), {}, 0.25, 4096, 4});
+    PartSettings rigid;
+    rigid.mode = PartMode::Rigid;
+    const BodyId a = world.add(buildPartModel(makeIcoSphere(1.0, 1)), rigid, BodySettings{}, Pose{});
+    const BodyId b = world.add(buildPartModel(makeIcoSphere(1.0, 1)), rigid, BodySettings{}, at(Vec3(5, 0, 0)));
+    EXPECT_EQ(world.assemblyCount(), 0u);
+    AssemblyRule r = rule(SnapTechnique::ProximitySnap);
+    r.primary = a;
+    r.secondary = b;
+    EXPECT_EQ(world.addAssembly(r), 0u);
+    r.secondary = 7;  // no such body
+    EXPECT_THROW(world.addAssembly(r), InputError);
+    r.secondary = b;
+    r.snapDuration = -1.0;
+    EXPECT_THROW(world.addAssembly(r), InputError);
+    EXPECT_EQ(world.assemblyCount(), 1u);
+    EXPECT_THROW((void)world.assembled(1), InputError);
+}
