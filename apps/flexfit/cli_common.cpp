@@ -134,8 +134,7 @@ std::filesystem::path PendingFiles::add(const std::filesystem::path& path) {
     std::error_code ec;
     const std::filesystem::file_status status = std::filesystem::status(path, ec);
     if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) return path;  // /dev/stdout, a pipe
-    std::filesystem::path temporary = path;
-    temporary += ".partial";
+    const std::filesystem::path temporary = temporaryBeside(path);
     files_.push_back({temporary, path});
     return temporary;
 }

@@ -70,7 +70,7 @@ void writePartsObj(const std::filesystem::path& path, const std::string& header,
 void makeDirectory(const std::filesystem::path& dir);
 
 // The files of one run, all or none: each is written under a temporary name beside it
-// (`<path>.partial`), commit() renames them all once the run has finished, and the destructor
+// (temporaryBeside, frame_export.hpp), commit() renames them all once the run has finished, and the destructor
 // removes whatever was not committed. So a run that fails (a divergence, a write error) leaves
 // no half-written output; files of an earlier run under the same names stay until commit().
 class PendingFiles {

@@ -38,6 +38,12 @@ void writeGlbFrame(const std::filesystem::path& file, const std::vector<FramePar
 // A .pvd collection: (time in s, frame file relative to the .pvd) per frame.
 void writeVtkCollection(const std::filesystem::path& file, const std::vector<std::pair<double, std::string>>& frames);
 
+// The temporary that `file` is written under before it is renamed into place (the exports
+// here, and the runs' outputs): beside it, named by this process and a per-process count
+// (`<file>.<pid>-<n>.partial`), so two writers of the same file (a command and a Python sweep,
+// a retried task) never write into each other's temporary.
+std::filesystem::path temporaryBeside(const std::filesystem::path& file);
+
 // Frames <directory>/<stem>_<NNNNNN>.vtp and the collection <directory>/<stem>.pvd.
 class VtkSeries {
 public:

@@ -4,33 +4,36 @@
 #include <assimp/Exporter.hpp>
 #include <assimp/scene.h>
 
+#include <atomic>
+#include <cstdint>
 #include <cstdio>
+#include <unistd.h>
 #include <fstream>
 #include <sstream>
 
 namespace flexfit {
 namespace {
 
-// `file`'s temporary beside it; moveIntoPlace renames it once whole (or removes it and throws).
-std::filesystem::path temporaryOf(const std::filesystem::path& file) { return file.string() + ".partial"; }
-
-void moveIntoPlace(const std::filesystem::path& file, bool written, const std::string& problem = "cannot write the file") {
+// Renames `temporary` to `file` once whole (or removes it and throws).
+void moveIntoPlace(const std::filesystem::path& temporary, const std::filesystem::path& file, bool written,
+                   const std::string& problem = "cannot write the file") {
     std::error_code ec;
-    if (written) std::filesystem::rename(temporaryOf(file), file, ec);
+    if (written) std::filesystem::rename(temporary, file, ec);
     if (!written || ec) {
-        std::filesystem::remove(temporaryOf(file), ec);
+        std::filesystem::remove(temporary, ec);
         throw InputError(file.string(), 0, problem);
     }
 }
 
 void writeWhole(const std::filesystem::path& file, const std::string& text) {
+    const std::filesystem::path temporary = temporaryBeside(file);
     bool written = false;
     {
-        std::ofstream out(temporaryOf(file), std::ios::binary);
+        std::ofstream out(temporary, std::ios::binary);
         out << text;
         written = bool(out);
     }
-    moveIntoPlace(file, written);
+    moveIntoPlace(temporary, file, written);
 }
 
 void checkParts(const std::vector<FramePart>& parts, const std::filesystem::path& file) {
@@ -94,6 +97,11 @@ void appendPiece(std::ostringstream& out, const FramePart& named) {
 
 }  // namespace
 
+std::filesystem::path temporaryBeside(const std::filesystem::path& file) {
+    static std::atomic<std::uint64_t> count{0};
+    return file.string() + "." + std::to_string(::getpid()) + "-" + std::to_string(count++) + ".partial";
+}
+
 void writeVtkFrame(const std::filesystem::path& file, const std::vector<FramePart>& parts) {
     checkParts(parts, file);
     std::ostringstream out;
@@ -138,8 +146,9 @@ void writeGlbFrame(const std::filesystem::path& file, const std::vector<FramePar
         scene.mRootNode->mChildren[i] = node;
     }
     Assimp::Exporter exporter;
-    const bool written = exporter.Export(&scene, "glb2", temporaryOf(file).string()) == AI_SUCCESS;
-    moveIntoPlace(file, written, written ? "cannot write the file" : std::string("cannot write the glTF file: ") + exporter.GetErrorString());
+    const std::filesystem::path temporary = temporaryBeside(file);
+    const bool written = exporter.Export(&scene, "glb2", temporary.string()) == AI_SUCCESS;
+    moveIntoPlace(temporary, file, written, written ? "cannot write the file" : std::string("cannot write the glTF file: ") + exporter.GetErrorString());
 }
 
 void writeVtkCollection(const std::filesystem::path& file, const std::vector<std::pair<double, std::string>>& frames) {

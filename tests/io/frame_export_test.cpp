@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -105,9 +106,28 @@ TEST(FrameExport, UnwritablePathIsAnErrorNamingIt) {
             EXPECT_EQ(e.source(), file);
             EXPECT_NE(std::string(e.what()).find("cannot write"), std::string::npos) << e.what();
         }
-        EXPECT_FALSE(std::filesystem::exists(file + ".partial"));
     }
     EXPECT_THROW(writeVtkFrame("/tmp/none.vtp", {}), InputError);
+}
+
+// Nothing but the finished files is left in the directory, whether a write succeeds or fails
+// (here: the target is a directory, so the rename into place fails).
+TEST(FrameExport, TemporariesAreUniqueAndNeverLeftBehind) {
+    const TempDir temp;
+    const std::filesystem::path dir = temp.path();
+    std::filesystem::create_directories(dir / "taken.vtp");
+    const std::filesystem::path a = temporaryBeside(dir / "f.vtp"), b = temporaryBeside(dir / "f.vtp");
+    EXPECT_NE(a, b);
+    EXPECT_EQ(a.parent_path(), dir);
+    EXPECT_TRUE(a.string().ends_with(".partial")) << a;
+    const Part part = pressedTorus();
+    writeVtkFrame(dir / "f.vtp", {{"a", &part}});
+    writeGlbFrame(dir / "f.glb", {{"a", &part}});
+    EXPECT_THROW(writeVtkFrame(dir / "taken.vtp", {{"a", &part}}), InputError);
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"f.glb", "f.vtp", "taken.vtp"}));
 }
 
 }  // namespace
