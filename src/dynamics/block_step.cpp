@@ -40,6 +40,21 @@ void blockForcesScalar(const SpringBlocks& blocks, const double* x, const double
     }
 }
 
+// Masses [begin, n) whose cover count is 0 back to rest, velocity zero: by selection, without a
+// branch per mass (the region's edge is irregular).
+void holdAtRestFrom(const PartModel& model, const std::uint16_t* cover, PartState& state, std::size_t begin) {
+    const double* rest = model.restPositions.data()->data();
+    double* __restrict x = state.positions.data()->data();
+    double* __restrict v = state.velocities.data()->data();
+    for (std::size_t m = begin; m < model.massCount(); ++m) {
+        const bool moves = cover[m] != 0;
+        for (std::size_t c = 0; c < 3; ++c) {
+            x[3 * m + c] = moves ? x[3 * m + c] : rest[3 * m + c];
+            v[3 * m + c] = moves ? v[3 * m + c] : 0.0;
+        }
+    }
+}
+
 void integrateScalar(const PartModel& model, const MassUpdate& p, PartState& state, std::size_t begin) {
     for (std::size_t i = begin; i < model.massCount(); ++i) integrateMass(model, p, state, i);
 }
@@ -149,31 +164,23 @@ void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, Pa
     if (kernel == BlockKernel::Avx512) done = holdAtRestAvx512(model, cover.data(), state);
 #endif
     (void)kernel;
-    // The rest by selection, without a branch per mass (the region's edge is irregular).
-    const double* rest = model.restPositions.data()->data();
-    double* __restrict x = state.positions.data()->data();
-    double* __restrict v = state.velocities.data()->data();
-    for (std::size_t m = done; m < model.massCount(); ++m) {
-        const bool moves = cover[m] != 0;
-        for (std::size_t c = 0; c < 3; ++c) {
-            x[3 * m + c] = moves ? x[3 * m + c] : rest[3 * m + c];
-            v[3 * m + c] = moves ? v[3 * m + c] : 0.0;
-        }
-    }
+    holdAtRestFrom(model, cover.data(), state, done);
 }
 
-void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel) {
+void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel,
+                      const std::uint16_t* held) {
     const double* x = state.positions.data()->data();
     const double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
     blockForces(*model.springBlocks, x, v, f, kernel);
     listedSpringForces(model, model.springBlocks->remainder, nullptr, x, v, f, kernel);
-    std::size_t integrated = 0;  // what the vector kernels did; the scalar pass finishes
+    std::size_t integrated = 0, heldDone = 0;  // what the vector kernels did; the scalar passes finish
 #if defined(FLEXFIT_X86_KERNELS)
-    if (kernel == BlockKernel::Avx512) integrated = integrateAvx512(model, update, state);
+    if (kernel == BlockKernel::Avx512) heldDone = integrated = integrateAvx512(model, update, state, held);
     if (kernel == BlockKernel::Avx2) integrated = integrateAvx2(model, update, state);
 #endif
     integrateScalar(model, update, state, integrated);
+    if (held != nullptr) holdAtRestFrom(model, held, state, heldDone);
 }
 
 }  // namespace flexfit::detail

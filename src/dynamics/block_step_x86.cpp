@@ -209,7 +209,7 @@ FLEXFIT_AVX512 void regionBlocks512(const SpringBlocks& blocks, std::span<const 
 
 // Groups of 8 masses: group g starts at 8 octets[g], or at 8 g without a list.
 FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate& p, PartState& state,
-                                        const Index* octets, std::size_t groups) {
+                                        const Index* octets, std::size_t groups, const std::uint16_t* held = nullptr) {
     double* x = state.positions.data()->data();
     double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
@@ -223,6 +223,7 @@ FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate
         const std::size_t i = 8 * (octets != nullptr ? std::size_t(octets[g]) : g);
         const __m512d mass = _mm512_loadu_pd(model.mass.data() + i);
         const __m512d hOverMass = _mm512_mul_pd(h, _mm512_loadu_pd(model.inverseMass.data() + i));
+        const std::uint32_t heldLanes = held != nullptr ? kSpread3[heldBits8(held + i)] : 0u;
         for (int j = 0; j < 3; ++j) {
             const std::size_t o = 3 * i + 8 * std::size_t(j);
             const __m512d m = spread8(mass, j), hm = spread8(hOverMass, j);
@@ -244,6 +245,11 @@ FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate
                 const __m512d correction = _mm512_mul_pd(constraint, _mm512_sub_pd(r, xn));
                 xn = _mm512_add_pd(xn, correction);
                 vn = _mm512_add_pd(vn, _mm512_mul_pd(invH, correction));
+            }
+            if (heldLanes != 0) {  // masses no zone covers: back to rest, as holdAtRest puts them
+                const auto atRest = __mmask8((heldLanes >> (8 * j)) & 0xffu);
+                xn = _mm512_mask_loadu_pd(xn, atRest, rest + o);
+                vn = _mm512_mask_mov_pd(vn, atRest, _mm512_setzero_pd());
             }
             _mm512_storeu_pd(x + o, xn);
             _mm512_storeu_pd(v + o, vn);
@@ -564,8 +570,8 @@ std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Ind
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state) {
     return integrate256(model, update, state, nullptr, model.massCount() / 4);
 }
-std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state) {
-    return integrate512(model, update, state, nullptr, model.massCount() / 8);
+std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held) {
+    return integrate512(model, update, state, nullptr, model.massCount() / 8, held);
 }
 void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state) {
     integrate256(model, update, state, octets.data(), 2 * octets.size());

@@ -38,8 +38,16 @@ const char* toString(BlockKernel kernel);
 // fixes; the kernel must be available.
 void blockForces(const SpringBlocks& blocks, const double* x, const double* v, double* f, BlockKernel kernel);
 
-// Springs by blocks, the remainder, then every mass. The kernel must be available.
-void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel);
+// Springs by blocks, the remainder, then every mass. The kernel must be available. With
+// `held` (a cover count per mass), each mass whose count is 0 ends the step at rest instead,
+// velocity and force zero (what holdAtRest does after the step, in the integration's pass).
+void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel,
+                      const std::uint16_t* held = nullptr);
+
+// stepFullModel, or with `held` (cover counts) the full step standing for a region's
+// (stepRegionByFullModel): the masses no zone covers end the step at rest.
+void stepAllMasses(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
+                   const std::uint16_t* held, PartState& state, StepCounters* counters);
 
 // After a full step that stood for a region's (stepRegionByFullModel): every mass whose cover
 // count is 0 back to rest, velocity zero (the full step left every force at zero). A pure
@@ -77,7 +85,8 @@ std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Ind
                                      const double* x, const double* v, double* f);
 // Integrates masses [0, n) for the largest n that is a multiple of the width; returns n.
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state);
-std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state);
+// The same, 8 at a time; the masses whose `held` count is 0 (when given) left at rest.
+std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held);
 void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
                              const double* x, const double* v, double* f);
 void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state);

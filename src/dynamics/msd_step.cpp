@@ -36,14 +36,20 @@ double constraintFractionFor(const RestorationSettings& r, double timeStep) {
 
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
                    PartState& state, StepCounters* counters) {
+    detail::stepAllMasses(model, settings, loads, nullptr, state, counters);
+}
+
+void detail::stepAllMasses(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
+                           const std::uint16_t* held, PartState& state, StepCounters* counters) {
     const detail::FlushDenormals flush;
     const double start = state.time;
     for (const PointLoad& load : loads) state.forces[load.mass] += load.force;
     if (settings.integrator == Integrator::ImplicitEuler) {
         detail::stepImplicit(model, settings, nullptr, state, counters);
+        if (held != nullptr) detail::holdAtRest(model, {held, model.massCount()}, state, detail::fullStepKernel());
     } else {
         const detail::MassUpdate update = detail::MassUpdate::from(settings);
-        detail::stepSpringBlocks(model, update, state, detail::fullStepKernel());
+        detail::stepSpringBlocks(model, update, state, detail::fullStepKernel(), held);
         state.time += settings.timeStep;
         ++state.stepCount;
         if (counters != nullptr) {

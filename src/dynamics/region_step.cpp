@@ -38,8 +38,7 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
 
 void stepRegionByFullModel(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                            PartState& state, StepCounters* counters) {
-    stepFullModel(model, settings, {}, state, counters);
-    detail::holdAtRest(model, region.coverCounts(), state, detail::fullStepKernel());
+    detail::stepAllMasses(model, settings, {}, region.coverCounts().data(), state, counters);
 }
 
 bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses,
