@@ -309,14 +309,16 @@ bool Part::zoneAtRest(const Zone& zone) const {
     const double threshold = settings_.zones.activityThreshold;
     const double restSpeed2 = settings_.zones.restSpeed * settings_.zones.restSpeed;
     const auto interval = std::uint64_t(settings_.zones.retireCheckInterval);
+    // Each test is "within the threshold", so a NaN (which compares false with anything) keeps
+    // the zone: a diverged zone is never retired, and the divergence check sees it.
     for (const RingMember& m : zone.members) {
         const Index i = m.mass;
         if (lastLoadStep_[i] != kNeverLoaded && state_.stepCount - lastLoadStep_[i] <= interval) return false;
-        if (state_.velocities[i].squaredNorm() > restSpeed2) return false;
-        if ((state_.positions[i] - model_->restPositions[i]).norm() > threshold) return false;
+        if (!(state_.velocities[i].squaredNorm() <= restSpeed2)) return false;
+        if (!((state_.positions[i] - model_->restPositions[i]).norm() <= threshold)) return false;
         for (Index e : model_->springsAt(i)) {
             const double length = (state_.positions[model_->springA[e]] - state_.positions[model_->springB[e]]).norm();
-            if (std::abs(length - model_->restLength[e]) > threshold) return false;
+            if (!(std::abs(length - model_->restLength[e]) <= threshold)) return false;
         }
     }
     return true;
