@@ -189,29 +189,35 @@ void applyPartKeywords(const py::kwargs& keywords, PartSettings& part, BodySetti
     if (body) body->kineticFriction = kinetic.value_or(body->staticFriction);  // as in scene files
 }
 
-// A Python value as a TOML node: bool, int, float, str, a dict (table) or a sequence (array),
-// nested; `key` names it in the error for anything else.
-std::unique_ptr<toml::node> tomlValue(const py::handle& value, const std::string& key) {
+// A Python value as a TOML node: bool, int, float, str, a dict (table), a sequence (array),
+// nested, and NumPy scalars and arrays (by their tolist()); anything else is an InputError of
+// `source` naming the key.
+std::unique_ptr<toml::node> tomlValue(const py::handle& value, const std::string& key, const std::string& source) {
     if (py::isinstance<py::bool_>(value)) return std::make_unique<toml::value<bool>>(value.cast<bool>());
-    if (py::isinstance<py::int_>(value)) return std::make_unique<toml::value<std::int64_t>>(value.cast<std::int64_t>());
+    if (py::isinstance<py::int_>(value)) {
+        try {
+            return std::make_unique<toml::value<std::int64_t>>(value.cast<std::int64_t>());
+        } catch (const py::cast_error&) {
+            throw InputError(source, 0, "key '" + key + "': an integer out of range: " + std::string(py::str(value)));
+        }
+    }
     if (py::isinstance<py::float_>(value)) return std::make_unique<toml::value<double>>(value.cast<double>());
     if (py::isinstance<py::str>(value)) return std::make_unique<toml::value<std::string>>(value.cast<std::string>());
     if (py::isinstance<py::dict>(value)) {
         auto table = std::make_unique<toml::table>();
         for (const auto& [k, v] : value.cast<py::dict>()) {
             const std::string name = py::str(k);
-            table->insert(name, std::move(*tomlValue(v, key + "." + name)));
+            table->insert(name, std::move(*tomlValue(v, key + "." + name, source)));
         }
         return table;
     }
-    if (py::isinstance<py::sequence>(value) || py::hasattr(value, "tolist")) {
-        const py::handle items = py::hasattr(value, "tolist") ? value.attr("tolist")().release() : value.inc_ref();
-        const py::object list = py::reinterpret_steal<py::object>(items);
+    if (py::hasattr(value, "tolist")) return tomlValue(value.attr("tolist")(), key, source);  // NumPy: Python values
+    if (py::isinstance<py::sequence>(value)) {
         auto array = std::make_unique<toml::array>();
-        for (const py::handle item : list) array->push_back(std::move(*tomlValue(item, key)));
+        for (const py::handle item : value) array->push_back(std::move(*tomlValue(item, key, source)));
         return array;
     }
-    throw InputError(key, 0, "a value of a type a scene file cannot hold: " + std::string(py::str(py::repr(value))));
+    throw InputError(source, 0, "key '" + key + "': a value of a type a scene file cannot hold: " + std::string(py::str(py::repr(value))));
 }
 
 // An assembly rule from keywords named as the scene file's [[assembly]] keys, read by the
@@ -225,14 +231,18 @@ AssemblyRule assemblyRule(const World& w, BodyId primary, BodyId secondary, cons
     for (const auto& [key, value] : keywords) {
         const std::string k = py::str(key);
         if (k == "primary" || k == "secondary") throw InputError("add_assembly", 0, "key '" + k + "': give the body id as the argument");
-        table.insert(k, std::move(*tomlValue(value, k)));
+        table.insert(k, std::move(*tomlValue(value, k, "add_assembly")));
     }
     std::vector<std::string> names;
     for (BodyId id = 0; id < w.bodyCount(); ++id) names.push_back("body " + std::to_string(id));
     table.insert("primary", names[primary]);
     table.insert("secondary", names[secondary]);
     if (!table.contains("name")) table.insert("name", "assembly " + std::to_string(ruleCount));
-    return detail::readAssemblyTable(table, "add_assembly", names);
+    std::vector<SceneWarning> warnings;
+    AssemblyRule rule = detail::readAssemblyTable(table, "add_assembly", names, warnings);
+    for (const SceneWarning& warning : warnings)  // old spellings: Python warnings, as scene files print them
+        if (PyErr_WarnEx(PyExc_DeprecationWarning, warning.message.c_str(), 1) != 0) throw py::error_already_set();
+    return rule;
 }
 
 PartModelSettings modelSettings(std::optional<std::string> material, std::optional<std::pair<double, double>> springs, double vertexMass,
@@ -481,19 +491,21 @@ PYBIND11_MODULE(_flexfit, m) {
         }, py::arg("primary"), py::arg("secondary"),
              "Adds a snapping rule between two bodies; returns its index. Keywords as the scene file's [[assembly]] keys, with the "
              "same defaults and checks: name, technique ('zone'; 'collision', 'proximity', 'vector'), final_position, "
-             "final_rotation, snap_duration, distance_tolerance, angle_tolerance (degrees), primary_vector / secondary_vector "
+             "final_rotation (as in scene files: Euler angles in degrees, about x, then y, then z; not a quaternion), "
+             "snap_duration, distance_tolerance, angle_tolerance (degrees), primary_vector / secondary_vector "
              "({'origin': ..., 'end': ...}), vector_tolerance, area ({'shape': 'box' | 'sphere' | 'cylinder', 'position', "
              "'rotation', 'half_extents', 'radius', 'half_height'}).")
         .def("assembled", &World::assembled, py::arg("rule"), "Whether the rule has snapped its primary into place.")
         .def_property_readonly("assembly_count", &World::assemblyCount, "Assembly rules added (indices 0 .. assembly_count - 1).")
         .def("apply_force_at", &World::applyForceAt, py::arg("id"), py::arg("force"), py::arg("point"),
-             "A world-frame force at a world point for the next step (dynamic bodies): the force and its torque.")
+             "A world-frame force at a world point for the next step: the force and its torque (dynamic bodies; others ignore it).")
         .def("apply_face_force", &World::applyFaceForce, py::arg("id"), py::arg("face"), py::arg("force"),
-             "A world-frame force for the next step spread over a face's three masses.")
+             "A world-frame force for the next step spread over a face's three masses (on a part that does not deform, a third of "
+             "it at each of those points of its rigid body).")
         .def("set_kinematic_target", [](World& w, BodyId id, const Vec3& position, const Eigen::Vector4d& rotation) {
             w.setKinematicTarget(id, makePose(position, rotation));
         }, py::arg("id"), py::arg("position"), py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0),
-             "A kinematic body's pose to reach by the end of the next step (its velocity follows).")
+             "A kinematic body's pose to reach by the end of the next step (its velocity follows; other bodies ignore it).")
         .def("assembly_events", [](const World& w) {
             py::list out;
             for (const AssemblyEvent& e : w.assemblyEvents()) out.append(eventDict(e));

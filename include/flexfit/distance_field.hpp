@@ -66,8 +66,8 @@ public:
     };
     // The grid's interpolation at p (clamped into the grid).
     Interpolated sample(const Vec3& p) const;
-    // sample() at each of `points` (each inGrid), into `out` (as many): the same values bit for
-    // bit. On CPUs with AVX2, four points a vector (the same operations in the same order, each
+    // sample() at each of `points` (each must be inGrid, so finite), into `out` (at least as
+    // many; std::invalid_argument otherwise): the same values bit for bit. On CPUs with AVX2, four points a vector (the same operations in the same order, each
     // correctly rounded, so a lane equals sample()); a group with a corner not yet computed
     // goes through sample(), which computes it.
     void sampleMany(std::span<const Vec3> points, std::span<Interpolated> out) const;

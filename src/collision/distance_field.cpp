@@ -4,9 +4,11 @@
 #include "collision/triangle_queries.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #define FLEXFIT_SDF_AVX2 1
@@ -209,9 +211,9 @@ FLEXFIT_AVX2 bool sampleFour(const GridLanes& g, const Vec3* p, SignedDistanceFi
     __m128i base[3];
     for (int d = 0; d < 3; ++d) {
         const __m256d x = _mm256_div_pd(_mm256_sub_pd(lanesOf(p, d), g.min[d]), g.cell);
-        const __m256d b = clampLanes(_mm256_floor_pd(x), zero, g.hi[d]);
-        base[d] = _mm256_cvttpd_epi32(b);
-        t[d] = clampLanes(_mm256_sub_pd(x, b), zero, one);
+        base[d] = _mm256_cvttpd_epi32(clampLanes(_mm256_floor_pd(x), zero, g.hi[d]));
+        // As sample(): minus the int converted back (+0.0 where the floor was -0.0).
+        t[d] = clampLanes(_mm256_sub_pd(x, _mm256_cvtepi32_pd(base[d])), zero, one);
     }
     const __m128i node =
         _mm_add_epi32(_mm_mullo_epi32(_mm_add_epi32(_mm_mullo_epi32(base[2], g.dy), base[1]), g.dx), base[0]);
@@ -293,23 +295,26 @@ bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
 
 namespace detail {
 namespace {
-bool scalarSamplingChosen = false;  // ScopedScalarSampling
+std::atomic<int> scalarSamplingScopes{0};  // ScopedScalarSampling: alive, nested or on other threads
 }  // namespace
 
 bool vectorSamplingEnabled() {
 #if defined(FLEXFIT_SDF_AVX2)
     static const bool avx2 = __builtin_cpu_supports("avx2");
-    return avx2 && !scalarSamplingChosen;
+    return avx2 && scalarSamplingScopes.load(std::memory_order_relaxed) == 0;
 #else
     return false;
 #endif
 }
 
-ScopedScalarSampling::ScopedScalarSampling() { scalarSamplingChosen = true; }
-ScopedScalarSampling::~ScopedScalarSampling() { scalarSamplingChosen = false; }
+ScopedScalarSampling::ScopedScalarSampling() { scalarSamplingScopes.fetch_add(1, std::memory_order_relaxed); }
+ScopedScalarSampling::~ScopedScalarSampling() { scalarSamplingScopes.fetch_sub(1, std::memory_order_relaxed); }
 }  // namespace detail
 
 void SignedDistanceField::sampleMany(std::span<const Vec3> points, std::span<Interpolated> out) const {
+    if (out.size() < points.size())
+        throw std::invalid_argument("signed distance field: sampleMany needs an output per point (" + std::to_string(points.size()) +
+                                    " points, " + std::to_string(out.size()) + " outputs)");
     std::size_t i = 0;
 #if defined(FLEXFIT_SDF_AVX2)
     if (detail::vectorSamplingEnabled())

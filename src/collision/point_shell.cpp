@@ -4,6 +4,7 @@
 #include "flexfit/distance_field.hpp"
 
 #include <limits>
+#include <stdexcept>
 
 namespace flexfit {
 using namespace detail;
@@ -18,9 +19,15 @@ public:
                 const RelativePose& bInA, std::vector<Contact>& contacts, QueryStats& stats)
         : idA_(idA), idB_(idB), a_(a), field_(field), b_(b), bInA_(bInA), ra_(a.pose().rotation.toRotationMatrix()),
           contacts_(contacts), stats_(stats), batch_(scratch()) {
+        // One sampler at a time per thread: a second would clear the first one's queue.
+        if (batch_.inUse) throw std::logic_error("point shell: a second MassSampler on one thread");
+        batch_.inUse = true;
         batch_.masses.clear();
         batch_.points.clear();
     }
+    ~MassSampler() { batch_.inUse = false; }
+    MassSampler(const MassSampler&) = delete;
+    MassSampler& operator=(const MassSampler&) = delete;
 
     Vec3 pointOf(Index m) const { return bInA_.apply(b_.state().positions[m]); }
 
@@ -59,6 +66,7 @@ private:
         std::vector<Index> masses;
         std::vector<Vec3> points;
         std::vector<SignedDistanceField::Interpolated> samples;
+        bool inUse = false;
     };
     // This thread's batch, kept between queries so its capacity stays.
     static Batch& scratch() {

@@ -9,7 +9,7 @@ namespace flexfit::detail {
 // ScopedScalarSampling is alive.
 bool vectorSamplingEnabled();
 
-// Every sampleMany in this scope samples point by point. Not thread-safe; scopes must not overlap.
+// Every sampleMany (on any thread) samples point by point while at least one scope is alive.
 class ScopedScalarSampling {
 public:
     ScopedScalarSampling();

@@ -15,7 +15,9 @@ Scene readSceneDocument(const toml::table& document, const std::string& source, 
 
 // One [[assembly]] table read as the scene reader reads it, its `primary` and `secondary`
 // looked up in `partNames` (a body's id is its index there): for callers that build a rule from
-// the scene file's keys (the Python World.add_assembly). Errors name `source`.
-AssemblyRule readAssemblyTable(const toml::table& table, const std::string& source, const std::vector<std::string>& partNames);
+// the scene file's keys (the Python World.add_assembly). Errors name `source`; warnings (old
+// spellings) are added to `warnings`.
+AssemblyRule readAssemblyTable(const toml::table& table, const std::string& source, const std::vector<std::string>& partNames,
+                               std::vector<SceneWarning>& warnings);
 
 }  // namespace flexfit::detail

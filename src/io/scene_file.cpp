@@ -550,14 +550,15 @@ Scene parseScene(std::string_view text, const std::string& source, const std::fi
     return detail::readSceneDocument(document, source, baseDirectory, options);
 }
 
-AssemblyRule detail::readAssemblyTable(const toml::table& table, const std::string& source, const std::vector<std::string>& partNames) {
+AssemblyRule detail::readAssemblyTable(const toml::table& table, const std::string& source, const std::vector<std::string>& partNames,
+                                       std::vector<SceneWarning>& warnings) {
     Scene scene;  // only the parts' names: readAssembly looks the rule's bodies up by name
     scene.source = source;
     for (const std::string& name : partNames) {
         scene.parts.emplace_back();
         scene.parts.back().name = name;
     }
-    Table t(table, "assembly", scene.source, scene.warnings);
+    Table t(table, "assembly", scene.source, warnings);
     return readAssembly(t, scene);
 }
 

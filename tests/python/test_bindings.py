@@ -359,6 +359,15 @@ def test_assembly_keywords_are_the_scene_files_keys(tmp_path):
     assert world.state_hash() == scene_run.world.state_hash()
     np.testing.assert_array_equal(world.pose(b)["position"], [0, -12, 0])
 
+    # NumPy scalars and arrays are the values they hold; other objects are refused naming the key.
+    world.add_assembly(b, m, technique="proximity", snap_duration=np.float32(0.25), distance_tolerance=np.int64(2),
+                       final_position=np.zeros(3, np.float32), primary_vector={"origin": list(np.zeros(3)), "end": [0, 1, 0]})
+    assert world.assembly_count == 2
+    with pytest.raises(flexfit.InputError, match="out of range"):
+        world.add_assembly(b, m, distance_tolerance=2**70)
+    with pytest.raises(flexfit.InputError, match="area.radius") as error:
+        world.add_assembly(b, m, area={"shape": "sphere", "radius": object()})
+    assert error.value.source == "add_assembly"
     with pytest.raises(flexfit.InputError, match="snap_duraton"):
         world.add_assembly(b, m, snap_duraton=0.1)  # unknown keys are refused as in scene files
     with pytest.raises(flexfit.InputError, match="radius"):
@@ -369,7 +378,7 @@ def test_assembly_keywords_are_the_scene_files_keys(tmp_path):
         world.add_assembly(b, m, technique="glue")
     with pytest.raises(flexfit.InputError):
         world.assembled(5)
-    assert world.assembly_count == 1  # nothing half-added
+    assert world.assembly_count == 2  # nothing half-added
 
 
 def test_forces_at_points_faces_and_kinematic_targets():
