@@ -1,10 +1,11 @@
-// One full-MSD step of torus1, torus2 and heart, the heart with its vertices shuffled and then
-// renumbered breadth-first (reverse Cuthill-McKee), and a third-party mesh (Debian's
-// assimp-testmodels Wuson, as the file orders its vertices, renumbered breadth-first, and
-// remeshed at 0.5 % of its size): Flexfit's step against the thesis-style naive
-// array-of-structs reference (tests/support/naive_msd.hpp), same physics, same meshes, in one
-// run. Also the step with its scalar and AVX2 kernels forced (stepFullModel itself uses AVX-512
-// where the CPU has it).
+// One full-MSD step of torus1, torus2 and heart, the heart with its vertices shuffled (as given,
+// and renumbered by the model build's VertexOrder::Locality), and a third-party mesh (Debian's
+// assimp-testmodels Wuson, as the file orders its vertices, renumbered by VertexOrder::Locality,
+// and remeshed at 0.5 % of its size in CGAL's order and renumbered): Flexfit's step against the
+// thesis-style naive array-of-structs reference (tests/support/naive_msd.hpp), same physics, in
+// one run. The naive reference steps the mesh as given (the file's order): a renumbered row is
+// what a user with that file gets. Also the step with its scalar and AVX2 kernels forced
+// (stepFullModel itself uses AVX-512 where the CPU has it).
 // Counters: steps/s and spring updates/s. Single thread.
 #include "dynamics/flush_denormals.hpp"
 #include "dynamics/full_step.hpp"
@@ -34,19 +35,26 @@ TriMesh named(TriMesh mesh, const std::string& name) {
 
 // Empty when the third-party file is not installed.
 const TriMesh& meshByIndex(int which) {
-    using flexfit::testing::breadthFirstVertices;
-    static const std::array<TriMesh, 8> meshes = [] {
+    static const std::array<TriMesh, 9> meshes = [] {
         const TriMesh shuffledHeart = named(flexfit::testing::shuffledVertices(flexfit::makeHeart(), 3), "heart shuffled");
         const TriMesh wuson = thirdParty();
         const double diagonal = wuson.vertices.empty() ? 0.0 : flexfit::Aabb::around(wuson.vertices).size();
-        return std::array<TriMesh, 8>{flexfit::makeTorus1(), flexfit::makeTorus2(), flexfit::makeHeart(), shuffledHeart,
-                                      named(breadthFirstVertices(shuffledHeart), "heart shuffled, breadth-first"),
-                                      named(wuson, "Wuson"),
-                                      wuson.vertices.empty() ? TriMesh{} : named(breadthFirstVertices(wuson), "Wuson, breadth-first"),
-                                      wuson.vertices.empty() ? TriMesh{}
-                                          : named(flexfit::remeshForSimulation(wuson, {0.005 * diagonal}, kThirdParty).mesh, "Wuson remeshed 0.5%")};
+        const TriMesh remeshed = wuson.vertices.empty() ? TriMesh{}
+            : named(flexfit::remeshForSimulation(wuson, {0.005 * diagonal}, kThirdParty).mesh, "Wuson remeshed 0.5%");
+        return std::array<TriMesh, 9>{flexfit::makeTorus1(), flexfit::makeTorus2(), flexfit::makeHeart(), shuffledHeart,
+                                      named(shuffledHeart, "heart shuffled, locality order"), named(wuson, "Wuson"),
+                                      named(wuson, "Wuson, locality order"), remeshed, named(remeshed, "Wuson remeshed 0.5%, locality order")};
     }();
     return meshes[std::size_t(which)];
+}
+
+// The rows whose model is built with VertexOrder::Locality (the naive reference keeps the order).
+bool inLocalityOrder(int which) { return which == 4 || which == 6 || which == 8; }
+
+std::shared_ptr<const flexfit::PartModel> flexfitModel(int which) {
+    flexfit::PartModelSettings settings;  // the elastic preset, 1 kg masses
+    if (inLocalityOrder(which)) settings.vertexOrder = flexfit::VertexOrder::Locality;
+    return flexfit::buildPartModel(meshByIndex(which), settings);
 }
 
 bool skipMissing(benchmark::State& state, const TriMesh& mesh) {
@@ -64,7 +72,13 @@ flexfit::SimulationSettings benchSettings() {
     return s;
 }
 
-void setCounters(benchmark::State& state, std::size_t springs) {
+// Share of the model's springs in spring blocks (0 for the naive reference, which has none).
+double blockedShare(const flexfit::PartModel& model) {
+    return double(flexfit::SpringBlocks::kWidth * model.springBlocks->blockCount()) / double(model.springCount());
+}
+
+void setCounters(benchmark::State& state, std::size_t springs, double inBlocks) {
+    state.counters["in_blocks"] = inBlocks;
     state.counters["steps_per_s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["spring_updates_per_s"] =
         benchmark::Counter(double(state.iterations()) * double(springs), benchmark::Counter::kIsRate);
@@ -75,14 +89,14 @@ void BM_FlexfitFullStep(benchmark::State& state) {
     const TriMesh& mesh = meshByIndex(int(state.range(0)));
     state.SetLabel(mesh.name);
     if (skipMissing(state, mesh)) return;
-    const auto model = flexfit::buildPartModel(mesh);  // the elastic preset, 1 kg masses
+    const auto model = flexfitModel(int(state.range(0)));
     const flexfit::SimulationSettings settings = benchSettings();
     flexfit::PartState partState = flexfit::PartState::atRest(*model);
     for (auto _ : state) {
         flexfit::stepFullModel(*model, settings, {}, partState);
         benchmark::DoNotOptimize(partState.positions.data());
     }
-    setCounters(state, model->springCount());
+    setCounters(state, model->springCount(), blockedShare(*model));
 }
 
 void BM_NaiveFullStep(benchmark::State& state) {
@@ -96,7 +110,7 @@ void BM_NaiveFullStep(benchmark::State& state) {
         model.step(1e-3, naive::Vector3D(0, -9.81, 0), 0.1);
         benchmark::DoNotOptimize(model.masses[0]->position.x);
     }
-    setCounters(state, std::size_t(model.numOfSprings));
+    setCounters(state, std::size_t(model.numOfSprings), 0.0);
 }
 
 // The full step with a kernel forced (stepFullModel picks the widest).
@@ -108,7 +122,7 @@ void runDetailStep(benchmark::State& state, flexfit::detail::BlockKernel kernel)
         state.SkipWithError("kernel not supported by this CPU");
         return;
     }
-    const auto model = flexfit::buildPartModel(mesh);  // the elastic preset, 1 kg masses
+    const auto model = flexfitModel(int(state.range(0)));
     const auto update = flexfit::detail::MassUpdate::from(benchSettings());
     flexfit::PartState partState = flexfit::PartState::atRest(*model);
     const flexfit::detail::FlushDenormals flush;  // as stepFullModel
@@ -116,7 +130,7 @@ void runDetailStep(benchmark::State& state, flexfit::detail::BlockKernel kernel)
         flexfit::detail::stepSpringBlocks(*model, update, partState, kernel);
         benchmark::DoNotOptimize(partState.positions.data());
     }
-    setCounters(state, model->springCount());
+    setCounters(state, model->springCount(), blockedShare(*model));
 }
 
 void BM_FlexfitScalar(benchmark::State& state) { runDetailStep(state, flexfit::detail::BlockKernel::Scalar); }
@@ -136,6 +150,7 @@ FLEXFIT_MSD_BENCHMARKS(4);
 FLEXFIT_MSD_BENCHMARKS(5);
 FLEXFIT_MSD_BENCHMARKS(6);
 FLEXFIT_MSD_BENCHMARKS(7);
+FLEXFIT_MSD_BENCHMARKS(8);
 
 }  // namespace
 

@@ -45,6 +45,25 @@ py::array_t<double> vec3Copy(const std::vector<Vec3>& v) {
     return a;
 }
 
+// Python speaks the given mesh's vertex indices: a model renumbered for locality
+// (PartModel::massOfVertex) translates them to masses here; an index out of range passes
+// through for the C++ call to refuse.
+Index massOfVertex(const PartModel& model, Index vertex) { return vertex < model.massCount() ? model.massOf(vertex) : vertex; }
+
+// Per-mass rows in the given mesh's vertex order: a read-only view of the state when the model
+// keeps that order, else a read-only copy.
+py::array vertexRows(const PartModel& model, const std::vector<Vec3>& perMass, py::handle owner) {
+    if (!model.renumbered()) return vec3View(perMass, owner);
+    std::vector<Vec3> rows;
+    inVertexOrder<Vec3>(model, perMass, rows);
+    py::array a = vec3Copy(rows);
+    a.attr("flags").attr("writeable") = false;
+    return a;
+}
+
+// The same for a world's body; an unknown body passes through for the C++ call to refuse.
+Index massOfBody(const World& w, BodyId id, Index vertex) { return id < w.bodyCount() ? massOfVertex(w.part(id).model(), vertex) : vertex; }
+
 template <class Enum>
 Enum enumFrom(const std::string& text, const char* what) {
     const std::optional<Enum> value = parseName<Enum>(text);
@@ -69,7 +88,7 @@ py::dict poseDict(const Pose& p) {
     return d;
 }
 
-py::dict contactDict(const Contact& c) {
+py::dict contactDict(const World& w, const Contact& c) {
     py::dict d;
     d["part_a"] = c.partA;
     d["part_b"] = c.partB;
@@ -78,7 +97,7 @@ py::dict contactDict(const Contact& c) {
     d["point"] = c.point;
     d["normal"] = c.normal;
     d["depth"] = c.depth;
-    d["mass_b"] = c.massB == kNoMass ? py::object(py::none()) : py::object(py::int_(c.massB));
+    d["mass_b"] = c.massB == kNoMass ? py::object(py::none()) : py::object(py::int_(w.part(c.partB).model().vertexOf(c.massB)));
     return d;
 }
 
@@ -279,23 +298,27 @@ void addPartReaders(Class& c, Get get) {
     c.def_property_readonly("mode", [get](py::object self) { return std::string(toString(get(self).mode())); }, "rigid, rigid-deformable or full-deformable.")
         .def_property_readonly("model", [get](py::object self) { return std::const_pointer_cast<PartModel>(get(self).sharedModel()); },
                                "The part's model (shared, immutable).")
-        .def_property_readonly("positions", [get](py::object self) { return vec3View(get(self).state().positions, self); },
+        .def_property_readonly("positions", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().positions, self); },
                                "Mass positions in the part frame, a read-only (n, 3) view of the state (non-moving masses at rest).")
-        .def_property_readonly("velocities", [get](py::object self) { return vec3View(get(self).state().velocities, self); },
+        .def_property_readonly("velocities", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().velocities, self); },
                                "Mass velocities (part frame), a read-only (n, 3) view.")
         .def_property_readonly("moving_masses", [get](py::object self) {
-            const auto masses = get(self).movingMasses();
-            return py::array_t<Index>(py::ssize_t(masses.size()), masses.data());
+            const Part& part = get(self);
+            std::vector<Index> vertices;
+            for (Index m : part.movingMasses()) vertices.push_back(part.model().vertexOf(m));
+            return py::array_t<Index>(py::ssize_t(vertices.size()), vertices.data());
         }, "Indices of the masses the zones move, a new array (the list changes with every zone).")
         .def_property_readonly("zone_depths", [get](py::object self) {
-            std::vector<int> depths;
-            get(self).zoneDepths(depths);
+            std::vector<int> perMass, depths;
+            get(self).zoneDepths(perMass);
+            inVertexOrder<int>(get(self).model(), perMass, depths);
             return py::array_t<int>(py::ssize_t(depths.size()), depths.data());
         }, "Each mass's depth in the zones covering it (0 = seed, -1 = at rest), a new int array.")
         .def("world_positions", [get](py::object self) {
-            std::vector<Vec3> w;
+            std::vector<Vec3> w, rows;
             get(self).worldPositions(w);
-            return vec3Copy(w);
+            inVertexOrder<Vec3>(get(self).model(), w, rows);
+            return vec3Copy(rows);
         }, "Mass positions in the world, a new (n, 3) array.")
         .def_property_readonly("zone_count", [get](py::object self) { return get(self).zoneCount(); }, "Zones open on the part.")
         .def_property_readonly("time", [get](py::object self) { return get(self).time(); }, "The part's simulated time (s).")
@@ -379,21 +402,34 @@ PYBIND11_MODULE(_flexfit, m) {
     py::class_<PartModel, std::shared_ptr<PartModel>>(m, "PartModel", "A part's immutable model: its mesh, masses and springs.")
         .def(py::init([](TriMesh mesh, std::optional<std::string> material, std::optional<std::pair<double, double>> springs, double vertexMass,
                          std::optional<double> youngsModulus, std::optional<double> thickness, std::optional<double> density, double poissonRatio,
-                         double dampingRatio, bool bendingSprings) {
-                 return std::const_pointer_cast<PartModel>(buildPartModel(
-                     std::move(mesh), modelSettings(material, springs, vertexMass, youngsModulus, thickness, density, poissonRatio, dampingRatio, bendingSprings)));
+                         double dampingRatio, bool bendingSprings, const std::string& vertexOrder) {
+                 PartModelSettings settings = modelSettings(material, springs, vertexMass, youngsModulus, thickness, density, poissonRatio, dampingRatio, bendingSprings);
+                 if (vertexOrder != "as_given" && vertexOrder != "locality")
+                     throw InputError("vertex_order", 0, "unknown value '" + vertexOrder + "' (expected 'as_given' or 'locality')");
+                 settings.vertexOrder = vertexOrder == "locality" ? VertexOrder::Locality : VertexOrder::AsGiven;
+                 return std::const_pointer_cast<PartModel>(buildPartModel(std::move(mesh), settings));
              }),
              py::arg("mesh"), py::arg("material") = py::none(), py::arg("springs") = py::none(), py::arg("vertex_mass") = 1.0, py::kw_only(),
              py::arg("youngs_modulus") = py::none(), py::arg("thickness") = py::none(), py::arg("density") = py::none(), py::arg("poisson_ratio") = 0.35,
-             py::arg("damping_ratio") = 0.1, py::arg("bending_springs") = false,
+             py::arg("damping_ratio") = 0.1, py::arg("bending_springs") = false, py::arg("vertex_order") = "as_given",
              "Builds a model from a mesh: material a preset name ('elastic'), or springs=(stiffness, damping) with vertex_mass in kg, or a "
-             "physical material (SI units): youngs_modulus, thickness, density, poisson_ratio, damping_ratio, bending_springs.")
+             "physical material (SI units): youngs_modulus, thickness, density, poisson_ratio, damping_ratio, bending_springs. "
+             "vertex_order='locality' renumbers the masses for memory locality when that makes the step faster (a mesh from a file); "
+             "every index and per-mass array in Python stays in the mesh's own vertex order either way.")
         .def_property_readonly("mass_count", &PartModel::massCount, "Number of masses (the mesh's vertices).")
         .def_property_readonly("spring_count", [](const PartModel& model) { return model.springCount(); }, "Number of springs (edges, and bending springs of a physical material).")
-        .def_property_readonly("mesh", [](py::object self) { return py::cast(&self.cast<const PartModel&>().mesh, py::return_value_policy::reference_internal, self); },
-                               "The simulation mesh (rest shape, part frame).")
-        .def_property_readonly("rest_positions", [](py::object self) { return vec3View(self.cast<const PartModel&>().restPositions, self); },
-                               "Rest positions, a read-only (n, 3) view.");
+        .def_property_readonly("mesh", [](py::object self) {
+            const PartModel& model = self.cast<const PartModel&>();
+            return py::cast(model.givenMesh ? model.givenMesh.get() : &model.mesh, py::return_value_policy::reference_internal, self);
+        }, "The simulation mesh as given (rest shape, part frame).")
+        .def_property_readonly("rest_positions", [](py::object self) { return vertexRows(self.cast<const PartModel&>(), self.cast<const PartModel&>().restPositions, self); },
+                               "Rest positions, a read-only (n, 3) array (a view unless the masses are renumbered).")
+        .def_property_readonly("renumbered", &PartModel::renumbered, "Whether the masses are the mesh's vertices renumbered (vertex_order='locality').")
+        .def_property_readonly("mass_of_vertex", [](const PartModel& model) {
+            std::vector<Index> masses(model.massCount());
+            for (Index v = 0; v < masses.size(); ++v) masses[v] = model.massOf(v);
+            return py::array_t<Index>(py::ssize_t(masses.size()), masses.data());
+        }, "The internal mass of each vertex (for C++ code and the state hash; Python's indices are the vertices).");
 
     py::class_<Part> partClass(m, "Part", "A part: a rigid body until pressed, then mass-spring-damper zones around the contacts.");
     partClass.def(py::init([](std::shared_ptr<PartModel> model, const py::kwargs& settings) {
@@ -404,10 +440,12 @@ PYBIND11_MODULE(_flexfit, m) {
              py::arg("model"),
              "A part stepped on its own (without a world). Settings as keywords named as the scene file's [[part]] keys "
              "(mode='rigid-deformable', restoration, anchor_stiffness, global_damping, integrator, contact_level, ...) and time_step.")
-        .def("open_zone", [](Part& p, Index mass, int level) { return p.openZone(ZoneSeed::mass(mass), level); }, py::arg("mass"), py::arg("level"),
+        .def("open_zone", [](Part& p, Index mass, int level) { return p.openZone(ZoneSeed::mass(massOfVertex(p.model(), mass)), level); }, py::arg("mass"), py::arg("level"),
              "Opens a zone of `level` rings around a mass; returns its id.")
-        .def("apply_force", &Part::applyForce, py::arg("mass"), py::arg("force"), "A world-frame force on one mass for the next step.")
-        .def("kick_mass", &Part::kickMass, py::arg("mass"), py::arg("velocity_change"), "A velocity change on one mass, now.")
+        .def("apply_force", [](Part& p, Index mass, const Vec3& force) { p.applyForce(massOfVertex(p.model(), mass), force); }, py::arg("mass"), py::arg("force"),
+             "A world-frame force on one mass for the next step.")
+        .def("kick_mass", [](Part& p, Index mass, const Vec3& change) { p.kickMass(massOfVertex(p.model(), mass), change); }, py::arg("mass"),
+             py::arg("velocity_change"), "A velocity change on one mass, now.")
         .def("step", [](Part& p) {
             py::gil_scoped_release release;
             p.step();
@@ -448,7 +486,7 @@ PYBIND11_MODULE(_flexfit, m) {
         .def_property_readonly("step_count", &World::stepCount, "Steps taken.")
         .def("contacts", [](const World& w) {
             py::list out;
-            for (const Contact& c : w.contacts()) out.append(contactDict(c));
+            for (const Contact& c : w.contacts()) out.append(contactDict(w, c));
             return out;
         }, "The last step's contacts, as dicts (part_a, part_b, point, normal, depth, ...).")
         .def("profile", [](const World& w) { return profileDict(w.profile()); }, "Per-stage times of the last step and in total (s).")
@@ -456,12 +494,14 @@ PYBIND11_MODULE(_flexfit, m) {
         .def("centre_of_mass", &World::centreOfMass, py::arg("id"), "World position of a body's centre of mass.")
         .def("pose", [](const World& w, BodyId id) { return poseDict(w.part(id).pose()); }, py::arg("id"), "A body's pose: {'position', 'rotation_wxyz'}.")
         .def("apply_force", &World::applyForce, py::arg("id"), py::arg("force"), "A force at the centre of mass for the next step.")
-        .def("apply_mass_force", &World::applyMassForce, py::arg("id"), py::arg("mass"), py::arg("force"), "A world-frame force on one mass.")
-        .def("kick_mass", &World::kickMass, py::arg("id"), py::arg("mass"), py::arg("velocity_change"),
+        .def("apply_mass_force", [](World& w, BodyId id, Index mass, const Vec3& force) { w.applyMassForce(id, massOfBody(w, id, mass), force); },
+             py::arg("id"), py::arg("mass"), py::arg("force"), "A world-frame force on one mass.")
+        .def("kick_mass", [](World& w, BodyId id, Index mass, const Vec3& change) { w.kickMass(id, massOfBody(w, id, mass), change); },
+             py::arg("id"), py::arg("mass"), py::arg("velocity_change"),
              "A velocity change on one mass of a deforming part; on a rigid dynamic body, the same momentum as an impulse.")
         .def("set_velocity", &World::setVelocity, py::arg("id"), py::arg("linear"), py::arg("angular") = Vec3::Zero(),
              "Sets a dynamic body's velocity (world frame; rad/s for the angular one).")
-        .def("open_zone", [](World& w, BodyId id, Index mass, int level) { return w.openZone(id, ZoneSeed::mass(mass), level); }, py::arg("id"),
+        .def("open_zone", [](World& w, BodyId id, Index mass, int level) { return w.openZone(id, ZoneSeed::mass(massOfBody(w, id, mass)), level); }, py::arg("id"),
              py::arg("mass"), py::arg("level"), "Opens a zone on a body's part around a mass (ahead of a contact); returns its id.")
         .def("grab", [](World& w, BodyId id, double frequency, double stiffness, double damping, double angularStiffness, double angularDamping) {
             GrabSettings g;

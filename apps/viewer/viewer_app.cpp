@@ -435,7 +435,8 @@ void App::drawPanels() {
     }
     if (ImGui::CollapsingHeader("Operate", ImGuiTreeNodeFlags_DefaultOpen)) {
         if (selection_)
-            ImGui::Text("selected: part %u, mass %u, face %u", selection_->body, selection_->mass, selection_->face);
+            ImGui::Text("selected: part %u, mass %u, face %u", selection_->body,  // the mesh file's vertex index
+                        session_->world().part(selection_->body).model().vertexOf(selection_->mass), selection_->face);
         else
             ImGui::TextWrapped("Shift+click: select a mass. Ctrl+drag: grab a part.");
         ImGui::RadioButton("force on the mass", &forceTarget_, 0);

@@ -171,11 +171,12 @@ std::vector<Vec3> SurfaceNormals::computeAll(const Part& part) {
 }
 
 void showPart(const Part& part, const std::vector<Vec3>& massNormals, const std::vector<Vec3>& massColours, ShownSurface& out) {
-    const auto& drawn = part.model().drawn;
-    if (!drawn) {
-        out.positions = part.state().positions;
-        out.normals = massNormals;
-        out.colours = massColours;
+    const PartModel& model = part.model();
+    const auto& drawn = model.drawn;
+    if (!drawn) {  // the masses, in the given mesh's vertex order (drawnMesh()'s faces)
+        inVertexOrder<Vec3>(model, part.state().positions, out.positions);
+        inVertexOrder<Vec3>(model, massNormals, out.normals);
+        inVertexOrder<Vec3>(model, massColours, out.colours);
         return;
     }
     part.drawnPositions(out.positions);

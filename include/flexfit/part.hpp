@@ -128,6 +128,8 @@ public:
     std::vector<ZoneId> zoneIds() const;
 
     // --- Loads, for the next step ---
+    // Mass indices here and below are the model's (PartModel::massOf gives a renumbered model's
+    // mass of a mesh vertex); face indices are the mesh's, in every order.
     // A world-frame force on one mass. Opens a zone (defaultLevel) when no zone covers it and
     // keeps the covering zones alive. Ignored in Rigid mode. Throws InputError for a bad mass.
     void applyForce(Index mass, const Vec3& worldForce);
@@ -174,7 +176,8 @@ public:
     Vec3 worldPosition(Index mass) const { return pose_.apply(state_.positions[mass]); }
     void worldPositions(std::vector<Vec3>& out) const;
     // The vertices of model().drawnMesh() as the part looks now, in the part frame / the world
-    // (the mass positions themselves when the model has no drawn mesh of its own).
+    // (the mass positions in the given mesh's vertex order when the model has no drawn mesh of
+    // its own).
     void drawnPositions(std::vector<Vec3>& out) const;
     void drawnWorldPositions(std::vector<Vec3>& out) const;
     // Depth of each mass in the zones covering it (minimum; 0 = seed), -1 when not moving.

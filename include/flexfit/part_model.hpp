@@ -11,6 +11,7 @@
 #include "flexfit/mesh.hpp"
 #include "flexfit/topology.hpp"
 
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <span>
@@ -61,6 +62,15 @@ struct ShellMaterial {
     bool bendingSprings = false;
 };
 
+// How a model numbers its masses.
+enum class VertexOrder {
+    AsGiven,   // mass i is the mesh's vertex i
+    // The vertices renumbered for memory locality (src/model/vertex_order.hpp) when that puts more
+    // springs in spring blocks than the given order does (the full step's fast layout): for
+    // meshes from files, whose order is the exporter's. A mesh already in rows keeps its order.
+    Locality,
+};
+
 struct PartModelSettings {
     Material material = Material::elastic();  // for every spring unless springMaterials is set
     double vertexMass = 1.0;                  // kg, for every vertex unless vertexMasses is set
@@ -74,6 +84,9 @@ struct PartModelSettings {
     // part simulates on a remeshed surface), embedded in it (surface_embedding.hpp). Empty: the
     // simulation mesh is drawn.
     TriMesh drawnMesh;
+    // The masses' order; per-vertex and per-spring arrays above are given in the mesh's own order
+    // either way.
+    VertexOrder vertexOrder = VertexOrder::AsGiven;
 };
 
 struct PartModel {
@@ -110,8 +123,21 @@ struct PartModel {
     bool hasSpringBlocks() const;
     // The drawn mesh tied to the simulation surface; null when the simulation mesh is drawn.
     std::shared_ptr<const SurfaceEmbedding> drawn;
-    // What the part looks like at rest: the drawn mesh, else the simulation mesh.
+    // What the part looks like at rest: the drawn mesh, else the simulation mesh as given.
     const TriMesh& drawnMesh() const;
+
+    // The masses' order (VertexOrder::Locality). When the build renumbered the given mesh's
+    // vertices, mass massOfVertex[v] is its vertex v and vertexOfMass[m] is mass m's vertex;
+    // `mesh`, restPositions, topology and every per-mass and per-spring array are in mass order
+    // (faces keep their order and indices), and givenMesh is the mesh as given, which drawnMesh()
+    // returns when there is no drawn mesh: frames and the viewer show the user's vertices in their
+    // order. Empty (and givenMesh null): mass i is vertex i.
+    std::vector<Index> massOfVertex;  // (V or 0)
+    std::vector<Index> vertexOfMass;  // (V or 0)
+    std::shared_ptr<const TriMesh> givenMesh;
+    bool renumbered() const { return !massOfVertex.empty(); }
+    Index massOf(Index vertex) const { return renumbered() ? massOfVertex[vertex] : vertex; }
+    Index vertexOf(Index m) const { return renumbered() ? vertexOfMass[m] : m; }
 
     std::size_t massCount() const { return mass.size(); }
     std::size_t springCount() const { return springA.size(); }
@@ -124,5 +150,16 @@ struct PartModel {
 // materials), or one that leaves a vertex without mass (in no face of positive area); a drawn
 // mesh must pass validateMesh.
 std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings = {});
+
+// Per-mass values in the given mesh's vertex order (a copy when the model is not renumbered).
+template <class T>
+void inVertexOrder(const PartModel& model, std::span<const T> perMass, std::vector<T>& out) {
+    out.resize(perMass.size());
+    if (!model.renumbered()) {
+        std::copy(perMass.begin(), perMass.end(), out.begin());
+        return;
+    }
+    for (std::size_t v = 0; v < out.size(); ++v) out[v] = perMass[model.massOfVertex[v]];
+}
 
 }  // namespace flexfit

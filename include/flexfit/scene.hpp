@@ -14,7 +14,9 @@
 //                coherent_collision (true/false)
 //   [[part]]     name, mesh (path relative to the scene) or generator ("torus1", "torus2",
 //                "heart", "container-mouth", or a table {type = "torus" | "sphere" | "box" |
-//                "plate", ...}),
+//                "plate", ...}); with a mesh file: repair, remesh, draw, vertex_order
+//                ("locality", the default: masses renumbered for memory locality, while the
+//                scene's mass indices, frames and outputs stay in the file's order; or "as_given"),
 //                mode, motion, material (preset, {stiffness, damping} or a physical material
 //                {youngs_modulus, thickness, density, poisson_ratio, damping_ratio,
 //                bending_springs}), vertex_mass (not with a physical material), position,

@@ -131,7 +131,8 @@ public:
     const Pose& grabTarget() const;
     const Coupling& coupling() const;
     // A world-frame force for the next step on one mass, or spread over a face's three masses.
-    // Throws InputError for an index out of range.
+    // Throws InputError for an index out of range. Masses are the model's (a model renumbered
+    // for locality: PartModel::massOf of the mesh vertex).
     void applyMassForce(BodyId id, Index mass, const Vec3& worldForce);
     void applyFaceForce(BodyId id, Index face, const Vec3& worldForce);
     // A velocity kick on one mass (Part::kickMass) of a deforming part; on a part that does not

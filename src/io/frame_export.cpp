@@ -69,15 +69,18 @@ void appendPiece(std::ostringstream& out, const FramePart& named) {
     const Part& part = *named.part;
     const PartModel& model = part.model();
     const std::size_t n = model.massCount();
-    const auto& faces = model.mesh.faces;
-    std::vector<Vec3> points, displacement(n), velocity(n);
-    part.worldPositions(points);
-    for (std::size_t m = 0; m < n; ++m) {
-        displacement[m] = part.pose().rotate(part.state().positions[m] - model.restPositions[m]);
-        velocity[m] = part.pose().rotate(part.state().velocities[m]);
-    }
-    std::vector<int> depth;
-    part.zoneDepths(depth);
+    // The simulation surface, in the order its mesh was given (PartModel::massOfVertex).
+    const auto& faces = model.givenMesh ? model.givenMesh->faces : model.mesh.faces;
+    std::vector<Vec3> world, perMass(n), points, displacement, velocity;
+    part.worldPositions(world);
+    inVertexOrder<Vec3>(model, world, points);
+    for (std::size_t m = 0; m < n; ++m) perMass[m] = part.pose().rotate(part.state().positions[m] - model.restPositions[m]);
+    inVertexOrder<Vec3>(model, perMass, displacement);
+    for (std::size_t m = 0; m < n; ++m) perMass[m] = part.pose().rotate(part.state().velocities[m]);
+    inVertexOrder<Vec3>(model, perMass, velocity);
+    std::vector<int> depthPerMass, depth;
+    part.zoneDepths(depthPerMass);
+    inVertexOrder<int>(model, depthPerMass, depth);
     out << "<Piece Name=\"" << xmlEscaped(named.name) << "\" NumberOfPoints=\"" << n << "\" NumberOfPolys=\"" << faces.size() << "\">\n";
     out << "<PointData Scalars=\"zone_depth\" Vectors=\"displacement\">\n";
     out << "<DataArray type=\"Int32\" Name=\"zone_depth\" format=\"ascii\">\n";

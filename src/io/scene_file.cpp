@@ -335,13 +335,21 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     ScenePart p;
     p.name = t.requiredText("name");
     if (t.has("mesh") == t.has("generator")) t.fail("needs exactly one of 'mesh' and 'generator'");
-    for (const char* key : {"repair", "remesh", "draw"})
+    for (const char* key : {"repair", "remesh", "draw", "vertex_order"})
         if (t.has(key) && !t.has("mesh")) t.fail(*t.node(key), key, "applies only to a part read from a 'mesh' file");
     PartMeshes meshes = t.has("mesh") ? readPartMesh(t, base, options, warnings) : PartMeshes{generatePartMesh(t), {}};
     TriMesh mesh = std::move(meshes.simulated);
     mesh.name = p.name;
     PartModelSettings model;
     model.drawnMesh = std::move(meshes.drawn);
+    // A file's vertices come in its exporter's order: renumbered for locality unless asked not
+    // to (the scene's mass indices, frames and outputs stay in the file's order either way).
+    if (t.has("mesh")) {
+        const std::string order = t.text("vertex_order", "locality");
+        if (order != "locality" && order != "as_given")
+            t.fail(*t.node("vertex_order"), "vertex_order", "unknown value '" + order + "' (expected 'locality' or 'as_given')");
+        model.vertexOrder = order == "locality" ? VertexOrder::Locality : VertexOrder::AsGiven;
+    }
     readMaterial(t, model);
     model.vertexMass = t.positive("vertex_mass", 1.0);
 

@@ -2,6 +2,7 @@
 
 #include "flexfit/surface_embedding.hpp"
 #include "model/spring_blocks.hpp"
+#include "model/vertex_order.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -150,7 +151,10 @@ std::optional<Material> materialPreset(std::string_view name) {
     return std::nullopt;
 }
 
-std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings) {
+namespace {
+
+// The model with mass i = vertex i, without its drawn mesh.
+std::shared_ptr<PartModel> buildInGivenOrder(TriMesh mesh, const PartModelSettings& settings) {
     auto model = std::make_shared<PartModel>();
     model->topology = buildTopology(mesh.faces, mesh.vertices.size());
     const std::size_t vertices = mesh.vertices.size();
@@ -198,16 +202,65 @@ std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSet
     for (std::size_t v = 0; v < vertices; ++v) model->springAdr[v + 1] += model->springAdr[v];
     model->springBlocks = std::make_shared<const SpringBlocks>(
         buildSpringBlocks(model->springA, model->springB, model->restLength, model->stiffness, model->damping));
+    model->mesh = std::move(mesh);
+    return model;
+}
+
+// Topology edge e of the given order is edge edgeOf[e] of the renumbered one.
+std::vector<Index> renumberedEdges(const Topology& given, const Topology& renumbered, std::span<const Index> newIndex) {
+    std::vector<Index> edgeOf(given.edgeCount());
+    for (std::size_t e = 0; e < edgeOf.size(); ++e) {
+        const Index a = std::min(newIndex[given.edgeA[e]], newIndex[given.edgeB[e]]);
+        const Index b = std::max(newIndex[given.edgeA[e]], newIndex[given.edgeB[e]]);
+        const auto neighbours = renumbered.neighborsOf(a);
+        const auto at = std::lower_bound(neighbours.begin(), neighbours.end(), b) - neighbours.begin();
+        edgeOf[e] = renumbered.edgesOf(a)[std::size_t(at)];
+    }
+    return edgeOf;
+}
+
+// The given model's mesh renumbered for locality, when that puts more springs in blocks; null
+// otherwise. Settings were checked by the given order's build (their errors name the user's
+// vertices and springs).
+std::shared_ptr<PartModel> renumberedForLocality(const PartModel& given, const PartModelSettings& settings) {
+    const std::vector<Index> newIndex = detail::localityOrder(given.topology, given.mesh.faces);
+    PartModelSettings renumbered = settings;
+    for (std::size_t v = 0; v < settings.vertexMasses.size(); ++v) renumbered.vertexMasses[newIndex[v]] = settings.vertexMasses[v];
+    auto model = buildInGivenOrder(detail::renumberVertices(given.mesh, newIndex), [&] {
+        PartModelSettings s = renumbered;
+        s.springMaterials.clear();  // per-spring constants go in below, by edge
+        return s;
+    }());
+    if (model->springBlocks->blockCount() <= given.springBlocks->blockCount()) return nullptr;
+    if (!settings.springMaterials.empty()) {
+        const std::vector<Index> edgeOf = renumberedEdges(given.topology, model->topology, newIndex);
+        for (std::size_t e = 0; e < edgeOf.size(); ++e) renumbered.springMaterials[edgeOf[e]] = settings.springMaterials[e];
+        model = buildInGivenOrder(std::move(model->mesh), renumbered);
+    }
+    model->massOfVertex = newIndex;
+    model->vertexOfMass.resize(newIndex.size());
+    for (std::size_t v = 0; v < newIndex.size(); ++v) model->vertexOfMass[newIndex[v]] = Index(v);
+    return model;
+}
+
+}  // namespace
+
+std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings) {
+    std::shared_ptr<PartModel> model = buildInGivenOrder(std::move(mesh), settings);
+    if (settings.vertexOrder == VertexOrder::Locality)
+        if (auto renumbered = renumberedForLocality(*model, settings)) {
+            renumbered->givenMesh = std::make_shared<const TriMesh>(std::move(model->mesh));
+            model = std::move(renumbered);
+        }
     if (!settings.drawnMesh.faces.empty()) {
         validateMesh(settings.drawnMesh, kSettingsSource + ", drawn mesh");
-        model->drawn = std::make_shared<const SurfaceEmbedding>(embedSurface(settings.drawnMesh, mesh, kSettingsSource));
+        model->drawn = std::make_shared<const SurfaceEmbedding>(embedSurface(settings.drawnMesh, model->mesh, kSettingsSource));
     }
-    model->mesh = std::move(mesh);
     return model;
 }
 
 bool PartModel::hasSpringBlocks() const { return springBlocks != nullptr && !springBlocks->empty(); }
 
-const TriMesh& PartModel::drawnMesh() const { return drawn ? drawn->mesh : mesh; }
+const TriMesh& PartModel::drawnMesh() const { return drawn ? drawn->mesh : givenMesh ? *givenMesh : mesh; }
 
 }  // namespace flexfit

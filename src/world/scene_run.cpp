@@ -37,7 +37,7 @@ void SceneRun::start(const SceneAction& a) {
         case Kind::Release: world_->release(); return;
         case Kind::Velocity: world_->setVelocity(a.body, a.linear, a.angular); return;
         case Kind::Kick:
-            for (Index m : a.masses) world_->kickMass(a.body, m, a.linear);
+            for (Index m : a.masses) world_->kickMass(a.body, world_->part(a.body).model().massOf(m), a.linear);
             return;
         case Kind::Move:
             // A snap may have taken the part from the operator: the move is then void.
@@ -52,7 +52,7 @@ void SceneRun::apply(const SceneAction& a, const Pose& moveStart, double t) {
     using Kind = SceneAction::Kind;
     if (a.kind == Kind::Push) world_->applyForce(a.body, a.force);
     if (a.kind == Kind::Force) {
-        for (Index m : a.masses) world_->applyMassForce(a.body, m, a.force);
+        for (Index m : a.masses) world_->applyMassForce(a.body, world_->part(a.body).model().massOf(m), a.force);
         for (Index f : a.faces) world_->applyFaceForce(a.body, f, a.force);
     }
     if (a.kind == Kind::Move && world_->grabbed() == a.body) {

@@ -3,6 +3,8 @@
 #include "flexfit/flexfit.hpp"
 #include "golden.hpp"
 #include "model/spring_blocks.hpp"
+#include "model/vertex_order.hpp"
+#include "shuffled_mesh.hpp"
 
 #include <gtest/gtest.h>
 
@@ -529,5 +531,67 @@ TEST(Part, AnInvalidDrawnMeshIsRejected) {
         FAIL() << "accepted a drawn mesh with a vertex index out of range";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("drawn mesh"), std::string::npos) << e.what();
+    }
+}
+
+// --- A model renumbered for locality (VertexOrder::Locality): the same run as in the mesh's own
+// order, read in that order through drawnPositions. ---
+
+namespace {
+
+// Loads the part's vertex `vertex` (the given mesh's index) for 40 steps, then lets it go for
+// `steps` more; the drawn positions (the given mesh's order) at the end.
+std::vector<Vec3> loadedRun(const std::shared_ptr<const PartModel>& model, Index vertex, PartMode mode, int steps) {
+    PartSettings settings = zoneSettings();
+    settings.mode = mode;
+    Part part(model, settings);
+    part.rotate(Vec3(0.3, 1, 0.2).normalized(), 0.7);
+    for (int i = 0; i < 40 + steps; ++i) {
+        if (i < 40) part.applyForce(model->massOf(vertex), Vec3(0.4, -0.2, 0.3));
+        part.step();
+    }
+    std::vector<Vec3> drawn;
+    part.drawnPositions(drawn);
+    return drawn;
+}
+
+}  // namespace
+
+TEST(PartVertexOrder, TheSameRunBitForBitAsTheMeshGivenInTheRenumberedOrder) {
+    const TriMesh shuffled = flexfit::testing::shuffledVertices(makeTorus(3.0, 1.0, 24, 16), 11);
+    PartModelSettings locality;
+    locality.vertexOrder = VertexOrder::Locality;
+    const auto renumbered = buildPartModel(shuffled, locality);
+    ASSERT_TRUE(renumbered->renumbered());
+    // The same masses in the same order, given as such: every sum runs in the same order.
+    const std::vector<Index> order = detail::localityOrder(buildTopology(shuffled.faces, shuffled.vertices.size()), shuffled.faces);
+    ASSERT_EQ(order, renumbered->massOfVertex);
+    const auto inOrder = buildPartModel(detail::renumberVertices(shuffled, order));
+    for (const PartMode mode : {PartMode::RigidDeformable, PartMode::FullDeformable}) {
+        const std::vector<Vec3> a = loadedRun(renumbered, 100, mode, 60);
+        const std::vector<Vec3> b = loadedRun(inOrder, order[100], mode, 60);
+        ASSERT_EQ(a.size(), b.size());
+        for (Index v = 0; v < a.size(); ++v) ASSERT_EQ(a[v], b[order[v]]) << "vertex " << v;
+    }
+}
+
+TEST(PartVertexOrder, TheSameRunAsInTheGivenOrderUpToTheSummationOrder) {
+    const TriMesh shuffled = flexfit::testing::shuffledVertices(makeTorus(3.0, 1.0, 24, 16), 11);
+    PartModelSettings locality;
+    locality.vertexOrder = VertexOrder::Locality;
+    const auto renumbered = buildPartModel(shuffled, locality);
+    const auto given = buildPartModel(shuffled);
+    ASSERT_TRUE(renumbered->renumbered());
+    for (const PartMode mode : {PartMode::RigidDeformable, PartMode::FullDeformable}) {
+        const std::vector<Vec3> a = loadedRun(renumbered, 100, mode, 60);
+        const std::vector<Vec3> b = loadedRun(given, 100, mode, 60);
+        ASSERT_EQ(a.size(), shuffled.vertices.size());
+        double largest = 0.0, moved = 0.0;
+        for (std::size_t v = 0; v < a.size(); ++v) {
+            largest = std::max(largest, (a[v] - b[v]).norm());
+            moved = std::max(moved, (b[v] - given->restPositions[v]).norm());
+        }
+        EXPECT_GT(moved, 1e-3) << "the load moved the part";
+        EXPECT_LT(largest, 1e-12 * 4.0) << "positions differ beyond rounding";
     }
 }

@@ -2,6 +2,8 @@
 #include "flexfit/generators.hpp"
 #include "flexfit/part_model.hpp"
 #include "flexfit/part_state.hpp"
+#include "model/spring_blocks.hpp"
+#include "shuffled_mesh.hpp"
 
 #include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
@@ -547,6 +549,99 @@ TEST(PartModel, SharedByTwoStates) {
 
     other.reset();
     EXPECT_EQ(model.use_count(), 1);
+}
+
+
+// --- VertexOrder::Locality: every per-mass and per-spring value follows its vertex or edge,
+// checked against the model built in the given order. ---
+
+PartModelSettings inLocalityOrder(PartModelSettings s = {}) {
+    s.vertexOrder = VertexOrder::Locality;
+    return s;
+}
+
+TEST(PartModelVertexOrder, AShuffledMeshIsRenumberedAndEveryValueFollowsItsVertex) {
+    const TriMesh shuffled = flexfit::testing::shuffledVertices(makeTorus(3.0, 1.0, 24, 16), 7);
+    PartModelSettings settings;
+    for (std::size_t v = 0; v < shuffled.vertices.size(); ++v) settings.vertexMasses.push_back(1.0 + 0.01 * double(v));
+    const auto given = buildPartModel(shuffled, settings);
+    const auto model = buildPartModel(shuffled, inLocalityOrder(settings));
+    ASSERT_TRUE(model->renumbered());
+    EXPECT_FALSE(given->renumbered());
+    EXPECT_GT(model->springBlocks->blockCount(), given->springBlocks->blockCount());
+    const std::size_t n = shuffled.vertices.size();
+    ASSERT_EQ(model->massOfVertex.size(), n);
+    for (Index v = 0; v < n; ++v) {
+        const Index m = model->massOf(v);
+        ASSERT_LT(m, n);
+        EXPECT_EQ(model->vertexOf(m), v);
+        EXPECT_EQ(model->restPositions[m], shuffled.vertices[v]);
+        EXPECT_EQ(model->mass[m], settings.vertexMasses[v]);
+    }
+    for (std::size_t f = 0; f < shuffled.faces.size(); ++f)
+        for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(model->mesh.faces[f][c], model->massOf(shuffled.faces[f][c]));
+    // Springs: the same edges with the same constants (rest lengths computed from the same pair).
+    ASSERT_EQ(model->springCount(), given->springCount());
+    for (std::size_t e = 0; e < given->springCount(); ++e) {
+        const Index r = springBetween(*model, model->massOf(given->springA[e]), model->massOf(given->springB[e]));
+        EXPECT_NEAR(model->restLength[r], given->restLength[e], 1e-15 * given->restLength[e]);
+    }
+    // What is drawn and exported is the mesh as given, in its order.
+    EXPECT_EQ(model->drawnMesh().vertices, shuffled.vertices);
+    EXPECT_EQ(model->drawnMesh().faces, shuffled.faces);
+}
+
+TEST(PartModelVertexOrder, PerSpringMaterialsFollowTheirEdges) {
+    const TriMesh shuffled = flexfit::testing::shuffledVertices(makeTorus(3.0, 1.0, 16, 12), 2);
+    const Topology topology = buildTopology(shuffled.faces, shuffled.vertices.size());
+    PartModelSettings settings;
+    for (std::size_t e = 0; e < topology.edgeCount(); ++e) settings.springMaterials.push_back({1.0 + double(e), 0.5 * double(e)});
+    const auto model = buildPartModel(shuffled, inLocalityOrder(settings));
+    ASSERT_TRUE(model->renumbered());
+    for (std::size_t e = 0; e < topology.edgeCount(); ++e) {
+        const Index r = springBetween(*model, model->massOf(topology.edgeA[e]), model->massOf(topology.edgeB[e]));
+        EXPECT_EQ(model->stiffness[r], settings.springMaterials[e].stiffness) << "edge " << e;
+        EXPECT_EQ(model->damping[r], settings.springMaterials[e].damping) << "edge " << e;
+    }
+}
+
+TEST(PartModelVertexOrder, AShellMaterialLumpsTheSameMassesOnTheSameVertices) {
+    const TriMesh shuffled = flexfit::testing::shuffledVertices(makeTorus(0.3, 0.1, 20, 12), 4);
+    PartModelSettings settings;
+    settings.shell = ShellMaterial{2e9, 0.35, 0.002, 1200.0, 0.1, true};
+    const auto given = buildPartModel(shuffled, settings);
+    const auto model = buildPartModel(shuffled, inLocalityOrder(settings));
+    ASSERT_TRUE(model->renumbered());
+    ASSERT_EQ(model->springCount(), given->springCount());
+    for (Index v = 0; v < shuffled.vertices.size(); ++v) EXPECT_EQ(model->mass[model->massOf(v)], given->mass[v]);
+    for (std::size_t e = 0; e < given->springCount(); ++e) {
+        const Index r = springBetween(*model, model->massOf(given->springA[e]), model->massOf(given->springB[e]));
+        EXPECT_NEAR(model->stiffness[r], given->stiffness[e], 1e-12 * given->stiffness[e]);
+    }
+}
+
+TEST(PartModelVertexOrder, AMeshInRowsKeepsItsOrder) {
+    const TriMesh heart = makeHeart();
+    const auto given = buildPartModel(heart);
+    const auto model = buildPartModel(heart, inLocalityOrder());
+    EXPECT_FALSE(model->renumbered());
+    EXPECT_EQ(model->givenMesh, nullptr);
+    EXPECT_EQ(model->springA, given->springA);
+    EXPECT_EQ(model->springB, given->springB);
+    EXPECT_EQ(model->massOf(17), 17u);
+}
+
+TEST(PartModelVertexOrder, ErrorsNameTheGivenVertex) {
+    const TriMesh shuffled = flexfit::testing::shuffledVertices(makeTorus(3.0, 1.0, 24, 16), 7);
+    PartModelSettings settings = inLocalityOrder();
+    settings.vertexMasses.assign(shuffled.vertices.size(), 1.0);
+    settings.vertexMasses[17] = -1.0;
+    try {
+        buildPartModel(shuffled, settings);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(contains(e.what(), "mass of vertex 17 ")) << e.what();
+    }
 }
 
 }  // namespace

@@ -438,3 +438,37 @@ def test_grab_with_explicit_coupling_stiffness():
     world.release()
     with pytest.raises(flexfit.InputError):
         world.grab(b, stiffness=1e12, damping=0.0)  # a coupling the time step cannot integrate
+
+
+def test_a_model_renumbered_for_locality_speaks_the_meshs_own_vertex_order():
+    torus = flexfit.torus(3, 1, 24, 16)
+    shuffle = np.random.default_rng(4).permutation(len(torus.vertices))  # vertex v goes to row shuffle[v]
+    vertices = np.empty_like(torus.vertices)
+    vertices[shuffle] = torus.vertices
+    mesh = flexfit.Mesh(vertices, shuffle[torus.faces], "shuffled")
+    local = flexfit.PartModel(mesh, springs=(0.1, 0.01), vertex_order="locality")
+    given = flexfit.PartModel(mesh, springs=(0.1, 0.01))
+    assert local.renumbered and not given.renumbered
+    assert sorted(local.mass_of_vertex) == list(range(len(vertices))) and list(given.mass_of_vertex) == list(range(len(vertices)))
+    np.testing.assert_array_equal(local.mesh.vertices, vertices)
+    np.testing.assert_array_equal(local.mesh.faces, mesh.faces)
+    np.testing.assert_array_equal(local.rest_positions, vertices)
+    runs = []
+    for model in (local, given):
+        part = flexfit.Part(model, mode="rigid-deformable", restoration="none", global_damping=0.5)
+        part.open_zone(40, 1)
+        for _ in range(30):
+            part.apply_force(7, [0, 0.3, 0.1])
+            part.step()
+        part.kick_mass(9, [0.2, 0, 0])
+        part.step()
+        runs.append(part)
+    a, b = runs
+    np.testing.assert_allclose(a.positions, b.positions, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(a.velocities, b.velocities, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(a.world_positions(), b.world_positions(), rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(a.zone_depths, b.zone_depths)
+    assert set(a.moving_masses) == set(b.moving_masses) and 7 in set(a.moving_masses)
+    assert np.linalg.norm(b.positions[7] - vertices[7]) > 1e-5  # the load moved vertex 7
+    with pytest.raises(flexfit.InputError, match="vertex_order"):
+        flexfit.PartModel(mesh, vertex_order="sorted")

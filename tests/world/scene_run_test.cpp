@@ -5,13 +5,19 @@
 #include "collision/sampling_kernel.hpp"
 #include "flexfit/scene_file.hpp"
 #include "flexfit/scene_run.hpp"
+#include "flexfit/frame_export.hpp"
+#include "flexfit/mesh_io.hpp"
 #include "golden.hpp"
+#include "shuffled_mesh.hpp"
+#include "temp_dir.hpp"
 #include "test_bodies.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <optional>
 #include <stdexcept>
 #include <string_view>
@@ -380,8 +386,9 @@ const GoldenScene kGoldenScenes[] = {
     {"zones.toml", "d945221b1c4370a4"},        {"incline.toml", "c6346202c7018ec7"},
     {"peg_in_hole.toml", "a7d3aa5751ab152e"},  {"stack.toml", "5afa580fd130e1cd"},
     {"ball_torus_friction.toml", "48041e611fddb539"}, {"stiff_clip.toml", "b1a97775ad8c4992"},
-    // On CGAL's remeshed surfaces (the remeshing is deterministic: exact predicates, no threads).
-    {"ball_torus_remeshed.toml", "b9df78c671721279"}, {"contact_remeshed.toml", "9b76fb71f69fe0df"},
+    // On CGAL's remeshed surfaces (the remeshing is deterministic: exact predicates, no threads),
+    // their masses renumbered for locality (vertex_order.hpp).
+    {"ball_torus_remeshed.toml", "c8f1ac90a535dc7d"}, {"contact_remeshed.toml", "4c36e049ea25e3c2"},
 };
 
 [[maybe_unused]] bool remeshed(const GoldenScene& scene) { return std::string(scene.file).find("remeshed") != std::string::npos; }
@@ -477,5 +484,118 @@ duration = 0.1
         EXPECT_EQ(e.body(), BodyId(1));
         EXPECT_EQ(e.name(), "rim");
         EXPECT_EQ(std::string(e.what()).rfind("body 1 'rim' diverged at t = ", 0), 0u) << e.what();
+    }
+}
+
+// A mesh file in no useful vertex order (a shuffled torus): the scene renumbers its masses for
+// locality (vertex_order = "locality", the default), yet its mass indices, drawn positions and
+// VTK frames are the file's, and the run is the one vertex_order = "as_given" gives up to the
+// summation order.
+namespace {
+
+std::string vtkSection(const std::string& text, const std::string& opening) {
+    const std::size_t start = text.find(opening);
+    if (start == std::string::npos) return {};
+    const std::size_t body = text.find('>', start + opening.size()) + 1;
+    return text.substr(body, text.find("</DataArray>", body) - body);
+}
+
+std::vector<double> numbers(const std::string& text) {
+    std::istringstream in(text);
+    std::vector<double> out;
+    for (double x; in >> x;) out.push_back(x);
+    return out;
+}
+
+}  // namespace
+
+TEST(SceneRun, AFileMeshRenumberedForLocalityKeepsTheFilesOrderInEveryOutput) {
+    flexfit::testing::TempDir dir;
+    const TriMesh file = flexfit::testing::shuffledVertices(makeTorus(3.0, 1.0, 24, 16), 9);
+    writeMesh(file, dir.path() / "torus.tri");
+    const std::string scene = R"(
+[world]
+time_step = 0.001
+gravity = [0, 0, 0]
+duration = 0.2
+
+[[part]]
+name = "ring"
+mesh = "torus.tri"
+mode = "full-deformable"
+restoration = "none"
+global_damping = 0.5
+
+[[action]]
+time = 0.0
+type = "force"
+part = "ring"
+masses = [5, 200]
+force = [0.3, -0.1, 0.2]
+duration = 0.1
+
+[[action]]
+time = 0.05
+type = "kick"
+part = "ring"
+masses = [77]
+velocity = [0, 0.5, 0]
+)";
+    const Scene local = parseScene(scene, "scene.toml", dir.path());
+    ASSERT_TRUE(local.parts[0].model->renumbered());
+    const Scene asGiven = parseScene(
+        std::string(scene).insert(scene.find("mode ="), "vertex_order = \"as_given\"\n"), "scene.toml", dir.path());
+    ASSERT_FALSE(asGiven.parts[0].model->renumbered());
+
+    SceneRun a(local), b(asGiven);
+    std::vector<Vec3> drawnA, drawnB;
+    a.world().part(0).drawnWorldPositions(drawnA);
+    EXPECT_EQ(drawnA, file.vertices) << "at rest, the file's vertices in its order";
+    EXPECT_EQ(a.world().part(0).model().drawnMesh().faces, file.faces);
+    runFor(a, 0.2);
+    runFor(b, 0.2);
+    a.world().part(0).drawnWorldPositions(drawnA);
+    b.world().part(0).drawnWorldPositions(drawnB);
+    ASSERT_EQ(drawnA.size(), drawnB.size());
+    double largest = 0.0;
+    for (std::size_t v = 0; v < drawnA.size(); ++v) largest = std::max(largest, (drawnA[v] - drawnB[v]).norm());
+    EXPECT_LT(largest, 1e-12);
+    // The loaded and kicked vertices are the file's 5, 200 and 77: they moved most.
+    EXPECT_GT((drawnB[77] - file.vertices[77]).norm(), 0.01);
+
+    // VTK frames: the same connectivity (the file's faces), the same points up to rounding.
+    writeVtkFrame(dir.path() / "a.vtp", {{"ring", &a.world().part(0)}});
+    writeVtkFrame(dir.path() / "b.vtp", {{"ring", &b.world().part(0)}});
+    auto read = [&](const char* name) {
+        std::ifstream in(dir.path() / name);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const std::string vtkA = read("a.vtp"), vtkB = read("b.vtp");
+    EXPECT_EQ(vtkSection(vtkA, "Name=\"connectivity\""), vtkSection(vtkB, "Name=\"connectivity\""));
+    EXPECT_EQ(numbers(vtkSection(vtkA, "Name=\"zone_depth\"")), numbers(vtkSection(vtkB, "Name=\"zone_depth\"")));
+    for (const char* field : {"Name=\"displacement\"", "<Points>\n<DataArray"}) {
+        const std::vector<double> x = numbers(vtkSection(vtkA, field)), y = numbers(vtkSection(vtkB, field));
+        ASSERT_EQ(x.size(), 3 * file.vertices.size()) << field;
+        ASSERT_EQ(x.size(), y.size()) << field;
+        for (std::size_t i = 0; i < x.size(); ++i) ASSERT_NEAR(x[i], y[i], 1e-12) << field << " " << i;
+    }
+}
+
+TEST(SceneRun, VertexOrderIsCheckedAndAppliesToMeshFilesOnly) {
+    flexfit::testing::TempDir dir;
+    writeMesh(makeTorus(3.0, 1.0, 12, 8), dir.path() / "torus.tri");
+    const std::string part = "[[part]]\nname = \"ring\"\nmesh = \"torus.tri\"\n";
+    try {
+        parseScene(part + "vertex_order = \"sorted\"\n", "scene.toml", dir.path());
+        ADD_FAILURE() << "accepted vertex_order = \"sorted\"";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("scene.toml:4: part 1, key 'vertex_order': unknown value 'sorted'"), std::string::npos) << e.what();
+    }
+    try {
+        parseScene("[[part]]\nname = \"ring\"\ngenerator = \"torus1\"\nvertex_order = \"as_given\"\n", "scene.toml", dir.path());
+        ADD_FAILURE() << "accepted vertex_order on a generated part";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("key 'vertex_order': applies only to a part read from a 'mesh' file"), std::string::npos)
+            << e.what();
     }
 }
