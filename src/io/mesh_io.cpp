@@ -70,8 +70,10 @@ MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSou
 MeshReadResult readMesh(const std::filesystem::path& path, const MeshReadOptions& options) {
     if (options.weldTolerance && !(*options.weldTolerance >= 0.0 && std::isfinite(*options.weldTolerance)))
         throw InputError(path.string(), 0, "weld tolerance must be a finite number >= 0");
-    if (lowerExtension(path) != ".tri") return readWithAssimp(path, options);
-    return readTri(path, options);
+    const std::string ext = lowerExtension(path);
+    if (ext == ".tri") return readTri(path, options);
+    if (ext == ".obj") return readObj(path, options);
+    return readWithAssimp(path, options);
 }
 
 void writeObj(const TriMesh& mesh, const std::filesystem::path& path) {

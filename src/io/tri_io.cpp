@@ -1,6 +1,7 @@
 // The `.tri` reader and writer (format in mesh_io.hpp).
 #include "flexfit/mesh_io.hpp"
 #include "io_internal.hpp"
+#include "text_lines.hpp"
 
 #include <charconv>
 #include <cstdio>
@@ -12,84 +13,16 @@
 namespace flexfit {
 namespace {
 
-struct Line {
-    std::size_t number = 0;
-    std::vector<std::string_view> tokens;
-};
-
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-std::vector<std::string_view> tokenize(std::string_view line) {
-    std::vector<std::string_view> tokens;
-    std::size_t i = 0;
-    while (i < line.size()) {
-        while (i < line.size() && isSpace(line[i])) ++i;
-        const std::size_t start = i;
-        while (i < line.size() && !isSpace(line[i])) ++i;
-        if (i > start) tokens.push_back(line.substr(start, i - start));
-    }
-    return tokens;
-}
-
-// Walks the text line by line, skipping blank lines, remembering line numbers.
-class LineCursor {
-public:
-    explicit LineCursor(std::string_view text) : text_(text) {}
-
-    // The raw first line (the model's name), without its end of line.
-    std::string_view firstLine() {
-        const std::size_t end = text_.find('\n');
-        std::string_view line = text_.substr(0, end);
-        pos_ = end == std::string_view::npos ? text_.size() : end + 1;
-        lineNumber_ = 1;
-        return line;
-    }
-
-    // Next non-blank line; false at the end of the text.
-    bool next(Line& out) {
-        while (pos_ < text_.size()) {
-            const std::size_t end = std::min(text_.find('\n', pos_), text_.size());
-            std::string_view raw = text_.substr(pos_, end - pos_);
-            pos_ = end + 1;
-            ++lineNumber_;
-            out.number = lineNumber_;
-            out.tokens = tokenize(raw);
-            if (!out.tokens.empty()) return true;
-        }
-        return false;
-    }
-
-    std::size_t lineNumber() const { return lineNumber_; }
-
-private:
-    std::string_view text_;
-    std::size_t pos_ = 0;
-    std::size_t lineNumber_ = 0;
-};
-
-std::string quoted(std::string_view token) {
-    constexpr std::size_t kMax = 40;
-    std::string text(token.substr(0, kMax));
-    for (char& c : text)
-        if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
-    return "'" + text + (token.size() > kMax ? "...'" : "'");
-}
+using detail::LineCursor;
+using detail::parseCoordinate;
+using detail::quoted;
+using Line = detail::TextLine;
 
 std::uint64_t parseCount(std::string_view token, const std::string& source, std::size_t line, const char* what) {
     std::uint64_t value = 0;
     const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
     if (ec != std::errc() || end != token.data() + token.size())
         throw InputError(source, line, std::string(what) + " " + quoted(token) + " is not a non-negative integer");
-    return value;
-}
-
-double parseCoordinate(std::string_view token, const std::string& source, std::size_t line) {
-    double value = 0.0;
-    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-    if (ec == std::errc::result_out_of_range)
-        throw InputError(source, line, "coordinate " + quoted(token) + " is out of the range of a double");
-    if (ec != std::errc() || end != token.data() + token.size())
-        throw InputError(source, line, "coordinate " + quoted(token) + " is not a number");
     return value;
 }
 
@@ -154,8 +87,8 @@ void readFaces(LineCursor& cursor, const std::string& source, std::uint64_t coun
 
 std::string trimmed(std::string_view s) {
     std::size_t b = 0, e = s.size();
-    while (b < e && (isSpace(s[b]) || s[b] == '\n')) ++b;
-    while (e > b && (isSpace(s[e - 1]) || s[e - 1] == '\n')) --e;
+    while (b < e && (detail::isBlank(s[b]) || s[b] == '\n')) ++b;
+    while (e > b && (detail::isBlank(s[e - 1]) || s[e - 1] == '\n')) --e;
     return std::string(s.substr(b, e - b));
 }
 
@@ -187,15 +120,7 @@ MeshReadResult parseTri(std::string_view text, const std::string& source, const 
 }
 
 MeshReadResult readTri(const std::filesystem::path& path, const MeshReadOptions& options) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec))
-        throw InputError(path.string(), 0, std::filesystem::exists(path, ec) ? "not a regular file"
-                                                                               : "cannot open the file for reading: it does not exist");
-    std::ifstream file(path, std::ios::binary);
-    if (!file) throw InputError(path.string(), 0, "cannot open the file for reading");
-    std::ostringstream buffer;
-    buffer << file.rdbuf();
-    return parseTri(buffer.str(), path.string(), options);
+    return parseTri(detail::readTextFile(path), path.string(), options);
 }
 
 std::string formatTri(const TriMesh& mesh) {

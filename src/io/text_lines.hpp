@@ -1,0 +1,106 @@
+// Internal to src/io: line-by-line reading of text mesh formats (.tri, OBJ), with line numbers
+// for every error.
+#pragma once
+
+#include "flexfit/core.hpp"
+
+#include <charconv>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace flexfit::detail {
+
+struct TextLine {
+    std::size_t number = 0;
+    std::vector<std::string_view> tokens;
+};
+
+inline bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+inline std::vector<std::string_view> tokenize(std::string_view line) {
+    std::vector<std::string_view> tokens;
+    std::size_t i = 0;
+    while (i < line.size()) {
+        while (i < line.size() && isBlank(line[i])) ++i;
+        const std::size_t start = i;
+        while (i < line.size() && !isBlank(line[i])) ++i;
+        if (i > start) tokens.push_back(line.substr(start, i - start));
+    }
+    return tokens;
+}
+
+// Walks the text line by line, skipping blank lines, remembering line numbers.
+class LineCursor {
+public:
+    explicit LineCursor(std::string_view text) : text_(text) {}
+
+    // The raw first line (a .tri model's name), without its end of line.
+    std::string_view firstLine() {
+        const std::size_t end = text_.find('\n');
+        std::string_view line = text_.substr(0, end);
+        pos_ = end == std::string_view::npos ? text_.size() : end + 1;
+        lineNumber_ = 1;
+        return line;
+    }
+
+    // Next non-blank line; false at the end of the text.
+    bool next(TextLine& out) {
+        while (pos_ < text_.size()) {
+            const std::size_t end = std::min(text_.find('\n', pos_), text_.size());
+            std::string_view raw = text_.substr(pos_, end - pos_);
+            pos_ = end + 1;
+            ++lineNumber_;
+            out.number = lineNumber_;
+            out.tokens = tokenize(raw);
+            if (!out.tokens.empty()) return true;
+        }
+        return false;
+    }
+
+    std::size_t lineNumber() const { return lineNumber_; }
+
+private:
+    std::string_view text_;
+    std::size_t pos_ = 0;
+    std::size_t lineNumber_ = 0;
+};
+
+// A token for an error message: at most 40 characters, control bytes as '?'.
+inline std::string quoted(std::string_view token) {
+    constexpr std::size_t kMax = 40;
+    std::string text(token.substr(0, kMax));
+    for (char& c : text)
+        if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+    return "'" + text + (token.size() > kMax ? "...'" : "'");
+}
+
+// A decimal number; a leading '+' is allowed (from_chars alone refuses it).
+inline double parseCoordinate(std::string_view token, const std::string& source, std::size_t line) {
+    double value = 0.0;
+    const std::string_view digits = token.size() > 1 && token[0] == '+' && token[1] != '-' ? token.substr(1) : token;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (ec == std::errc::result_out_of_range)
+        throw InputError(source, line, "coordinate " + quoted(token) + " is out of the range of a double");
+    if (ec != std::errc() || end != digits.data() + digits.size())
+        throw InputError(source, line, "coordinate " + quoted(token) + " is not a number");
+    return value;
+}
+
+// The whole file as text; InputError naming it when it is missing, not a file, or unreadable.
+inline std::string readTextFile(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw InputError(path.string(), 0, std::filesystem::exists(path, ec) ? "not a regular file"
+                                                                               : "cannot open the file for reading: it does not exist");
+    std::ifstream file(path, std::ios::binary);
+    if (!file) throw InputError(path.string(), 0, "cannot open the file for reading");
+    std::ostringstream buffer;
+    buffer << file.rdbuf();
+    return buffer.str();
+}
+
+}  // namespace flexfit::detail
