@@ -299,9 +299,10 @@ void addPartReaders(Class& c, Get get) {
         .def_property_readonly("model", [get](py::object self) { return std::const_pointer_cast<PartModel>(get(self).sharedModel()); },
                                "The part's model (shared, immutable).")
         .def_property_readonly("positions", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().positions, self); },
-                               "Mass positions in the part frame, a read-only (n, 3) view of the state (non-moving masses at rest).")
+                               "Mass positions in the part frame (the mesh's vertex order), a read-only (n, 3) view of the state, or a read-only copy when "
+                               "the model's masses are renumbered (non-moving masses at rest).")
         .def_property_readonly("velocities", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().velocities, self); },
-                               "Mass velocities (part frame), a read-only (n, 3) view.")
+                               "Mass velocities (part frame, the mesh's vertex order), a read-only (n, 3) view, or a copy when the masses are renumbered.")
         .def_property_readonly("moving_masses", [get](py::object self) {
             const Part& part = get(self);
             std::vector<Index> vertices;

@@ -3,7 +3,7 @@
 // `.tri` is the thesis's text format, as SPEC.md defines it: line 1 the model's name; then the
 // vertex count V and the face count F (on one line or two); then V lines `x y z`; then F lines
 // `a b c` of 0-based indices. Blank lines are ignored. OBJ has its own reader (obj_io.cpp: the
-// file's vertex order and double precision; polygons split as fans). Everything else (STL, PLY,
+// file's vertex order and double precision; polygons triangulated in their plane). Everything else (STL, PLY,
 // OFF, glTF/GLB) goes through assimp, which gives vertices in first-use order, in single
 // precision. Every reader returns a whole, valid mesh or throws InputError
 // naming the file, the line where there is one, and the problem.

@@ -119,7 +119,8 @@ void triangulate(const std::vector<Vec3>& vertices, std::span<const Index> corne
     if (corners.size() == 3) return fan();
     const std::vector<Eigen::Vector2d> p = projected(vertices, corners);
     bool convex = true;
-    for (std::size_t i = 0; i < p.size() && convex; ++i) convex = turn(p[i], p[(i + 1) % p.size()], p[(i + 2) % p.size()]) >= 0.0;
+    // Strictly convex: a corner on a straight edge (a T-junction) would give the fan a flat triangle.
+    for (std::size_t i = 0; i < p.size() && convex; ++i) convex = turn(p[i], p[(i + 1) % p.size()], p[(i + 2) % p.size()]) > 0.0;
     if (convex) return fan();
     const std::size_t before = out.size();
     if (!clipEars(corners, p, out)) {
@@ -171,9 +172,15 @@ MeshReadResult parseObj(std::string_view text, const std::string& source, const 
     // Exporters that split vertices to carry normals or texture seams repeat positions: those
     // are welded as the format's welding (the rest keep the file's order and their lines).
     const std::vector<Index> target = weldTargets(mesh.vertices, 0.0);
-    bool repeats = false;
-    for (std::size_t v = 0; v < target.size() && !repeats; ++v) repeats = target[v] != v;
-    return finishRead(std::move(mesh), source, lines, options, repeats);
+    std::size_t repeats = 0;
+    for (std::size_t v = 0; v < target.size(); ++v) repeats += target[v] != v ? 1 : 0;
+    MeshReadResult result = finishRead(std::move(mesh), source, lines, options, repeats > 0);
+    if (repeats > 0)
+        result.diagnostics.warnings.insert(result.diagnostics.warnings.begin(),
+                                           std::to_string(repeats) + " vertices repeat an earlier one's position (split normals or "
+                                           "texture seams) and were welded into it: vertex indices (scene masses, frames) are the welded mesh's, "
+                                           "not the file's (flexfit convert writes that mesh)");
+    return result;
 }
 
 MeshReadResult readObj(const std::filesystem::path& path, const MeshReadOptions& options) {

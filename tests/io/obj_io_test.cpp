@@ -61,19 +61,6 @@ TEST(ObjIo, CornerFormsNegativeAndForwardIndices) {
     EXPECT_TRUE(contains(before.problem(), "refers before the first vertex (2 vertices read so far)")) << before.problem();
 }
 
-TEST(ObjIo, PolygonsAreSplitAsFans) {
-    const std::string cube = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
-                             "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
-    TempDir dir;
-    const MeshReadResult r = readMesh(dir.write("cube.obj", cube));
-    ASSERT_EQ(r.mesh.faces.size(), 12u);
-    EXPECT_EQ(r.mesh.faces[0], (Face{0, 3, 2}));
-    EXPECT_EQ(r.mesh.faces[1], (Face{0, 2, 1}));
-    EXPECT_TRUE(r.diagnostics.closed());
-    const MeshReadResult hexagon = readMesh(dir.write("hex.obj", "v 2 0 0\nv 1 2 0\nv -1 2 0\nv -2 0 0\nv -1 -2 0\nv 1 -2 0\nf 1 2 3 4 5 6\n"));
-    EXPECT_EQ(hexagon.mesh.faces.size(), 4u);
-}
-
 // Triangles of a planar polygon cover it exactly when each turns the polygon's way and their
 // areas add up to its area (a fan over a concave polygon has a triangle turned the other way).
 void expectExactCover(const TriMesh& mesh, double polygonArea) {
@@ -84,6 +71,30 @@ void expectExactCover(const TriMesh& mesh, double polygonArea) {
         area += 0.5 * n.z();
     }
     EXPECT_NEAR(area, polygonArea, 1e-12 * polygonArea);
+}
+
+TEST(ObjIo, PolygonsAreSplitAsFans) {
+    const std::string cube = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                             "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("cube.obj", cube));
+    ASSERT_EQ(r.mesh.faces.size(), 12u);
+    EXPECT_EQ(r.mesh.faces[0], (Face{0, 3, 2}));
+    EXPECT_EQ(r.mesh.faces[1], (Face{0, 2, 1}));
+    EXPECT_TRUE(r.diagnostics.closed());
+}
+
+TEST(ObjIo, ConvexPolygonsAreFansUnlessACornerIsOnAStraightEdge) {
+    TempDir dir;
+    const MeshReadResult hexagon = readMesh(dir.write("hex.obj", "v 2 0 0\nv 1 2 0\nv -1 2 0\nv -2 0 0\nv -1 -2 0\nv 1 -2 0\nf 1 2 3 4 5 6\n"));
+    EXPECT_EQ(hexagon.mesh.faces.size(), 4u);
+    expectExactCover(hexagon.mesh, 12.0);
+    // A square with a corner in the middle of an edge (a T-junction): a fan from the first corner
+    // would make a flat triangle; strict reading accepts it whole.
+    const std::string square = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nf 1 2 3 4 5\n";
+    const MeshReadResult t = readMesh(dir.write("t.obj", square), {.weldTolerance = std::nullopt, .repair = false});
+    EXPECT_EQ(t.mesh.faces.size(), 3u);
+    expectExactCover(t.mesh, 4.0);
 }
 
 TEST(ObjIo, ConcavePolygonsAreClippedByEars) {
@@ -109,6 +120,8 @@ TEST(ObjIo, RepeatedPositionsAreWeldedAsTheFormatsWelding) {
     const MeshReadResult r = readMesh(dir.write("square.obj", text));
     EXPECT_EQ(r.mesh.vertices.size(), 4u);
     EXPECT_EQ(r.weldedVertices, 2u);
+    ASSERT_FALSE(r.diagnostics.warnings.empty());
+    EXPECT_TRUE(contains(r.diagnostics.warnings[0], "2 vertices repeat an earlier one's position")) << r.diagnostics.warnings[0];
     EXPECT_EQ(r.mesh.faces[1], (Face{0, 2, 3}));
     EXPECT_EQ(r.mesh.vertices[3], Vec3(0, 1, 0));
 }
@@ -138,9 +151,11 @@ TEST(ObjIo, ProblemsNameTheirLine) {
         EXPECT_EQ(e.line(), c.line) << c.text << e.what();
         EXPECT_TRUE(contains(e.problem(), c.problem)) << c.text << e.what();
     }
-    // Strict: a degenerate face is refused at its line (repaired by default).
-    const InputError strict = readError("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 4\n# flat\nf 1 2 3\n", {.weldTolerance = std::nullopt, .repair = false});
-    EXPECT_EQ(strict.line(), 7u) << strict.what();
+    // Strict: a degenerate face is refused at its line (repaired by default), after a quad split
+    // in two triangles (each keeps the quad's line).
+    const InputError strict = readError("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 5 4\n# flat\nf 1 2 3\n",
+                                        {.weldTolerance = std::nullopt, .repair = false});
+    EXPECT_EQ(strict.line(), 8u) << strict.what();
 }
 
 }  // namespace

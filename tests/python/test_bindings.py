@@ -472,3 +472,28 @@ def test_a_model_renumbered_for_locality_speaks_the_meshs_own_vertex_order():
     assert np.linalg.norm(b.positions[7] - vertices[7]) > 1e-5  # the load moved vertex 7
     with pytest.raises(flexfit.InputError, match="vertex_order"):
         flexfit.PartModel(mesh, vertex_order="sorted")
+
+
+def test_a_worlds_mass_calls_name_the_meshs_vertices_when_renumbered():
+    torus = flexfit.torus(3, 1, 24, 16)
+    shuffle = np.random.default_rng(6).permutation(len(torus.vertices))
+    vertices = np.empty_like(torus.vertices)
+    vertices[shuffle] = torus.vertices
+    mesh = flexfit.Mesh(vertices, shuffle[torus.faces], "shuffled")
+    parts = []
+    for order in ("locality", "as_given"):
+        world = flexfit.World(time_step=1e-3, gravity=[0, 0, 0])
+        model = flexfit.PartModel(mesh, springs=(0.1, 0.01), vertex_order=order)
+        body = world.add(model, mode="rigid-deformable", motion="static", restoration="none")
+        world.open_zone(body, 40, 1)
+        for _ in range(20):
+            world.apply_mass_force(body, 7, [0, 0.3, 0.1])
+            world.step()
+        world.kick_mass(body, 9, [0.2, 0, 0])
+        world.step()
+        parts.append((world, world.part(body)))
+    (wa, a), (wb, b) = parts
+    assert a.model.renumbered and not b.model.renumbered
+    np.testing.assert_allclose(a.positions, b.positions, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(a.zone_depths, b.zone_depths)
+    assert a.zone_depths[7] == 0 and a.zone_depths[9] >= 0  # zones at the loaded and kicked file vertices
