@@ -145,11 +145,13 @@ void stepRegionByFullModel(const PartModel& model, const SimulationSettings& set
 // `computedSprings` springs (`springsInWholeBlocks` of them in whole spring blocks,
 // ActiveRegion::fullBlocks) and `movingMasses` masses. A rule on counts alone, so every machine
 // chooses alike and a run's bits do not depend on the CPU: per spring, the region step costs
-// about 13 ns listed (in the order the zones grew: its ends and constants are random reads) and
-// 4.5 ns in whole blocks, the full step about 4 ns by spring blocks and 6 ns listed (in index
-// order), plus ~0.5 ns per mass put back (measured on this project's machine, AVX-512, torus2,
-// heart, shuffled heart); the rule asks the full step to be 10 % cheaper. On CPUs without AVX2
-// both steps run scalar, at 2-3 times these costs in about the same ratios.
+// about 11.5 ns listed (in the order the zones grew: its ends and constants are random reads)
+// and 2.9 ns in whole blocks, plus 2 ns per moving mass; the full step about 2.8 ns by spring
+// blocks and 5.8 ns listed (in index order), plus 0.3 ns per mass put back (fitted on this
+// project's machine, AVX-512, to both steps timed at 4-7 coverages on torus1, torus2, the heart,
+// the shuffled heart and the same renumbered for locality, 2026-12-03). The cheaper estimate
+// wins: near the crossover both cost the same. On CPUs without AVX2 both steps run scalar, at
+// 2-3 times these costs in about the same ratios.
 bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses,
                        std::size_t springsInWholeBlocks = 0);
 

@@ -44,12 +44,13 @@ void stepRegionByFullModel(const PartModel& model, const SimulationSettings& set
 bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses,
                        std::size_t springsInWholeBlocks) {
     // Costs in ns on the reference machine (simulation.hpp); only their ratios matter.
-    constexpr double kRegionSpring = 13.0, kRegionBlockSpring = 4.5, kRegionMass = 2.0;
-    constexpr double kBlockSpring = 4.0, kListedSpring = 6.0, kPutBack = 0.5;
-    // Switch only when clearly cheaper: near the crossover the two cost the same, and in a world
-    // the full step's streaming also evicts what the collision stages keep in cache (measured on
-    // the haptic scene, ~35 % of the springs: no difference either way).
-    constexpr double kMargin = 0.9;
+    constexpr double kRegionSpring = 11.5, kRegionBlockSpring = 2.9, kRegionMass = 2.0;
+    constexpr double kBlockSpring = 2.8, kListedSpring = 5.8, kPutBack = 0.3;
+    // No margin: near the crossover the two cost the same, and a margin towards the region step
+    // let a renumbered heart's zones at 66 % cost 1.13x its whole model. (In a world the full
+    // step's streaming also evicts what the collision stages keep in cache: measured on the
+    // haptic scene, ~35 % of the springs, no difference either way.)
+    constexpr double kMargin = 1.0;
     const double region = kRegionSpring * double(computedSprings - springsInWholeBlocks) +
                           kRegionBlockSpring * double(springsInWholeBlocks) + kRegionMass * double(movingMasses);
     const std::size_t blocked = model.springBlocks->blockCount() * SpringBlocks::kWidth;

@@ -160,7 +160,7 @@ TEST(RegionStep, ByTheFullModelHoldsInTheIntegrationPassBitForBit) {
 }
 
 // The rule on counts: by spring blocks the full step is chosen past about 35 % of the springs
-// when the region's springs are loose, past about 85 % when they fill whole blocks; with every
+// when the region's springs are loose, past about 80 % when they fill whole blocks; with every
 // spring listed (no blocks) past about 50 % (simulation.hpp).
 TEST(RegionStep, TheFullStepIsChosenWhenItCostsLess) {
     const auto blocks = buildPartModel(makeHeart());
@@ -174,7 +174,7 @@ TEST(RegionStep, TheFullStepIsChosenWhenItCostsLess) {
     EXPECT_FALSE(fullStepCostsLess(*blocks, share(0.2), massShare(0.2)));
     EXPECT_TRUE(fullStepCostsLess(*blocks, share(0.4), massShare(0.4)));
     EXPECT_FALSE(fullStepCostsLess(*blocks, share(0.4), massShare(0.4), share(0.4)));
-    EXPECT_FALSE(fullStepCostsLess(*blocks, share(0.7), massShare(0.7), share(0.65)));
+    EXPECT_FALSE(fullStepCostsLess(*blocks, share(0.6), massShare(0.6), share(0.55)));  // measured: 58 against 66 us
     EXPECT_TRUE(fullStepCostsLess(*blocks, share(0.9), massShare(0.9), share(0.85)));
     EXPECT_FALSE(fullStepCostsLess(*listed, share(0.4), massShare(0.4)));
     EXPECT_TRUE(fullStepCostsLess(*listed, share(0.55), massShare(0.55)));
