@@ -1,7 +1,6 @@
 #include "viewer_app.hpp"
 
 #include "gl.hpp"
-#include "flexfit/surface_embedding.hpp"
 
 #include <GLFW/glfw3.h>
 #include <backends/imgui_impl_glfw.h>
@@ -482,15 +481,7 @@ void App::applySettingsAndRestart() {
     const Material materials[] = {Material::rigid(), Material::elastic(), Material::superelastic()};
     for (ScenePart& part : scene.parts) {
         if (part.part.mode == PartMode::Rigid) continue;
-        // Rebuilt from the mesh as given, its masses in its order, renumbered as before and with
-        // its drawn mesh: the scene's mass indices keep naming the same vertices.
-        const PartModel& old = *part.model;
-        PartModelSettings model;
-        model.material = materials[material_];
-        inVertexOrder<double>(old, old.mass, model.vertexMasses);
-        model.vertexOrder = old.renumbered() ? VertexOrder::Locality : VertexOrder::AsGiven;
-        if (old.drawn) model.drawnMesh = old.drawn->mesh;
-        part.model = buildPartModel(old.givenMesh ? *old.givenMesh : old.mesh, model);
+        part.model = withMaterial(*part.model, materials[material_]);
         part.part.simulation.restoration.method = restorationAt(restoration_);
         part.part.zones.contactLevel = contactLevel_;
     }

@@ -185,6 +185,15 @@ void showPart(const Part& part, const std::vector<Vec3>& massNormals, const std:
     for (std::size_t v = 0; v < out.colours.size(); ++v) out.colours[v] = massColours[drawn->nearestMass[v]];
 }
 
+std::shared_ptr<const PartModel> withMaterial(const PartModel& old, const Material& material) {
+    PartModelSettings settings;
+    settings.material = material;
+    inVertexOrder<double>(old, old.mass, settings.vertexMasses);
+    settings.vertexOrder = old.renumbered() ? VertexOrder::Locality : VertexOrder::AsGiven;
+    if (old.drawn) settings.drawnMesh = old.drawn->mesh;
+    return buildPartModel(old.givenMesh ? *old.givenMesh : old.mesh, settings);
+}
+
 std::span<const Index> MovedMasses::update(const Part& part) {
     const auto moving = part.movingMasses();
     moved_.assign(moving.begin(), moving.end());

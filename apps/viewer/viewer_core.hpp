@@ -124,8 +124,14 @@ struct ShownSurface {
     std::vector<Vec3> positions, normals, colours;
 };
 // `massNormals`: the simulated surface's normals (SurfaceNormals), used when the part has no
-// drawn mesh of its own.
+// drawn mesh of its own. A model whose masses are renumbered (VertexOrder::Locality) shows
+// them in its given mesh's vertex order, the order of drawnMesh()'s faces.
 void showPart(const Part& part, const std::vector<Vec3>& massNormals, const std::vector<Vec3>& massColours, ShownSurface& out);
+
+// The model a material change restarts a part with: the same mesh as given, its masses on the
+// same vertices, renumbered as before, its drawn mesh kept, so a scene's mass indices keep
+// naming the same vertices.
+std::shared_ptr<const PartModel> withMaterial(const PartModel& model, const Material& material);
 
 // A part's face hierarchy for drawing, kept in step with the part's shape by the viewer: the
 // world refits its own hierarchies only when a face query needs them (never for a part met

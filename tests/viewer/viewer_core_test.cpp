@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 using namespace flexfit;
@@ -141,6 +142,42 @@ TEST(ShowPart, ADrawnMeshIsWhatIsShown) {
     EXPECT_EQ(shown.positions, plain.state().positions);
     EXPECT_EQ(shown.normals, normals);
     EXPECT_EQ(shown.colours, massColours);
+}
+
+// A model renumbered for locality shows its masses in the given mesh's order: the shuffled
+// mesh's own vertices at rest, each in its own mass's colour; a material change (the viewer's
+// restart) keeps the renumbering, the masses on their vertices and the drawn mesh.
+TEST(ShowPart, ARenumberedModelShowsTheGivenMeshsOrder) {
+    const TriMesh torus = makeTorus(3.0, 1.0, 24, 16);
+    std::vector<Index> order(torus.vertices.size());
+    for (std::size_t v = 0; v < order.size(); ++v) order[v] = Index(v);
+    std::shuffle(order.begin(), order.end(), std::mt19937(4));
+    TriMesh shuffled = torus;
+    for (std::size_t v = 0; v < order.size(); ++v) shuffled.vertices[order[v]] = torus.vertices[v];
+    for (Face& f : shuffled.faces)
+        for (Index& v : f) v = order[v];
+    PartModelSettings settings;
+    settings.vertexOrder = VertexOrder::Locality;
+    for (std::size_t v = 0; v < order.size(); ++v) settings.vertexMasses.push_back(1.0 + 0.001 * double(v));
+    const auto model = buildPartModel(shuffled, settings);
+    ASSERT_TRUE(model->renumbered());
+    Part part(model);
+    std::vector<Vec3> massColours(model->massCount());
+    for (std::size_t m = 0; m < massColours.size(); ++m) massColours[m] = Vec3(double(m), 0.0, 0.0);
+    ShownSurface shown;
+    showPart(part, SurfaceNormals::computeAll(part), massColours, shown);
+    EXPECT_EQ(shown.positions, shuffled.vertices);
+    EXPECT_EQ(model->drawnMesh().faces, shuffled.faces);
+    for (Index v = 0; v < shown.colours.size(); ++v) EXPECT_EQ(shown.colours[v].x(), double(model->massOf(v)));
+
+    const auto restarted = withMaterial(*model, Material::superelastic());
+    EXPECT_EQ(restarted->massOfVertex, model->massOfVertex);
+    EXPECT_EQ(restarted->mass, model->mass);
+    EXPECT_EQ(restarted->stiffness.front(), Material::superelastic().stiffness);
+    EXPECT_EQ(restarted->drawnMesh().vertices, shuffled.vertices);
+    PartModelSettings drawn;
+    drawn.drawnMesh = makeIcoSphere(1.01, 2);
+    EXPECT_EQ(withMaterial(*buildPartModel(makeIcoSphere(1.0, 1), drawn), Material::rigid())->drawnMesh().vertices, drawn.drawnMesh.vertices);
 }
 
 TEST(Session, FixedStepWhateverTheFrameTimes) {
