@@ -111,10 +111,12 @@ bool clipEars(std::span<const Index> corners, const std::vector<Eigen::Vector2d>
     return true;
 }
 
-// Triangles of one polygon, in its winding; each tagged with the polygon's line.
-void triangulate(const std::vector<Vec3>& vertices, std::span<const Index> corners, std::vector<Face>& out) {
+// Triangles of one polygon, in its winding. False when it had to be split as a fan though it is
+// not convex (self-intersecting or flat: no ear left), which the reader reports.
+bool triangulate(const std::vector<Vec3>& vertices, std::span<const Index> corners, std::vector<Face>& out) {
     const auto fan = [&] {
         for (std::size_t k = 1; k + 1 < corners.size(); ++k) out.push_back({corners[0], corners[k], corners[k + 1]});
+        return true;
     };
     if (corners.size() == 3) return fan();
     const std::vector<Eigen::Vector2d> p = projected(vertices, corners);
@@ -123,10 +125,10 @@ void triangulate(const std::vector<Vec3>& vertices, std::span<const Index> corne
     for (std::size_t i = 0; i < p.size() && convex; ++i) convex = turn(p[i], p[(i + 1) % p.size()], p[(i + 2) % p.size()]) > 0.0;
     if (convex) return fan();
     const std::size_t before = out.size();
-    if (!clipEars(corners, p, out)) {
-        out.resize(before);
-        fan();
-    }
+    if (clipEars(corners, p, out)) return true;
+    out.resize(before);
+    fan();
+    return false;
 }
 
 }  // namespace
@@ -157,6 +159,7 @@ MeshReadResult parseObj(std::string_view text, const std::string& source, const 
     if (mesh.vertices.size() > std::numeric_limits<Index>::max())
         throw InputError(source, 0, std::to_string(mesh.vertices.size()) + " vertices exceed the supported maximum");
     std::vector<Index> corners;
+    std::size_t fanned = 0;
     for (const RawPolygon& polygon : polygons) {
         corners.clear();
         for (const std::int64_t c : polygon.corners) {
@@ -165,7 +168,7 @@ MeshReadResult parseObj(std::string_view text, const std::string& source, const 
                                                            std::to_string(mesh.vertices.size()) + " vertices)");
             corners.push_back(Index(c));
         }
-        triangulate(mesh.vertices, corners, mesh.faces);
+        if (!triangulate(mesh.vertices, corners, mesh.faces)) ++fanned;
         lines.faceLine.resize(mesh.faces.size(), polygon.line);
     }
     if (mesh.faces.empty()) throw InputError(source, 0, "empty mesh: no triangles");
@@ -175,6 +178,10 @@ MeshReadResult parseObj(std::string_view text, const std::string& source, const 
     std::size_t repeats = 0;
     for (std::size_t v = 0; v < target.size(); ++v) repeats += target[v] != v ? 1 : 0;
     MeshReadResult result = finishRead(std::move(mesh), source, lines, options, repeats > 0);
+    if (fanned > 0)
+        result.diagnostics.warnings.insert(result.diagnostics.warnings.begin(),
+                                           std::to_string(fanned) + " polygons cross themselves (or are flat) and were split as fans: "
+                                           "their triangles may overlap");
     if (repeats > 0)
         result.diagnostics.warnings.insert(result.diagnostics.warnings.begin(),
                                            std::to_string(repeats) + " vertices repeat an earlier one's position (split normals or "

@@ -1,15 +1,24 @@
 #include "model/vertex_order.hpp"
 
 #include <algorithm>
+#include <cstdint>
 
 namespace flexfit::detail {
 namespace {
 
+// Scratch for oneRing: per-vertex marks stamped with a counter, so a query costs O(valence log
+// valence) however large the valence (a fan-triangulated cap meets one vertex in every face).
+struct RingScratch {
+    std::vector<std::pair<Index, Index>> turns;
+    std::vector<std::uint32_t> reachedMark, inRingMark;  // (V)
+    std::uint32_t stamp = 0;
+};
+
 // v's neighbours in the turning order of its faces (a -> b for each face (v, a, b) as wound),
 // starting at a boundary neighbour when v has one; neighbours off that cycle follow in index
 // order.
-void oneRing(const Topology& topology, std::span<const Face> faces, Index v, std::vector<std::pair<Index, Index>>& turns,
-             std::vector<Index>& ring) {
+void oneRing(const Topology& topology, std::span<const Face> faces, Index v, RingScratch& s, std::vector<Index>& ring) {
+    std::vector<std::pair<Index, Index>>& turns = s.turns;
     turns.clear();
     for (Index f : topology.facesOf(v)) {
         const Face& face = faces[f];
@@ -23,23 +32,23 @@ void oneRing(const Topology& topology, std::span<const Face> faces, Index v, std
     };
     ring.clear();
     if (turns.empty()) return;
+    const std::uint32_t stamp = ++s.stamp;
+    for (const auto& t : turns) s.reachedMark[t.second] = stamp;
     Index start = turns.front().first;
-    for (const auto& [a, b] : turns) {  // a neighbour no turn reaches starts an open fan
-        const bool reached = std::any_of(turns.begin(), turns.end(), [&](const auto& t) { return t.second == a; });
-        if (!reached) {
-            start = a;
+    for (const auto& t : turns)  // a neighbour no turn reaches starts an open fan
+        if (s.reachedMark[t.first] != stamp) {
+            start = t.first;
             break;
         }
-    }
-    for (Index a = start; ring.size() <= turns.size();) {
-        if (std::find(ring.begin(), ring.end(), a) != ring.end()) break;
+    for (Index a = start; s.inRingMark[a] != stamp;) {
+        s.inRingMark[a] = stamp;
         ring.push_back(a);
         const Index* next = nextOf(a);
         if (next == nullptr) break;
         a = *next;
     }
     for (Index w : topology.neighborsOf(v))
-        if (std::find(ring.begin(), ring.end(), w) == ring.end()) ring.push_back(w);
+        if (s.inRingMark[w] != stamp) s.inRingMark[w] = stamp, ring.push_back(w);
 }
 
 // The vertex a breadth-first search from `start` reaches last (in start's component).
@@ -59,7 +68,9 @@ std::vector<Index> localityOrder(const Topology& topology, std::span<const Face>
     const std::size_t n = topology.vertexCount;
     std::vector<char> seen(n, 0);
     std::vector<Index> order, queue, ring;
-    std::vector<std::pair<Index, Index>> turns;
+    RingScratch scratch;
+    scratch.reachedMark.assign(n, 0);
+    scratch.inRingMark.assign(n, 0);
     order.reserve(n);
     for (Index lowest = 0; lowest < n; ++lowest) {
         if (seen[lowest]) continue;
@@ -67,7 +78,7 @@ std::vector<Index> localityOrder(const Topology& topology, std::span<const Face>
         seen[start] = 1;
         order.push_back(start);
         for (std::size_t head = order.size() - 1; head < order.size(); ++head) {
-            oneRing(topology, faces, order[head], turns, ring);
+            oneRing(topology, faces, order[head], scratch, ring);
             const std::size_t k = ring.size();
             std::size_t first = 0;  // just after the visited run, so fronts keep turning one way
             for (std::size_t i = 0; i < k; ++i)

@@ -113,6 +113,14 @@ TEST(ObjIo, ConcavePolygonsAreClippedByEars) {
     EXPECT_EQ(k.diagnostics.nonManifoldEdges, 0u);
 }
 
+TEST(ObjIo, ASelfIntersectingPolygonIsFannedWithAWarning) {
+    // A bow tie drawn as one quad: its two halves turn opposite ways, so no ear can be clipped.
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("bow.obj", "v 0 0 0\nv 2 2 0\nv 2 0 0\nv 0 2 0\nv 1 1 5\nf 1 2 3 4\nf 1 3 5\n"));
+    ASSERT_FALSE(r.diagnostics.warnings.empty());
+    EXPECT_TRUE(contains(r.diagnostics.warnings[0], "1 polygons cross themselves")) << r.diagnostics.warnings[0];
+}
+
 TEST(ObjIo, RepeatedPositionsAreWeldedAsTheFormatsWelding) {
     // A square of two triangles, its diagonal's ends written twice (a split-normal export).
     const std::string text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 4 5 6\n";
