@@ -45,11 +45,9 @@ py::array_t<double> vec3Copy(const std::vector<Vec3>& v) {
     return a;
 }
 
-// Python speaks the given mesh's vertex indices: a model renumbered for locality
-// (PartModel::massOfVertex) translates them to masses here; an index out of range passes
-// through for the C++ call to refuse.
-Index massOfVertex(const PartModel& model, Index vertex) { return vertex < model.massCount() ? model.massOf(vertex) : vertex; }
-
+// Python speaks the given mesh's vertex indices: a model renumbered for locality translates
+// them to masses here (PartModel::massOf; an index out of range passes through for the C++ call
+// to refuse).
 // Per-mass rows in the given mesh's vertex order: a read-only view of the state when the model
 // keeps that order, else a read-only copy.
 py::array vertexRows(const PartModel& model, const std::vector<Vec3>& perMass, py::handle owner) {
@@ -62,7 +60,7 @@ py::array vertexRows(const PartModel& model, const std::vector<Vec3>& perMass, p
 }
 
 // The same for a world's body; an unknown body passes through for the C++ call to refuse.
-Index massOfBody(const World& w, BodyId id, Index vertex) { return id < w.bodyCount() ? massOfVertex(w.part(id).model(), vertex) : vertex; }
+Index massOfBody(const World& w, BodyId id, Index vertex) { return id < w.bodyCount() ? w.part(id).model().massOf(vertex) : vertex; }
 
 template <class Enum>
 Enum enumFrom(const std::string& text, const char* what) {
@@ -441,11 +439,11 @@ PYBIND11_MODULE(_flexfit, m) {
              py::arg("model"),
              "A part stepped on its own (without a world). Settings as keywords named as the scene file's [[part]] keys "
              "(mode='rigid-deformable', restoration, anchor_stiffness, global_damping, integrator, contact_level, ...) and time_step.")
-        .def("open_zone", [](Part& p, Index mass, int level) { return p.openZone(ZoneSeed::mass(massOfVertex(p.model(), mass)), level); }, py::arg("mass"), py::arg("level"),
+        .def("open_zone", [](Part& p, Index mass, int level) { return p.openZone(ZoneSeed::mass(p.model().massOf(mass)), level); }, py::arg("mass"), py::arg("level"),
              "Opens a zone of `level` rings around a mass; returns its id.")
-        .def("apply_force", [](Part& p, Index mass, const Vec3& force) { p.applyForce(massOfVertex(p.model(), mass), force); }, py::arg("mass"), py::arg("force"),
+        .def("apply_force", [](Part& p, Index mass, const Vec3& force) { p.applyForce(p.model().massOf(mass), force); }, py::arg("mass"), py::arg("force"),
              "A world-frame force on one mass for the next step.")
-        .def("kick_mass", [](Part& p, Index mass, const Vec3& change) { p.kickMass(massOfVertex(p.model(), mass), change); }, py::arg("mass"),
+        .def("kick_mass", [](Part& p, Index mass, const Vec3& change) { p.kickMass(p.model().massOf(mass), change); }, py::arg("mass"),
              py::arg("velocity_change"), "A velocity change on one mass, now.")
         .def("step", [](Part& p) {
             py::gil_scoped_release release;

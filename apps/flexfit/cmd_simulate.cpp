@@ -71,7 +71,7 @@ void run(const SimulateOptions& opt) {
     modelSettings.vertexOrder = opt.vertexOrder == "locality" ? VertexOrder::Locality : VertexOrder::AsGiven;
     config.model = buildPartModel(read.mesh, modelSettings);
     // MASS arguments name the file's vertices; the model's masses may be renumbered.
-    const auto massOf = [&](Index vertex) { return vertex < config.model->massCount() ? config.model->massOf(vertex) : vertex; };
+    const auto massOf = [&](Index vertex) { return config.model->massOf(vertex); };
     config.part.simulation = opt.sim.simulationSettings(*config.model);
     config.part.mode = enumOption<PartMode>(opt.mode, "option --mode");
     config.part.zones.defaultLevel = opt.defaultLevel;

@@ -136,7 +136,8 @@ struct PartModel {
     std::vector<Index> vertexOfMass;  // (V or 0)
     std::shared_ptr<const TriMesh> givenMesh;
     bool renumbered() const { return !massOfVertex.empty(); }
-    Index massOf(Index vertex) const { return renumbered() ? massOfVertex[vertex] : vertex; }
+    // An index out of range passes through unchanged, for the call it goes to to refuse.
+    Index massOf(Index vertex) const { return renumbered() && vertex < massOfVertex.size() ? massOfVertex[vertex] : vertex; }
     Index vertexOf(Index m) const { return renumbered() ? vertexOfMass[m] : m; }
 
     std::size_t massCount() const { return mass.size(); }

@@ -15,9 +15,7 @@ namespace {
 // A scene's mass index names the given mesh's vertex (PartModel::massOf); one out of range (a
 // scene built in code) passes through for the world to refuse.
 Index massOfVertexOf(const World& world, BodyId body, Index vertex) {
-    if (body >= world.bodyCount()) return vertex;
-    const PartModel& model = world.part(body).model();
-    return vertex < model.massCount() ? model.massOf(vertex) : vertex;
+    return body < world.bodyCount() ? world.part(body).model().massOf(vertex) : vertex;
 }
 
 }  // namespace
