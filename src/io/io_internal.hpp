@@ -1,4 +1,5 @@
-// Internal to src/io: the assimp path behind readMesh(), and the steps every reader ends with.
+// Internal to src/io: the readers behind readMesh() (our own for .tri, OBJ and OFF; assimp for the
+// rest), and the steps every reader ends with.
 #pragma once
 
 #include "flexfit/mesh_io.hpp"
@@ -8,6 +9,20 @@ MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadO
 // OBJ in the file's vertex order (obj_io.cpp).
 MeshReadResult parseObj(std::string_view text, const std::string& source, const MeshReadOptions& options);
 MeshReadResult readObj(const std::filesystem::path& path, const MeshReadOptions& options);
+// OFF in the file's vertex order (off_io.cpp).
+MeshReadResult parseOff(std::string_view text, const std::string& source, const MeshReadOptions& options);
+MeshReadResult readOff(const std::filesystem::path& path, const MeshReadOptions& options);
+
+// The end of the polygon formats' readers (OBJ, OFF): a mesh with no triangle refused; positions
+// repeated exactly (split normals, texture seams, the seams of a model made of pieces) welded
+// as the format's welding (the rest keep the file's order and their lines); finishRead; a
+// warning for each, and for `fanned` polygons split as fans though not convex.
+MeshReadResult finishPolygonRead(TriMesh mesh, const std::string& source, const MeshSourceLines& lines, const MeshReadOptions& options,
+                                 std::size_t fanned);
+
+using TextMeshParser = MeshReadResult (*)(std::string_view text, const std::string& source, const MeshReadOptions& options);
+// A text file parsed by `parse`, the mesh named after the file's stem.
+MeshReadResult readTextMesh(const std::filesystem::path& path, const MeshReadOptions& options, TextMeshParser parse);
 
 // What every reader does with the mesh it parsed (`lines`: where its vertices and faces were,
 // when known): the asked-for welding (or the format's, `formatWelds`: identical positions),

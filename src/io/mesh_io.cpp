@@ -2,6 +2,7 @@
 #include "flexfit/mesh_io.hpp"
 #include "io_internal.hpp"
 #include "geometry/mesh_checks.hpp"
+#include "text_lines.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -40,6 +41,39 @@ void requireNoCollapse(const TriMesh& mesh, double tolerance, const std::string&
 
 }  // namespace
 
+namespace {
+
+std::size_t repeatedPositions(const std::vector<Vec3>& vertices) {
+    const std::vector<Index> target = weldTargets(vertices, 0.0);
+    std::size_t repeats = 0;
+    for (std::size_t v = 0; v < target.size(); ++v) repeats += target[v] != v ? 1 : 0;
+    return repeats;
+}
+
+}  // namespace
+
+MeshReadResult finishPolygonRead(TriMesh mesh, const std::string& source, const MeshSourceLines& lines, const MeshReadOptions& options,
+                                 std::size_t fanned) {
+    if (mesh.faces.empty()) throw InputError(source, 0, "empty mesh: no triangles");
+    const std::size_t repeats = repeatedPositions(mesh.vertices);
+    MeshReadResult result = finishRead(std::move(mesh), source, lines, options, repeats > 0);
+    std::vector<std::string>& warnings = result.diagnostics.warnings;
+    if (fanned > 0)
+        warnings.insert(warnings.begin(), std::to_string(fanned) + " polygons cross themselves (or are flat) and were split as fans: "
+                                                                   "their triangles may overlap");
+    if (repeats > 0)
+        warnings.insert(warnings.begin(), std::to_string(repeats) + " vertices repeat an earlier one's position (split normals, texture "
+                                          "seams, the seams of a model made of pieces) and were welded into it: vertex indices (scene "
+                                          "masses, frames) are the welded mesh's, not the file's (flexfit convert writes that mesh)");
+    return result;
+}
+
+MeshReadResult readTextMesh(const std::filesystem::path& path, const MeshReadOptions& options, TextMeshParser parse) {
+    MeshReadResult result = parse(detail::readTextFile(path), path.string(), options);
+    result.mesh.name = path.stem().string();
+    return result;
+}
+
 MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSourceLines& lines, const MeshReadOptions& options,
                           bool formatWelds) {
     detail::requireWellFormed(mesh, source, lines);
@@ -73,6 +107,7 @@ MeshReadResult readMesh(const std::filesystem::path& path, const MeshReadOptions
     const std::string ext = lowerExtension(path);
     if (ext == ".tri") return readTri(path, options);
     if (ext == ".obj") return readObj(path, options);
+    if (ext == ".off") return readOff(path, options);
     return readWithAssimp(path, options);
 }
 

@@ -1,4 +1,4 @@
-// Tests readMesh on small hand-written files: through assimp (STL, PLY, OFF, glTF 2.0) and, for OBJ, through its own reader (obj_io_test.cpp tests it further), against hand-counted vertices/faces/edges after welding, the OBJ writer's round trip and the error contract.
+// Tests readMesh on small hand-written files: through assimp (STL, PLY, glTF 2.0) and, for OBJ and OFF, through their own readers (obj_io_test.cpp and off_io_test.cpp test them further), against hand-counted vertices/faces/edges after welding, the OBJ writer's round trip and the error contract.
 #include "flexfit/generators.hpp"
 #include "flexfit/mesh_io.hpp"
 
@@ -245,7 +245,7 @@ TEST(AssimpIo, AsciiPlyCubeOfQuads) {
     expectCubeResult(readMesh(dir.write("cube.ply", ply)));
 }
 
-TEST(AssimpIo, Off) {
+TEST(AssimpIo, OffByItsOwnReader) {
     TempDir dir;
     const std::string off =
         "OFF\n8 6 12\n"
@@ -254,7 +254,7 @@ TEST(AssimpIo, Off) {
     expectCubeResult(readMesh(dir.write("cube.off", off)));
 }
 
-TEST(AssimpIo, OffTetrahedron) {
+TEST(AssimpIo, OffTetrahedronByItsOwnReader) {
     TempDir dir;
     std::string off = "OFF\n4 4 6\n";
     for (const auto& v : kTetVertices) off += std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) + "\n";
@@ -392,9 +392,12 @@ TEST(AssimpIo, CoordinateBeyondSinglePrecision) {
     // build) reads it as infinity: the file is then rejected as holding a non-finite coordinate.
     // A double-precision assimp reads it. Either way: no crash, no half-built mesh.
     TempDir dir;
-    const fs::path file = dir.write("big.off", "OFF\n3 1 0\n0 0 0\n1e39 0 0\n0 1e39 0\n3 0 1 2\n");
-    // The OBJ reader reads doubles: there it is simply a large triangle.
+    const fs::path file = dir.write("big.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+                                               "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                               "0 0 0\n1e39 0 0\n0 1e39 0\n3 0 1 2\n");
+    // The OBJ and OFF readers read doubles: there it is simply a large triangle.
     EXPECT_EQ(boundingBox(readMesh(dir.write("big.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1e39 0\nf 1 2 3\n")).mesh).max().x(), 1e39);
+    EXPECT_EQ(boundingBox(readMesh(dir.write("big.off", "OFF\n3 1 0\n0 0 0\n1e39 0 0\n0 1e39 0\n3 0 1 2\n")).mesh).max().x(), 1e39);
     try {
         const MeshReadResult r = readMesh(file);
         ASSERT_EQ(r.mesh.vertices.size(), 3u);
