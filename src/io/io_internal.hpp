@@ -1,5 +1,5 @@
-// Internal to src/io: the readers behind readMesh() (our own for .tri, OBJ and OFF; assimp for the
-// rest), and the steps every reader ends with.
+// Internal to src/io: the readers behind readMesh() (our own for .tri, OBJ, OFF and PLY; assimp for
+// the rest), and the steps every reader ends with.
 #pragma once
 
 #include "flexfit/mesh_io.hpp"
@@ -12,6 +12,9 @@ MeshReadResult readObj(const std::filesystem::path& path, const MeshReadOptions&
 // OFF in the file's vertex order (off_io.cpp).
 MeshReadResult parseOff(std::string_view text, const std::string& source, const MeshReadOptions& options);
 MeshReadResult readOff(const std::filesystem::path& path, const MeshReadOptions& options);
+// PLY (ASCII and binary) in the file's vertex order (ply_io.cpp).
+MeshReadResult parsePly(std::string_view text, const std::string& source, const MeshReadOptions& options);
+MeshReadResult readPly(const std::filesystem::path& path, const MeshReadOptions& options);
 
 // The end of the polygon formats' readers (OBJ, OFF): a mesh with no triangle refused; positions
 // repeated exactly (split normals, texture seams, the seams of a model made of pieces) welded

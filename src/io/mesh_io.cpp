@@ -108,6 +108,7 @@ MeshReadResult readMesh(const std::filesystem::path& path, const MeshReadOptions
     if (ext == ".tri") return readTri(path, options);
     if (ext == ".obj") return readObj(path, options);
     if (ext == ".off") return readOff(path, options);
+    if (ext == ".ply") return readPly(path, options);
     return readWithAssimp(path, options);
 }
 

@@ -1,4 +1,4 @@
-// Tests readMesh on small hand-written files: through assimp (STL, PLY, glTF 2.0) and, for OBJ and OFF, through their own readers (obj_io_test.cpp and off_io_test.cpp test them further), against hand-counted vertices/faces/edges after welding, the OBJ writer's round trip and the error contract.
+// Tests readMesh on small hand-written files: through assimp (STL, glTF 2.0) and, for OBJ, OFF and PLY, through their own readers (obj_io_test.cpp, off_io_test.cpp and ply_io_test.cpp test them further), against hand-counted vertices/faces/edges after welding, the OBJ writer's round trip and the error contract.
 #include "flexfit/generators.hpp"
 #include "flexfit/mesh_io.hpp"
 
@@ -224,7 +224,7 @@ TEST(AssimpIo, BinaryStlTetrahedronIsWelded) {
     EXPECT_EQ(r.weldedVertices, 8u);
 }
 
-TEST(AssimpIo, AsciiPly) {
+TEST(AssimpIo, AsciiPlyByItsOwnReader) {
     TempDir dir;
     std::string ply =
         "ply\nformat ascii 1.0\ncomment tetrahedron\nelement vertex 4\n"
@@ -235,7 +235,7 @@ TEST(AssimpIo, AsciiPly) {
     expectTetrahedronResult(readMesh(dir.write("tet.ply", ply)));
 }
 
-TEST(AssimpIo, AsciiPlyCubeOfQuads) {
+TEST(AssimpIo, AsciiPlyCubeOfQuadsByItsOwnReader) {
     TempDir dir;
     const std::string ply =
         "ply\nformat ascii 1.0\nelement vertex 8\nproperty double x\nproperty double y\nproperty double z\n"
@@ -392,12 +392,14 @@ TEST(AssimpIo, CoordinateBeyondSinglePrecision) {
     // build) reads it as infinity: the file is then rejected as holding a non-finite coordinate.
     // A double-precision assimp reads it. Either way: no crash, no half-built mesh.
     TempDir dir;
-    const fs::path file = dir.write("big.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
-                                               "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                                               "0 0 0\n1e39 0 0\n0 1e39 0\n3 0 1 2\n");
-    // The OBJ and OFF readers read doubles: there it is simply a large triangle.
+    const fs::path file = dir.write("big.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1e39 0 0\n"
+                                               "vertex 0 1e39 0\nendloop\nendfacet\nendsolid t\n");
+    // The OBJ, OFF and PLY readers read doubles: there it is simply a large triangle.
     EXPECT_EQ(boundingBox(readMesh(dir.write("big.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1e39 0\nf 1 2 3\n")).mesh).max().x(), 1e39);
     EXPECT_EQ(boundingBox(readMesh(dir.write("big.off", "OFF\n3 1 0\n0 0 0\n1e39 0 0\n0 1e39 0\n3 0 1 2\n")).mesh).max().x(), 1e39);
+    EXPECT_EQ(boundingBox(readMesh(dir.write("big.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+                                                         "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                                         "0 0 0\n1e39 0 0\n0 1e39 0\n3 0 1 2\n")).mesh).max().x(), 1e39);
     try {
         const MeshReadResult r = readMesh(file);
         ASSERT_EQ(r.mesh.vertices.size(), 3u);

@@ -5,6 +5,7 @@
 #include "flexfit/generators.hpp"
 #include "flexfit/mesh_io.hpp"
 #include "shuffled_mesh.hpp"
+#include "mesh_read_error.hpp"
 #include "temp_dir.hpp"
 
 #include <gtest/gtest.h>
@@ -17,18 +18,9 @@ namespace {
 
 using testing::TempDir;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::contains;
 
-InputError readError(const std::string& text, const MeshReadOptions& options = {}) {
-    TempDir dir;
-    try {
-        readMesh(dir.write("m.obj", text), options);
-    } catch (const InputError& e) {
-        return e;
-    }
-    ADD_FAILURE() << "accepted:\n" << text;
-    return InputError("", 0, "");
-}
+InputError readError(const std::string& text, const MeshReadOptions& options = {}) { return testing::meshReadError("m.obj", text, options); }
 
 TEST(ObjIo, KeepsTheFilesVertexOrderAndEveryBit) {
     // A double mesh in no useful order, written with 17 digits: it reads back as it was.

@@ -5,7 +5,9 @@
 #include "flexfit/generators.hpp"
 #include "flexfit/mesh_io.hpp"
 #include "io/io_internal.hpp"
+#include "face_sets.hpp"
 #include "shuffled_mesh.hpp"
+#include "mesh_read_error.hpp"
 #include "temp_dir.hpp"
 
 #include <gtest/gtest.h>
@@ -23,28 +25,11 @@ namespace {
 
 using testing::TempDir;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
-
-InputError readError(const std::string& text) {
-    TempDir dir;
-    try {
-        readMesh(dir.write("m.off", text));
-    } catch (const InputError& e) {
-        return e;
-    }
-    ADD_FAILURE() << "accepted:\n" << text;
-    return InputError("", 0, "");
-}
+using testing::contains;
 
 std::string offText(const TriMesh& mesh) {
     std::string text = "OFF\n" + std::to_string(mesh.vertices.size()) + " " + std::to_string(mesh.faces.size()) + " 0\n";
-    char buffer[96];
-    for (const Vec3& v : mesh.vertices) {
-        std::snprintf(buffer, sizeof buffer, "%.17g %.17g %.17g\n", v.x(), v.y(), v.z());
-        text += buffer;
-    }
-    for (const Face& f : mesh.faces) text += "3 " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) + "\n";
-    return text;
+    return text + testing::vertexAndFaceLines(mesh);
 }
 
 const std::string kCubeVertices = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n";
@@ -125,40 +110,31 @@ TEST(OffIo, ConcavePolygonsAreClippedByEars) {
 }
 
 TEST(OffIo, ProblemsNameTheirLine) {
-    struct Case {
-        std::string text;
-        std::size_t line;
-        std::string problem;
-    };
     const std::string tri = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n";
-    for (const Case& c : std::vector<Case>{
-             {"", 0, "empty file"},
-             {"# nothing\n\n", 0, "empty file"},
-             {"ply\nformat ascii 1.0\n", 1, "not an OFF file"},
-             {"OFF BINARY\n", 1, "binary OFF"},
-             {"4OFF\n3 1 0\n", 1, "4D"},
-             {"nOFF 4\n3 1 0\n", 1, "only 3"},
-             {"OFF\n", 1, "ends before the vertex and face counts"},
-             {"OFF\n3\n", 2, "found one number"},
-             {"OFF\n-3 1 0\n", 2, "vertex count '-3'"},
-             {"OFF\n3 x 0\n", 2, "face count 'x'"},
-             {"OFF\n3 1 0\n0 0 0\n1 0 0\n", 4, "ends after 2 of its 3 vertices"},
-             {"OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n", 4, "a vertex needs 3 coordinates, found 2"},
-             {"OFF\n3 1 0\n0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n", 4, "coordinate 'zero' is not a number"},
-             {"OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n", 4, "NaN or infinite"},
-             {tri, 5, "ends after 0 of its 1 faces"},
-             {tri + "2 0 1\n", 6, "a face needs 3 corners, found 2"},
-             {tri + "4 0 1 2\n", 6, "has 4 corners but lists 3"},
-             {tri + "3 0 1 3\n", 6, "face corner 3 out of range"},
-             {tri + "3 0 -1 2\n", 6, "face corner -1 out of range"},
-             {tri + "3 0 1.5 2\n", 6, "face corner '1.5' is not a vertex index"},
-             {tri + "three 0 1 2\n", 6, "starts with its corner count"},
-             {tri + "3 0 1 2\n3 0 2 1\n", 7, "more data after the 3 vertices and 1 faces"},
-         }) {
-        const InputError e = readError(c.text);
-        EXPECT_EQ(e.line(), c.line) << c.text << "\n" << e.what();
-        EXPECT_TRUE(contains(e.problem(), c.problem)) << c.text << "\n" << e.what();
-    }
+    testing::expectReadErrors("m.off", {
+        {"", 0, "empty file"},
+        {"# nothing\n\n", 0, "empty file"},
+        {"ply\nformat ascii 1.0\n", 1, "not an OFF file"},
+        {"OFF BINARY\n", 1, "binary OFF"},
+        {"4OFF\n3 1 0\n", 1, "4D"},
+        {"nOFF 4\n3 1 0\n", 1, "only 3"},
+        {"OFF\n", 1, "ends before the vertex and face counts"},
+        {"OFF\n3\n", 2, "found one number"},
+        {"OFF\n-3 1 0\n", 2, "vertex count '-3'"},
+        {"OFF\n3 x 0\n", 2, "face count 'x'"},
+        {"OFF\n3 1 0\n0 0 0\n1 0 0\n", 4, "ends after 2 of its 3 vertices"},
+        {"OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n", 4, "a vertex needs 3 coordinates, found 2"},
+        {"OFF\n3 1 0\n0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n", 4, "coordinate 'zero' is not a number"},
+        {"OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n", 4, "NaN or infinite"},
+        {tri, 5, "ends after 0 of its 1 faces"},
+        {tri + "2 0 1\n", 6, "a face needs 3 corners, found 2"},
+        {tri + "4 0 1 2\n", 6, "has 4 corners but lists 3"},
+        {tri + "3 0 1 3\n", 6, "face corner 3 out of range"},
+        {tri + "3 0 -1 2\n", 6, "face corner -1 out of range"},
+        {tri + "3 0 1.5 2\n", 6, "face corner '1.5' is not a vertex index"},
+        {tri + "three 0 1 2\n", 6, "starts with its corner count"},
+        {tri + "3 0 1 2\n3 0 2 1\n", 7, "more data after the 3 vertices and 1 faces"},
+    });
 }
 
 TEST(OffIo, StrictReadingNamesTheDefectsLine) {
@@ -180,9 +156,7 @@ TEST(OffIo, StrictReadingNamesTheDefectsLine) {
 
 // Debian's assimp OFF test models (assimp-testmodels): the reader gives the file's vertices, in
 // its order and to the bit (compared with the file's lines read here with fscanf; positions the
-// file repeats welded into their first), and the same
-// triangles as assimp's importer once each of assimp's vertices (renumbered by first use, single
-// precision) is matched to the nearest of ours.
+// file repeats welded into their first), and the same triangles as assimp's importer.
 std::vector<Vec3> offVertices(const std::filesystem::path& file) {
     std::FILE* f = std::fopen(file.c_str(), "rb");
     char keyword[16];
@@ -192,16 +166,6 @@ std::vector<Vec3> offVertices(const std::filesystem::path& file) {
     for (Vec3& v : out) EXPECT_EQ(std::fscanf(f, "%lf %lf %lf", &v.x(), &v.y(), &v.z()), 3) << file;
     std::fclose(f);
     return out;
-}
-
-Index nearest(const std::vector<std::pair<Vec3, Index>>& byX, const Vec3& p) {
-    auto it = std::lower_bound(byX.begin(), byX.end(), p.x() - 1e-5, [](const auto& e, double x) { return e.first.x() < x; });
-    Index best = 0;
-    double bestDistance = std::numeric_limits<double>::infinity();
-    for (; it != byX.end() && it->first.x() <= p.x() + 1e-5; ++it)
-        if (const double d = (it->first - p).norm(); d < bestDistance) bestDistance = d, best = it->second;
-    EXPECT_LT(bestDistance, 1e-5) << "an assimp vertex far from every vertex of ours";
-    return best;
 }
 
 TEST(OffIo, DebiansTestModelsAsTheFileOrdersThem) {
@@ -221,23 +185,7 @@ TEST(OffIo, DebiansTestModelsAsTheFileOrdersThem) {
         EXPECT_EQ(ours.mesh.vertices, expected) << name;
         EXPECT_EQ(ours.weldedVertices, offVertices(file).size() - expected.size()) << name;
         const MeshReadResult theirs = readWithAssimp(file, exact);
-        std::vector<std::pair<Vec3, Index>> byX;
-        for (Index v = 0; v < ours.mesh.vertices.size(); ++v) byX.emplace_back(ours.mesh.vertices[v], v);
-        std::sort(byX.begin(), byX.end(), [](const auto& a, const auto& b) { return a.first.x() < b.first.x(); });
-        auto rotated = [](Face f) {
-            std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
-            return f;
-        };
-        std::map<Face, int> faces;
-        for (const Face& f : ours.mesh.faces) ++faces[rotated(f)];
-        for (const Face& f : theirs.mesh.faces) {
-            Face mapped;
-            for (int k = 0; k < 3; ++k) mapped[std::size_t(k)] = nearest(byX, theirs.mesh.vertices[f[std::size_t(k)]]);
-            --faces[rotated(mapped)];
-        }
-        int differing = 0;
-        for (const auto& entry : faces) differing += entry.second != 0 ? 1 : 0;
-        EXPECT_EQ(differing, 0) << name << ": faces only one reader has";
+        EXPECT_EQ(flexfit::testing::facesOnlyOneHas(ours.mesh, theirs.mesh), 0) << name << ": faces only one reader has";
         EXPECT_EQ(ours.mesh.faces.size(), theirs.mesh.faces.size()) << name;
     }
 }
