@@ -189,7 +189,12 @@ struct PairCoherence {
     std::uint32_t queriesSince = 0;        // queries answered from the list
     std::size_t testedAfterTraversal = 0;  // candidates tested by the query that took the list
     std::size_t scanCost = 0;              // candidates tested since beyond that many, summed
-    std::uint32_t plainQueriesLeft = 0;    // answered by plain traversals (outrun)
+    // Plain traversals answer while the motion would outrun any list: what the last of them saw.
+    bool plain = false;
+    RelativePose plainPose;
+    double plainDriftA = 0.0, plainDriftB = 0.0;
+    std::uint64_t plainGenerationA = 0, plainGenerationB = 0;
+    std::uint32_t plainQueries = 0;        // answered so since it began
     std::uint64_t traversals = 0;          // lists taken
 };
 
@@ -211,7 +216,10 @@ struct PairCoherence {
 // most half the margin) once the tests motion added have cost as much as a traversal (then it
 // is taken at once); within [1e-4, 0.05] of the smaller mean leaf size. A pair at rest never
 // traverses again. When the widest margin is outrun within 4 queries of a list's pose, plain
-// queryPair() calls answer the next 16.
+// queryPair() calls answer (at least the next 16) until the motion from one query to the next
+// (relative pose and both colliders' vertex drifts) is slow enough that a list of the widest
+// margin would last 8 queries: a tool sliding over a deforming part pays no lists it cannot
+// use, a pair that comes to rest gets them back within a query of the 16.
 // stats: volumeTests counts the traversal's nodes and the candidates tested; candidatePairs
 // the candidates whose leaves overlap now.
 void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,

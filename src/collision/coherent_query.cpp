@@ -25,11 +25,14 @@ constexpr double kMinMarginShare = 1e-4;
 constexpr double kMaxMarginShare = 0.05;
 constexpr double kScanBudget = 1.0;
 // When a list is outrun with the widest margin within kShortLived queries of its pose (a part
-// deforming fast), taking lists costs more than it saves: the next kPlainQueries queries are
-// plain traversals (measured: a tool pressed into a 60,000-face part whose zone moves every
-// step, 80 against 62 us a step without them).
+// deforming fast), taking lists costs more than it saves: at least the next kPlainQueries
+// queries are plain traversals (measured: a tool pressed into a 60,000-face part whose zone
+// moves every step, 80 against 62 us a step without them), and the following ones too while
+// the motion from query to query would outrun a list of the widest margin within
+// kSlowedQueries (twice kShortLived: no flapping at the edge).
 constexpr std::uint32_t kPlainQueries = 16;
 constexpr std::uint64_t kShortLived = 4;
+constexpr std::uint64_t kSlowedQueries = 2 * kShortLived;
 
 // B's leaves' growth as a ball metric: a box leaf within its earlier box grown by d along each
 // axis is within sqrt(3) d of it.
@@ -158,6 +161,28 @@ void scanCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const RelativePose
         c.scanCost += tested - std::min(tested, c.testedAfterTraversal);
 }
 
+void rememberPlainQuery(const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA, PairCoherence& c) {
+    c.plainPose = bInA;
+    c.plainDriftA = colliderA.vertexDrift();
+    c.plainDriftB = colliderB.vertexDrift();
+    c.plainGenerationA = colliderA.generation();
+    c.plainGenerationB = colliderB.generation();
+}
+
+// In plain traversals: whether this query is to be one as well (then remembered as the last):
+// for the first kPlainQueries, and after while the motion since the last one would outrun a
+// list of the widest margin within kSlowedQueries queries. A rebuilt hierarchy ends them.
+bool stillTooFast(const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA, PairCoherence& c) {
+    const bool rebuilt = c.plainGenerationA != colliderA.generation() || c.plainGenerationB != colliderB.generation();
+    const double step = rebuilt ? 0.0
+                                : relativeMotion(c.plainPose, bInA, colliderB.localSphere()) + colliderA.leafGrowth(colliderA.vertexDrift() - c.plainDriftA) +
+                                      ballGrowth(colliderB, colliderB.vertexDrift() - c.plainDriftB);
+    ++c.plainQueries;
+    c.plain = !rebuilt && (c.plainQueries < kPlainQueries || step * double(kSlowedQueries) > maxMargin(colliderA, colliderB));
+    if (c.plain) rememberPlainQuery(colliderA, colliderB, bInA, c);
+    return c.plain;
+}
+
 // The next list's walk: started at kWalkStart of the margin, 1 / kWalkShare of the last
 // traversal's node pairs a query (at least kMinWalkNodes).
 constexpr double kWalkStart = 0.25;
@@ -176,18 +201,17 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
                        const PartCollider& colliderB, ExactTest test, PairCoherence& c, std::vector<Contact>& contacts,
                        QueryStats& stats) {
     requireBuiltFor(colliderA, colliderB, test);
-    if (c.plainQueriesLeft > 0) {
-        --c.plainQueriesLeft;
-        return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
-    }
     const RelativePose bInA = relativePose(a, b);
+    if (c.plain && stillTooFast(colliderA, colliderB, bInA, c)) return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
     Coverage now = c.valid ? coverageOf(colliderA, colliderB, bInA, c.list) : Coverage{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
     const bool outrun = !(now.slack() <= c.list.margin);
     ++c.queries;
     // Outrun with the widest margin by the motion of a few queries since the list's pose.
     if (outrun && c.valid && c.queries - c.list.startQuery <= kShortLived && c.list.margin >= maxMargin(colliderA, colliderB)) {
-        c.valid = c.walking = false;  // the motion outruns the widest margin: plain traversals for a while
-        c.plainQueriesLeft = kPlainQueries;
+        c.valid = c.walking = false;  // the motion outruns the widest margin: plain traversals while it does
+        c.plain = true;
+        c.plainQueries = 0;
+        rememberPlainQuery(colliderA, colliderB, bInA, c);
         return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
     }
     dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) {

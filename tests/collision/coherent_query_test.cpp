@@ -195,6 +195,34 @@ TEST(CoherentQueryCost, APairAtRestStopsTraversing) {
     EXPECT_LT(coherentStats.volumeTests * 5, fullStats.volumeTests) << coherentStats.volumeTests << " vs " << fullStats.volumeTests;
 }
 
+TEST(CoherentQueryCost, MotionThatOutrunsEveryListIsAnsweredByPlainQueriesUntilItSlows) {
+    // A ball jumping about a tube (0.3 a step, far beyond the widest margin): the first list it
+    // takes is outrun at once, and plain queries answer from then on, a list tried only where a
+    // step happens to be short (a fixed 16 plain queries would try one every 17 queries). Then it
+    // stops: 16 queries on, lists again, and the pair at rest traverses no more. Every answer
+    // is the full query's.
+    std::mt19937 rng(3);
+    Part torus(buildPartModel(makeTorus(3.0, 1.0, 24, 12)), rigidPart());
+    Part ball(buildPartModel(makeIcoSphere(1.0, 1)), rigidPart());
+    ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(3.0, 1.6, 0.0)});
+    PairRun run(torus, ball, {BoundingVolumeKind::Aabb, ExactTest::TriangleTriangle});
+    int step = 0;
+    for (; step < 130; ++step) {
+        Pose next = nudged(ball.pose(), rng, 0.3, 0.0);
+        next.translation += 0.5 * (Vec3(3.0, 1.6, 0.0) - next.translation);
+        ball.setPose(next);
+        run.check(step, false);
+    }
+    EXPECT_TRUE(run.coherence.plain);
+    EXPECT_LE(run.coherence.traversals, 4u) << "lists taken while every one is outrun at once (16 plain queries each: 8)";
+    for (int rest = 0; rest < 17; ++rest, ++step) run.check(step, false);
+    EXPECT_FALSE(run.coherence.plain) << "at rest, the plain queries end after their 16";
+    EXPECT_TRUE(run.coherence.valid);
+    const std::uint64_t settled = run.coherence.traversals;
+    for (int rest = 0; rest < 50; ++rest, ++step) run.check(step, false);
+    EXPECT_EQ(run.coherence.traversals, settled);
+}
+
 TEST(CoherentQueryCost, ARebuiltHierarchyIsTraversedAgain) {
     Part torus(buildPartModel(makeTorus(3.0, 1.0, 32, 16)));
     Part ball(buildPartModel(makeIcoSphere(1.0, 2)), rigidPart());
