@@ -4,8 +4,8 @@
 // mass 574.)
 //
 // Read (Geomview's OFF, one record per line): an optional header keyword `[ST][C][N]OFF`,
-// or `nOFF` followed by the dimension 3; the counts `vertices faces [edges]` (on the header
-// line or the next); one vertex per line, `x y z` and whatever the keyword's prefixes add
+// or `nOFF` followed by the dimension 3 (ModelNet's `OFF490 518 0` too); the counts
+// `vertices faces [edges]` (on the header line, the next, or split over two); one vertex per line, `x y z` and whatever the keyword's prefixes add
 // (texture coordinates, colour, normal: ignored); one face per line, `n i_1 ... i_n` with
 // 0-based indices and an optional colour after them (ignored). Polygons are triangulated as the
 // OBJ reader does. `#` starts a comment. Refused, each with its line: binary OFF, 4D and other
@@ -68,6 +68,12 @@ bool isHeader(std::string_view token) {
 std::vector<std::string_view> headerAndCounts(detail::LineCursor& cursor, detail::TextLine& line, const std::string& source) {
     if (!nextRecord(cursor, line)) throw InputError(source, 0, "empty file");
     std::vector<std::string_view> rest = line.tokens;
+    // ModelNet's files run the keyword into the vertex count: `OFF490 518 0`.
+    if (const std::size_t digits = rest[0].find_first_of("0123456789"); digits != std::string_view::npos && digits > 0 &&
+                                                                          isHeader(rest[0].substr(0, digits))) {
+        rest.insert(rest.begin() + 1, rest[0].substr(digits));
+        rest[0] = rest[0].substr(0, digits);
+    }
     if (!isHeader(rest[0])) {
         if (!integer(rest[0])) throw InputError(source, line.number, "not an OFF file: it starts with " + quoted(rest[0]) + ", not OFF");
         return rest;  // no keyword: the counts come first
@@ -97,7 +103,8 @@ std::vector<std::string_view> headerAndCounts(detail::LineCursor& cursor, detail
 MeshReadResult parseOff(std::string_view text, const std::string& source, const MeshReadOptions& options) {
     detail::LineCursor cursor(text);
     detail::TextLine line;
-    const std::vector<std::string_view> counts = headerAndCounts(cursor, line, source);
+    std::vector<std::string_view> counts = headerAndCounts(cursor, line, source);
+    if (counts.size() < 2 && nextRecord(cursor, line)) counts.insert(counts.end(), line.tokens.begin(), line.tokens.end());  // split over lines
     if (counts.size() < 2) throw InputError(source, line.number, "expected the vertex and face counts, found one number");
     const std::int64_t vertexCount = count(counts[0], "vertex", source, line.number);
     const std::int64_t faceCount = count(counts[1], "face", source, line.number);

@@ -125,7 +125,10 @@ PlyHeader readHeader(std::string_view text, const std::string& source) {
             formatSeen = true;
         } else if (keyword == "element") {
             std::int64_t count = -1;
-            if (tokens.size() == 3) std::from_chars(tokens[2].data(), tokens[2].data() + tokens[2].size(), count);
+            if (tokens.size() == 3) {
+                const auto [stop, ec] = std::from_chars(tokens[2].data(), tokens[2].data() + tokens[2].size(), count);
+                if (ec != std::errc() || stop != tokens[2].data() + tokens[2].size()) count = -1;
+            }
             if (tokens.size() != 3 || count < 0) throw InputError(source, line, "an element line is 'element <name> <count>', the count an integer >= 0");
             header.elements.push_back({std::string(tokens[1]), count, {}});
         } else if (keyword == "property") {
@@ -158,9 +161,11 @@ PlyHeader readHeader(std::string_view text, const std::string& source) {
 void locateMesh(PlyHeader& header, const std::string& source) {
     PlyElement* vertex = nullptr;
     PlyElement* face = nullptr;
+    PlyElement* unused = nullptr;
     for (PlyElement& e : header.elements) {
-        if (e.name == "vertex") vertex = &e;
-        if (e.name == "face") face = &e;
+        PlyElement*& slot = e.name == "vertex" ? vertex : e.name == "face" ? face : unused;
+        if (&slot != &unused && slot != nullptr) throw InputError(source, 0, "two '" + e.name + "' elements: one of each is read");
+        slot = &e;
     }
     if (vertex == nullptr) throw InputError(source, 0, "no vertex element");
     vertex->x = propertyIndex(*vertex, {"x"});
@@ -251,7 +256,7 @@ public:
     void requireEnd() {
         if (format_ == PlyFormat::Ascii) {
             if (cursor_.next(line_)) throw InputError(source_, line_.number + headerLines_, "more data after the last element");
-        } else if (offset_ < text_.size()) {
+        } else if (text_.find_first_not_of(" \t\r\n", offset_) != std::string_view::npos) {  // an end of line is allowed
             throw InputError(source_, 0, std::to_string(text_.size() - offset_) + " bytes after the last element");
         }
     }
@@ -363,6 +368,7 @@ MeshReadResult parsePly(std::string_view text, const std::string& source, const 
     };
     std::vector<Polygon> polygons;
     for (const PlyElement& e : header.elements) {
+        if (e.properties.empty()) continue;  // its instances take no bytes, no values
         for (std::int64_t i = 0; i < e.count; ++i) {
             if (!in.start(e, i))
                 throw InputError(source, in.lastLine(),

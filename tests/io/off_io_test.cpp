@@ -84,6 +84,8 @@ TEST(OffIo, HeaderVariantsCommentsColoursAndNormals) {
     expectCube(readMesh(dir.write("b.off", "OFF 8 6 0\n" + kCubeVertices + kCubeFaces)));            // counts on the header line
     expectCube(readMesh(dir.write("c.off", "8 6 0\n" + kCubeVertices + kCubeFaces)));                // no keyword
     expectCube(readMesh(dir.write("d.off", "nOFF 3\n8 6\n" + kCubeVertices + kCubeFaces)));          // dimension given
+    expectCube(readMesh(dir.write("g.off", "OFF8 6 0\n" + kCubeVertices + kCubeFaces)));             // ModelNet's keyword run into the count
+    expectCube(readMesh(dir.write("h.off", "OFF\n8\n6 0\n" + kCubeVertices + kCubeFaces)));          // counts over two lines
     expectCube(readMesh(dir.write("e.off", "# made by hand\n\nOFF # header\n# counts next\n8 6 0\n" + kCubeVertices + kCubeFaces +
                                                "# the end\n")));
     // COFF / NOFF / STCNOFF vertices carry colours, normals, texture coordinates; faces a colour.

@@ -109,6 +109,17 @@ TEST(PlyIo, EveryScalarTypeAndElementsInAnyOrder) {
     EXPECT_TRUE(r.diagnostics.closed());
 }
 
+TEST(PlyIo, ElementsWithoutPropertiesAndAFinalEndOfLine) {
+    // An element of no properties (its instances take no bytes) before the vertices, however
+    // many it declares, and an end of line after the binary data: read as if absent.
+    const TriMesh mesh = makeIcoSphere(1.0, 0);
+    std::string text = binaryPly(mesh, false);
+    text.insert(text.find("element vertex"), "element marker 1000000000000000000\n");
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("m.ply", text + "\n"));
+    EXPECT_EQ(r.mesh.vertices, mesh.vertices);
+}
+
 TEST(PlyIo, FloatCoordinatesAreTheFloatsValues) {
     TempDir dir;
     std::string text = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
@@ -143,6 +154,9 @@ TEST(PlyIo, ProblemsNameTheirLine) {
         {"ply\nformat ascii 1.0\nelement vertex 3\nproperty real x\nend_header\n", 4, "unknown property type 'real'"},
         {"ply\nformat ascii 1.0\nproperty float x\nend_header\n", 3, "property before any element"},
         {"ply\nformat ascii 1.0\nelement vertex -3\nend_header\n", 3, "integer >= 0"},
+        {"ply\nformat ascii 1.0\nelement vertex 1e6\nend_header\n", 3, "integer >= 0"},
+        {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement vertex 3\n"
+         "property float x\nproperty float y\nproperty float z\nend_header\n", 0, "two 'vertex' elements"},
         {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n", 4, "no end_header"},
         {"ply\nelement vertex 0\nend_header\n", 3, "no format line"},
         {"ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n3 0 1 2\n", 0, "no vertex element"},
