@@ -6,7 +6,7 @@
 // `i//n` or `i/t/n` (1-based; negative: relative to the last vertex read; positive indices may
 // refer forward), polygons of more than 3 corners triangulated in their own plane (Newell's
 // normal): a convex one as a fan from its first corner, a concave one by ear clipping (a
-// self-intersecting one, which has no proper triangulation, as a fan). Ignored: comments, texture
+// self-intersecting one, which has no proper triangulation, as a fan). Ignored: comments (`#` to the end of any line), texture
 // coordinates and normals, groups, objects, smoothing groups, materials. Refused: points and
 // lines (`p`, `l`) and free-form geometry, which cannot be triangulated.
 #include "flexfit/mesh_io.hpp"
@@ -70,6 +70,8 @@ MeshReadResult parseObj(std::string_view text, const std::string& source, const 
     MeshSourceLines lines;
     std::vector<RawPolygon> polygons;
     for (detail::TextLine line; cursor.next(line);) {
+        detail::cutComment(line);  // `f 1 2 3 # a note` is a face
+        if (line.tokens.empty()) continue;
         const std::string_view keyword = line.tokens[0];
         if (keyword == "v") {
             if (line.tokens.size() < 4)

@@ -30,13 +30,7 @@ using detail::quoted;
 // The next line with a token left once its comment is cut; false at the end of the file.
 bool nextRecord(detail::LineCursor& cursor, detail::TextLine& line) {
     while (cursor.next(line)) {
-        for (std::size_t i = 0; i < line.tokens.size(); ++i) {
-            const std::size_t hash = line.tokens[i].find('#');
-            if (hash == std::string_view::npos) continue;
-            line.tokens[i] = line.tokens[i].substr(0, hash);
-            line.tokens.resize(line.tokens[i].empty() ? i : i + 1);
-            break;
-        }
+        detail::cutComment(line);
         if (!line.tokens.empty()) return true;
     }
     return false;

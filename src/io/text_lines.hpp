@@ -1,4 +1,4 @@
-// Internal to src/io: line-by-line reading of text mesh formats (.tri, OBJ), with line numbers
+// Internal to src/io: line-by-line reading of text mesh formats (.tri, OBJ, OFF, PLY), with line numbers
 // for every error.
 #pragma once
 
@@ -68,6 +68,17 @@ private:
     std::size_t pos_ = 0;
     std::size_t lineNumber_ = 0;
 };
+
+// The line's tokens up to a `#` (the comment it starts, to the end of the line, dropped).
+inline void cutComment(TextLine& line) {
+    for (std::size_t i = 0; i < line.tokens.size(); ++i) {
+        const std::size_t hash = line.tokens[i].find('#');
+        if (hash == std::string_view::npos) continue;
+        line.tokens[i] = line.tokens[i].substr(0, hash);
+        line.tokens.resize(line.tokens[i].empty() ? i : i + 1);
+        return;
+    }
+}
 
 // A token for an error message: at most 40 characters, control bytes as '?'.
 inline std::string quoted(std::string_view token) {

@@ -126,6 +126,16 @@ TEST(ObjIo, RepeatedPositionsAreWeldedAsTheFormatsWelding) {
     EXPECT_EQ(r.mesh.vertices[3], Vec3(0, 1, 0));
 }
 
+TEST(ObjIo, CommentsEndAnyLine) {
+    // `#` starts a comment anywhere on a line, after a face's corners too.
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("c.obj", "v 0 0 0 # origin\nv 1 0 0#x\nv 0 1 0\nv 0 0 1\n# faces\n"
+                                                         "f 1 3 2 # bottom\nf 1 2 4\nf 2 3 4 #\nf 1 4 3#last\n"));
+    EXPECT_EQ(r.mesh.vertices.size(), 4u);
+    EXPECT_EQ(r.mesh.faces, (std::vector<Face>{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}));
+    EXPECT_TRUE(r.diagnostics.closed());
+}
+
 TEST(ObjIo, ProblemsNameTheirLine) {
     struct Case {
         const char* text;
