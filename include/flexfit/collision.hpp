@@ -189,11 +189,10 @@ struct PairCoherence {
     std::uint32_t queriesSince = 0;        // queries answered from the list
     std::size_t testedAfterTraversal = 0;  // candidates tested by the query that took the list
     std::size_t scanCost = 0;              // candidates tested since beyond that many, summed
-    // Plain traversals answer while the motion would outrun any list: what the last of them saw.
+    // Plain traversals answer while the motion would outrun any list; lastPlain holds the pose
+    // and drifts the last of them saw (its candidates stay empty).
     bool plain = false;
-    RelativePose plainPose;
-    double plainDriftA = 0.0, plainDriftB = 0.0;
-    std::uint64_t plainGenerationA = 0, plainGenerationB = 0;
+    Take lastPlain;
     std::uint32_t plainQueries = 0;        // answered so since it began
     std::uint64_t traversals = 0;          // lists taken
 };

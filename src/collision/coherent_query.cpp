@@ -88,18 +88,23 @@ double nextMargin(const PartCollider& colliderA, const PartCollider& colliderB, 
 }
 
 // Begins a take at the current pose and state.
+// What a take assumes of the pair now: its relative pose, the colliders' drifts and generations.
+void notePose(PairCoherence::Take& t, const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA) {
+    t.pose = bInA;
+    t.vertexDriftA = colliderA.vertexDrift();
+    t.vertexDriftB = colliderB.vertexDrift();
+    t.generationA = colliderA.generation();
+    t.generationB = colliderB.generation();
+}
+
 void startTake(PairCoherence::Take& t, const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA, double margin,
                std::uint64_t query) {
     t.startQuery = query;
     t.candidates.clear();
     t.stack.assign(1, {0, 0});
     t.nodes = 0;
-    t.pose = bInA;
     t.margin = margin;
-    t.vertexDriftA = colliderA.vertexDrift();
-    t.vertexDriftB = colliderB.vertexDrift();
-    t.generationA = colliderA.generation();
-    t.generationB = colliderB.generation();
+    notePose(t, colliderA, colliderB, bInA);
 }
 
 // Goes on with the take for up to `budget` node pairs, at its pose; true once complete (its
@@ -161,25 +166,15 @@ void scanCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const RelativePose
         c.scanCost += tested - std::min(tested, c.testedAfterTraversal);
 }
 
-void rememberPlainQuery(const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA, PairCoherence& c) {
-    c.plainPose = bInA;
-    c.plainDriftA = colliderA.vertexDrift();
-    c.plainDriftB = colliderB.vertexDrift();
-    c.plainGenerationA = colliderA.generation();
-    c.plainGenerationB = colliderB.generation();
-}
-
-// In plain traversals: whether this query is to be one as well (then remembered as the last):
-// for the first kPlainQueries, and after while the motion since the last one would outrun a
-// list of the widest margin within kSlowedQueries queries. A rebuilt hierarchy ends them.
+// In plain traversals: whether this query is to be one as well (then noted as the last): for
+// the first kPlainQueries, and after while the leaves' motion since the last one (coverageOf,
+// infinite once a hierarchy was rebuilt, which ends them) would outrun a list of the widest
+// margin within kSlowedQueries queries.
 bool stillTooFast(const PartCollider& colliderA, const PartCollider& colliderB, const RelativePose& bInA, PairCoherence& c) {
-    const bool rebuilt = c.plainGenerationA != colliderA.generation() || c.plainGenerationB != colliderB.generation();
-    const double step = rebuilt ? 0.0
-                                : relativeMotion(c.plainPose, bInA, colliderB.localSphere()) + colliderA.leafGrowth(colliderA.vertexDrift() - c.plainDriftA) +
-                                      ballGrowth(colliderB, colliderB.vertexDrift() - c.plainDriftB);
+    const double step = coverageOf(colliderA, colliderB, bInA, c.lastPlain).leaves;
     ++c.plainQueries;
-    c.plain = !rebuilt && (c.plainQueries < kPlainQueries || step * double(kSlowedQueries) > maxMargin(colliderA, colliderB));
-    if (c.plain) rememberPlainQuery(colliderA, colliderB, bInA, c);
+    c.plain = std::isfinite(step) && (c.plainQueries < kPlainQueries || step * double(kSlowedQueries) > maxMargin(colliderA, colliderB));
+    if (c.plain) notePose(c.lastPlain, colliderA, colliderB, bInA);
     return c.plain;
 }
 
@@ -211,7 +206,7 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
         c.valid = c.walking = false;  // the motion outruns the widest margin: plain traversals while it does
         c.plain = true;
         c.plainQueries = 0;
-        rememberPlainQuery(colliderA, colliderB, bInA, c);
+        notePose(c.lastPlain, colliderA, colliderB, bInA);
         return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
     }
     dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) {
