@@ -45,15 +45,16 @@ py::array_t<double> vec3Copy(const std::vector<Vec3>& v) {
     return a;
 }
 
-// Python speaks the given mesh's vertex indices: a model renumbered for locality translates
-// them to masses here (PartModel::massOf; an index out of range passes through for the C++ call
-// to refuse).
-// Per-mass rows in the given mesh's vertex order: a read-only view of the state when the model
-// keeps that order, else a read-only copy.
-py::array vertexRows(const PartModel& model, const std::vector<Vec3>& perMass, py::handle owner) {
-    if (!model.renumbered()) return vec3View(perMass, owner);
+// Python speaks the user's vertex indices (the file's, for a scene part whose file lost vertices
+// to welding or repair): a model renumbered for locality translates them to masses here
+// (PartModel::massOf; an index out of range passes through for the C++ call to refuse).
+// Per-mass rows in the user's vertex order: a read-only view of the state when the masses are
+// the vertices, else a read-only copy. A file vertex the repair removed reads its file position
+// (part frame, `positions`) or zero.
+py::array vertexRows(const PartModel& model, const std::vector<Vec3>& perMass, py::handle owner, bool positions) {
+    if (model.massesAreVertices()) return vec3View(perMass, owner);
     std::vector<Vec3> rows;
-    inVertexOrder<Vec3>(model, perMass, rows);
+    inVertexOrder<Vec3>(model, perMass, rows, [&](Index v) { return positions ? model.file->vertices.positions[v] : Vec3(Vec3::Zero()); });
     py::array a = vec3Copy(rows);
     a.attr("flags").attr("writeable") = false;
     return a;
@@ -296,10 +297,10 @@ void addPartReaders(Class& c, Get get) {
     c.def_property_readonly("mode", [get](py::object self) { return std::string(toString(get(self).mode())); }, "rigid, rigid-deformable or full-deformable.")
         .def_property_readonly("model", [get](py::object self) { return std::const_pointer_cast<PartModel>(get(self).sharedModel()); },
                                "The part's model (shared, immutable).")
-        .def_property_readonly("positions", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().positions, self); },
+        .def_property_readonly("positions", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().positions, self, true); },
                                "Mass positions in the part frame (the mesh's vertex order), a read-only (n, 3) view of the state, or a read-only copy when "
                                "the model's masses are renumbered (non-moving masses at rest).")
-        .def_property_readonly("velocities", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().velocities, self); },
+        .def_property_readonly("velocities", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().velocities, self, false); },
                                "Mass velocities (part frame, the mesh's vertex order), a read-only (n, 3) view, or a copy when the masses are renumbered.")
         .def_property_readonly("moving_masses", [get](py::object self) {
             const Part& part = get(self);
@@ -310,13 +311,14 @@ void addPartReaders(Class& c, Get get) {
         .def_property_readonly("zone_depths", [get](py::object self) {
             std::vector<int> perMass, depths;
             get(self).zoneDepths(perMass);
-            inVertexOrder<int>(get(self).model(), perMass, depths);
+            inVertexOrder<int>(get(self).model(), perMass, depths, [](Index) { return -1; });
             return py::array_t<int>(py::ssize_t(depths.size()), depths.data());
         }, "Each mass's depth in the zones covering it (0 = seed, -1 = at rest), a new int array.")
         .def("world_positions", [get](py::object self) {
             std::vector<Vec3> w, rows;
-            get(self).worldPositions(w);
-            inVertexOrder<Vec3>(get(self).model(), w, rows);
+            const Part& part = get(self);
+            part.worldPositions(w);
+            inVertexOrder<Vec3>(part.model(), w, rows, [&](Index v) { return part.pose().apply(part.model().file->vertices.positions[v]); });
             return vec3Copy(rows);
         }, "Mass positions in the world, a new (n, 3) array.")
         .def_property_readonly("zone_count", [get](py::object self) { return get(self).zoneCount(); }, "Zones open on the part.")
@@ -416,19 +418,27 @@ PYBIND11_MODULE(_flexfit, m) {
              "vertex_order='locality' renumbers the masses for memory locality when that makes the step faster (a mesh from a file); "
              "every index and per-mass array in Python stays in the mesh's own vertex order either way.")
         .def_property_readonly("mass_count", &PartModel::massCount, "Number of masses (the mesh's vertices).")
+        .def_property_readonly("vertex_count", &PartModel::vertexCount,
+                               "Number of the user's vertices: the rows of per-vertex arrays (mass_count, or the file's vertex count for a scene "
+                               "part whose file lost vertices to welding or repair).")
         .def_property_readonly("spring_count", [](const PartModel& model) { return model.springCount(); }, "Number of springs (edges, and bending springs of a physical material).")
         .def_property_readonly("mesh", [](py::object self) {
             const PartModel& model = self.cast<const PartModel&>();
-            return py::cast(model.givenMesh ? model.givenMesh.get() : &model.mesh, py::return_value_policy::reference_internal, self);
-        }, "The simulation mesh as given (rest shape, part frame).")
-        .def_property_readonly("rest_positions", [](py::object self) { return vertexRows(self.cast<const PartModel&>(), self.cast<const PartModel&>().restPositions, self); },
+            return py::cast(&model.userMesh(), py::return_value_policy::reference_internal, self);
+        }, "The simulation mesh as given (rest shape, part frame; for a scene part whose file lost vertices to welding or repair, "
+           "the file's vertices with the repaired faces over them).")
+        .def_property_readonly("rest_positions", [](py::object self) { return vertexRows(self.cast<const PartModel&>(), self.cast<const PartModel&>().restPositions, self, true); },
                                "Rest positions, a read-only (n, 3) array (a view unless the masses are renumbered).")
         .def_property_readonly("renumbered", &PartModel::renumbered, "Whether the masses are the mesh's vertices renumbered (vertex_order='locality').")
         .def_property_readonly("mass_of_vertex", [](const PartModel& model) {
-            std::vector<Index> masses(model.massCount());
-            for (Index v = 0; v < masses.size(); ++v) masses[v] = model.massOf(v);
-            return py::array_t<Index>(py::ssize_t(masses.size()), masses.data());
-        }, "The internal mass of each vertex (for C++ code and the state hash; Python's indices are the vertices).");
+            std::vector<std::int64_t> masses(model.vertexCount());
+            for (Index v = 0; v < masses.size(); ++v) {
+                const bool removed = model.file && model.file->vertices.meshVertex[v] == kNoVertex;
+                masses[v] = removed ? -1 : std::int64_t(model.massOf(v));
+            }
+            return py::array_t<std::int64_t>(py::ssize_t(masses.size()), masses.data());
+        }, "The internal mass of each vertex (for C++ code and the state hash; Python's indices are the vertices); -1 for a file vertex "
+           "the repair removed.");
 
     py::class_<Part> partClass(m, "Part", "A part: a rigid body until pressed, then mass-spring-damper zones around the contacts.");
     partClass.def(py::init([](std::shared_ptr<PartModel> model, const py::kwargs& settings) {

@@ -69,6 +69,7 @@ void run(const SimulateOptions& opt) {
     PerturbationConfig config;
     PartModelSettings modelSettings = opt.sim.modelSettings();
     modelSettings.vertexOrder = opt.vertexOrder == "locality" ? VertexOrder::Locality : VertexOrder::AsGiven;
+    modelSettings.fileVertices = read.fileVertices;
     config.model = buildPartModel(read.mesh, modelSettings);
     // MASS arguments name the file's vertices; the model's masses may be renumbered.
     const auto massOf = [&](Index vertex) { return config.model->massOf(vertex); };
@@ -136,7 +137,9 @@ void run(const SimulateOptions& opt) {
     fmt::print("{}: {} masses, {} springs, mode {}, {} steps of {} s ({}, restore {}), {:.0f} steps/s{}\n", model.name,
                model.massCount(), model.springCount(), toString(config.part.mode), result.steps, s.timeStep,
                toString(s.integrator), toString(s.restoration.method), double(result.steps) / std::max(result.wallSeconds, 1e-9),
-               model.renumbered() ? " (masses renumbered for locality; indices and frames in the file's order)" : "");
+               model.renumbered() ? " (masses renumbered for locality; indices and frames in the file's order)"
+               : model.file       ? " (indices and frames in the file's vertex order)"
+                                  : "");
     fmt::print("active region: at most {} moving masses and {} computed springs; {} spring evaluations in all\n",
                result.maxMovingMasses, result.maxComputedSprings, result.counters.springsEvaluated);
     if (s.integrator == Integrator::ImplicitEuler)

@@ -173,9 +173,9 @@ std::vector<Vec3> SurfaceNormals::computeAll(const Part& part) {
 void showPart(const Part& part, const std::vector<Vec3>& massNormals, const std::vector<Vec3>& massColours, ShownSurface& out) {
     const PartModel& model = part.model();
     const auto& drawn = model.drawn;
-    if (!drawn) {  // the masses, in the given mesh's vertex order (drawnMesh()'s faces)
-        inVertexOrder<Vec3>(model, part.state().positions, out.positions);
-        inVertexOrder<Vec3>(model, massNormals, out.normals);
+    if (!drawn) {  // the masses, in the user's vertex order (drawnMesh()'s faces)
+        part.drawnPositions(out.positions);
+        inVertexOrder<Vec3>(model, massNormals, out.normals, [](Index) { return Vec3(Vec3::UnitY()); });
         inVertexOrder<Vec3>(model, massColours, out.colours);
         return;
     }
@@ -188,9 +188,10 @@ void showPart(const Part& part, const std::vector<Vec3>& massNormals, const std:
 std::shared_ptr<const PartModel> withMaterial(const PartModel& old, const Material& material) {
     PartModelSettings settings;
     settings.material = material;
-    inVertexOrder<double>(old, old.mass, settings.vertexMasses);
+    inGivenVertexOrder<double>(old, old.mass, settings.vertexMasses);
     settings.vertexOrder = old.renumbered() ? VertexOrder::Locality : VertexOrder::AsGiven;
     if (old.drawn) settings.drawnMesh = old.drawn->mesh;
+    if (old.file) settings.fileVertices = old.file->vertices;
     return buildPartModel(old.givenMesh ? *old.givenMesh : old.mesh, settings);
 }
 

@@ -8,6 +8,7 @@
 
 #include "flexfit/core.hpp"
 
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -43,12 +44,40 @@ struct MeshSourceLines {
 MeshDiagnostics validateMesh(const TriMesh& mesh, const std::string& source,
                              const MeshSourceLines& lines = {});
 
+// A vertex a change of the mesh removed (VertexMap).
+inline constexpr Index kNoVertex = std::numeric_limits<Index>::max();
+
+// Where each vertex of a mesh went when vertices were merged or removed: vertex i became
+// vertex newIndex[i] of the changed mesh, or was removed (kNoVertex).
+using VertexMap = std::vector<Index>;
+// `map` followed by `then` (each entry of `map` sent on through `then`; removed stays removed).
+void composeVertexMap(VertexMap& map, const VertexMap& then);
+
 // Merges vertices closer than `tolerance` (0: bit-identical positions only), keeping the first
 // of each cluster in input order, so the result is deterministic. Faces that collapse are
 // removed; the count is returned. Used for formats that split vertices per face (STL).
-std::size_t weldVertices(TriMesh& mesh, double tolerance);
+// `moved`, when given, gets where each vertex went.
+std::size_t weldVertices(TriMesh& mesh, double tolerance, VertexMap* moved = nullptr);
 // The vertex each vertex would be welded into (itself when none): always an earlier one.
 std::vector<Index> weldTargets(std::span<const Vec3> vertices, double tolerance);
+
+// A file's own vertices, when reading it merged or removed some (the format's welding, an
+// asked-for weld, the repair: mesh_io.hpp): file vertex i became mesh vertex meshVertex[i], or
+// was removed (kNoVertex: no face used it). Empty when the mesh's vertices are the file's, one
+// for one. A part built with it (PartModelSettings::fileVertices) takes and gives the file's
+// vertex indices.
+struct FileVertices {
+    VertexMap meshVertex;         // (file V)
+    std::vector<Vec3> positions;  // (file V) as read
+    bool empty() const { return meshVertex.empty(); }
+    std::size_t count() const { return meshVertex.size(); }
+};
+
+// The file's vertices (all of them, at the file's positions) with `mesh`'s faces, each corner
+// named by the first file vertex that became it: the mesh as the user's file numbers it.
+TriMesh inFileOrder(const TriMesh& mesh, const FileVertices& file);
+// For each mesh vertex, the first file vertex that became it (kNoVertex: none did).
+VertexMap firstFileVertices(const FileVertices& file, std::size_t meshVertexCount);
 
 // Axis-aligned bounds of the vertices.
 Eigen::AlignedBox3d boundingBox(const TriMesh& mesh);

@@ -2,11 +2,15 @@
 //
 // `.tri` is the thesis's text format, as SPEC.md defines it: line 1 the model's name; then the
 // vertex count V and the face count F (on one line or two); then V lines `x y z`; then F lines
-// `a b c` of 0-based indices. Blank lines are ignored. OBJ has its own reader (obj_io.cpp: the
-// file's vertex order and double precision; polygons triangulated in their plane). Everything else (STL, PLY,
-// OFF, glTF/GLB) goes through assimp, which gives vertices in first-use order, in single
-// precision. Every reader returns a whole, valid mesh or throws InputError
-// naming the file, the line where there is one, and the problem.
+// `a b c` of 0-based indices. Blank lines are ignored. OBJ, OFF and PLY have readers of their
+// own (obj_io.cpp, off_io.cpp, ply_io.cpp: the file's vertex order and double precision;
+// polygons triangulated in their plane). STL and glTF/GLB go through assimp, which gives
+// vertices in first-use order, in single precision. Every reader returns a whole, valid mesh or
+// throws InputError naming the file, the line where there is one, and the problem.
+//
+// The mesh read is renumbered where the format's welding or the repair merges or removes
+// vertices; MeshReadResult::fileVertices then says where each file vertex went, so a part built
+// with it (PartModelSettings::fileVertices) keeps the file's numbering.
 //
 // Corrupt files are errors: counts that do not match, indices out of range, NaN or infinite
 // coordinates, truncation, an empty mesh. Geometric defects a user cannot fix by hand are
@@ -41,6 +45,10 @@ struct MeshReadResult {
     std::size_t weldedVertices = 0;  // vertices removed by the asked-for or the format's welding
     std::size_t collapsedFaces = 0;  // faces removed because that welding collapsed them
     MeshRepairs repairs;             // what the repair changed (nothing when strict)
+    // The file's vertices, when the welding or the repair merged or removed some (mesh.hpp).
+    // OBJ, OFF, PLY and .tri: the vertices the file lists; STL: its face corners (assimp keeps
+    // their order); glTF and the other assimp formats: the vertices assimp gives.
+    FileVertices fileVertices;
 };
 
 // Parses `.tri` text; `source` names it in errors.

@@ -50,6 +50,9 @@ struct MeshRepairs {
     std::size_t flippedFaces = 0;             // turned to agree with their neighbours
     std::size_t nonOrientablePieces = 0;      // left as they are
     std::size_t unreferencedVertices = 0;     // used by no face: removed
+    // Where each input vertex went (welded into an earlier one, removed, or renumbered past the
+    // removed ones); empty when no vertex was welded or removed.
+    VertexMap vertexMap;
 
     bool any() const;
     // One line per kind found, with its count ("2 zero-area or repeated-vertex faces dropped").

@@ -176,8 +176,8 @@ public:
     Vec3 worldPosition(Index mass) const { return pose_.apply(state_.positions[mass]); }
     void worldPositions(std::vector<Vec3>& out) const;
     // The vertices of model().drawnMesh() as the part looks now, in the part frame / the world
-    // (the mass positions in the given mesh's vertex order when the model has no drawn mesh of
-    // its own).
+    // (the mass positions in the user's vertex order, PartModel::userMesh(), when the model has
+    // no drawn mesh of its own).
     void drawnPositions(std::vector<Vec3>& out) const;
     void drawnWorldPositions(std::vector<Vec3>& out) const;
     // Depth of each mass in the zones covering it (minimum; 0 = seed), -1 when not moving.

@@ -87,6 +87,18 @@ struct PartModelSettings {
     // The masses' order; per-vertex and per-spring arrays above are given in the mesh's own order
     // either way.
     VertexOrder vertexOrder = VertexOrder::AsGiven;
+    // Optional: the vertices of the file the mesh was read from, when the read welded or removed
+    // some (MeshReadResult::fileVertices). The model then takes and gives the file's vertex
+    // indices (PartModel::massOf, vertexOf, inVertexOrder, drawnMesh()): a user's vertex 574 is
+    // their file's vertex 574. Per-vertex arrays above stay in the mesh's order.
+    FileVertices fileVertices = {};
+};
+
+// A model's file numbering (PartModelSettings::fileVertices).
+struct FileNumbering {
+    FileVertices vertices;  // file vertex -> given mesh vertex (kNoVertex: removed)
+    VertexMap firstOf;      // (given V) given mesh vertex -> the first file vertex that became it
+    TriMesh mesh;           // the simulation surface as the file numbers it (inFileOrder)
 };
 
 struct PartModel {
@@ -136,9 +148,27 @@ struct PartModel {
     std::vector<Index> vertexOfMass;  // (V or 0)
     std::shared_ptr<const TriMesh> givenMesh;
     bool renumbered() const { return !massOfVertex.empty(); }
-    // An index out of range passes through unchanged, for the call it goes to to refuse.
-    Index massOf(Index vertex) const { return renumbered() && vertex < massOfVertex.size() ? massOfVertex[vertex] : vertex; }
-    Index vertexOf(Index m) const { return renumbered() ? vertexOfMass[m] : m; }
+
+    // The file's numbering, when the model was built with the file's vertices (a read that
+    // welded or removed some); null otherwise. A removed vertex (no face used it) has no mass: it
+    // is carried rigidly with the part at its file position, with no displacement or velocity
+    // of its own.
+    std::shared_ptr<const FileNumbering> file;
+
+    // The user's vertices: the file's when `file` is set, else the given mesh's.
+    std::size_t vertexCount() const { return file ? file->vertices.count() : massCount(); }
+    // Whether mass i is the user's vertex i (no renumbering, no file numbering).
+    bool massesAreVertices() const { return !renumbered() && !file; }
+    // The mass of the user's vertex. An index out of range passes through unchanged, for the
+    // call it goes to to refuse; a removed file vertex throws InputError naming the part.
+    Index massOf(Index vertex) const;
+    // The user's vertex of mass m (with a file numbering, the first file vertex that became it).
+    Index vertexOf(Index m) const;
+    // The mass of the given mesh's vertex (no file numbering).
+    Index massOfGivenVertex(Index v) const { return renumbered() ? massOfVertex[v] : v; }
+    // The simulation surface as the user numbers it: the file's vertices and the faces over
+    // them, else the given mesh.
+    const TriMesh& userMesh() const { return file ? file->mesh : givenMesh ? *givenMesh : mesh; }
 
     std::size_t massCount() const { return mass.size(); }
     std::size_t springCount() const { return springA.size(); }
@@ -154,13 +184,29 @@ std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSet
 
 // Per-mass values in the given mesh's vertex order (a copy when the model is not renumbered).
 template <class T>
-void inVertexOrder(const PartModel& model, std::span<const T> perMass, std::vector<T>& out) {
+void inGivenVertexOrder(const PartModel& model, std::span<const T> perMass, std::vector<T>& out) {
     out.resize(perMass.size());
     if (!model.renumbered()) {
         std::copy(perMass.begin(), perMass.end(), out.begin());
         return;
     }
     for (std::size_t v = 0; v < out.size(); ++v) out[v] = perMass[model.massOfVertex[v]];
+}
+
+// Per-mass values in the user's vertex order (PartModel::vertexCount() of them): a file
+// vertex welded into another repeats its value; a removed one gets removed(vertex), by default
+// T{} (no displacement, no velocity, no zone).
+template <class T, class Removed>
+void inVertexOrder(const PartModel& model, std::span<const T> perMass, std::vector<T>& out, Removed removed) {
+    if (!model.file) return inGivenVertexOrder(model, perMass, out);
+    const VertexMap& given = model.file->vertices.meshVertex;
+    out.resize(given.size());
+    for (std::size_t u = 0; u < out.size(); ++u)
+        out[u] = given[u] == kNoVertex ? removed(Index(u)) : perMass[model.massOfGivenVertex(given[u])];
+}
+template <class T>
+void inVertexOrder(const PartModel& model, std::span<const T> perMass, std::vector<T>& out) {
+    inVertexOrder(model, perMass, out, [](Index) { return T{}; });
 }
 
 }  // namespace flexfit

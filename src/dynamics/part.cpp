@@ -349,11 +349,11 @@ void Part::worldPositions(std::vector<Vec3>& out) const {
 
 void Part::drawnPositions(std::vector<Vec3>& out) const {
     if (model_->drawn) return embeddedPositions(*model_->drawn, model_->mesh.faces, state_.positions, out);
-    inVertexOrder(*model_, std::span<const Vec3>(state_.positions), out);
+    inVertexOrder(*model_, std::span<const Vec3>(state_.positions), out, [&](Index v) { return model_->file->vertices.positions[v]; });
 }
 
 void Part::drawnWorldPositions(std::vector<Vec3>& out) const {
-    if (!model_->drawn && !model_->renumbered()) return worldPositions(out);
+    if (!model_->drawn && model_->massesAreVertices()) return worldPositions(out);
     drawnPositions(out);
     const Eigen::Matrix3d r = pose_.rotation.toRotationMatrix();
     for (Vec3& p : out) p = r * p + pose_.translation;

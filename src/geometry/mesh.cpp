@@ -221,7 +221,28 @@ std::vector<Index> weldTargets(std::span<const Vec3> vertices, double tolerance)
     return tolerance > 0 ? positionsWithin(vertices, tolerance) : identicalPositions(vertices);
 }
 
-std::size_t weldVertices(TriMesh& mesh, double tolerance) {
+void composeVertexMap(VertexMap& map, const VertexMap& then) {
+    for (Index& v : map)
+        if (v != kNoVertex) v = then[v];
+}
+
+VertexMap firstFileVertices(const FileVertices& file, std::size_t meshVertexCount) {
+    VertexMap first(meshVertexCount, kNoVertex);
+    for (std::size_t i = file.count(); i-- > 0;)
+        if (const Index v = file.meshVertex[i]; v != kNoVertex) first[v] = Index(i);
+    return first;
+}
+
+TriMesh inFileOrder(const TriMesh& mesh, const FileVertices& file) {
+    if (file.empty()) return mesh;
+    const VertexMap first = firstFileVertices(file, mesh.vertices.size());
+    TriMesh out{mesh.name, file.positions, mesh.faces};
+    for (Face& f : out.faces)
+        for (Index& v : f) v = first[v];
+    return out;
+}
+
+std::size_t weldVertices(TriMesh& mesh, double tolerance, VertexMap* moved) {
     const std::vector<Index> target = weldTargets(mesh.vertices, tolerance);
     // Kept vertices in input order; every vertex maps to its target's new index.
     std::vector<Index> remap(mesh.vertices.size());
@@ -244,6 +265,7 @@ std::size_t weldVertices(TriMesh& mesh, double tolerance) {
     const std::size_t collapsed = mesh.faces.size() - faces.size();
     mesh.vertices = std::move(kept);
     mesh.faces = std::move(faces);
+    if (moved) *moved = std::move(remap);
     return collapsed;
 }
 

@@ -155,9 +155,9 @@ std::vector<bool> referenced(const TriMesh& mesh) {
     return used;
 }
 
-std::size_t removeUnreferencedVertices(TriMesh& mesh) {
+std::size_t removeUnreferencedVertices(TriMesh& mesh, VertexMap& remap) {
     const std::vector<bool> used = referenced(mesh);
-    std::vector<Index> remap(mesh.vertices.size(), Index(-1));
+    remap.assign(mesh.vertices.size(), kNoVertex);
     std::vector<Vec3> kept;
     kept.reserve(mesh.vertices.size());
     for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
@@ -212,14 +212,19 @@ MeshRepairs repairMesh(TriMesh& mesh, double weldTolerance, const std::string& s
     MeshRepairs r;
     r.weldTolerance = resolvedTolerance(mesh, weldTolerance);
     const std::size_t vertices = mesh.vertices.size(), faces = mesh.faces.size();
-    weldVertices(mesh, r.weldTolerance);  // also drops the faces it collapses: counted as degenerate below
+    VertexMap welded, removed;
+    weldVertices(mesh, r.weldTolerance, &welded);  // also drops the faces it collapses: counted as degenerate below
     r.weldedVertices = vertices - mesh.vertices.size();
     const std::size_t collapsed = faces - mesh.faces.size();
     r.degenerateFaces = collapsed + dropDegenerateFaces(mesh);
     r.duplicateFaces = dropDuplicateFaces(mesh.faces);
     r.flippedFaces = orientConsistently(mesh.faces, r.nonOrientablePieces);
-    r.unreferencedVertices = removeUnreferencedVertices(mesh);
+    r.unreferencedVertices = removeUnreferencedVertices(mesh, removed);
     if (mesh.faces.empty()) throw InputError(source, 0, "no face is left after dropping the degenerate and duplicate ones");
+    if (r.weldedVertices > 0 || r.unreferencedVertices > 0) {
+        r.vertexMap = std::move(welded);
+        composeVertexMap(r.vertexMap, removed);
+    }
     return r;
 }
 

@@ -69,19 +69,20 @@ void appendPiece(std::ostringstream& out, const FramePart& named) {
     const Part& part = *named.part;
     const PartModel& model = part.model();
     const std::size_t n = model.massCount();
-    // The simulation surface, in the order its mesh was given (PartModel::massOfVertex).
-    const auto& faces = model.givenMesh ? model.givenMesh->faces : model.mesh.faces;
+    // The simulation surface in the user's vertex order (PartModel::userMesh()); a file vertex
+    // the repair removed is carried rigidly, undisplaced, outside every zone.
+    const auto& faces = model.userMesh().faces;
     std::vector<Vec3> world, perMass(n), points, displacement, velocity;
     part.worldPositions(world);
-    inVertexOrder<Vec3>(model, world, points);
+    inVertexOrder<Vec3>(model, world, points, [&](Index v) { return part.pose().apply(model.file->vertices.positions[v]); });
     for (std::size_t m = 0; m < n; ++m) perMass[m] = part.pose().rotate(part.state().positions[m] - model.restPositions[m]);
     inVertexOrder<Vec3>(model, perMass, displacement);
     for (std::size_t m = 0; m < n; ++m) perMass[m] = part.pose().rotate(part.state().velocities[m]);
     inVertexOrder<Vec3>(model, perMass, velocity);
     std::vector<int> depthPerMass, depth;
     part.zoneDepths(depthPerMass);
-    inVertexOrder<int>(model, depthPerMass, depth);
-    out << "<Piece Name=\"" << xmlEscaped(named.name) << "\" NumberOfPoints=\"" << n << "\" NumberOfPolys=\"" << faces.size() << "\">\n";
+    inVertexOrder<int>(model, depthPerMass, depth, [](Index) { return -1; });
+    out << "<Piece Name=\"" << xmlEscaped(named.name) << "\" NumberOfPoints=\"" << points.size() << "\" NumberOfPolys=\"" << faces.size() << "\">\n";
     out << "<PointData Scalars=\"zone_depth\" Vectors=\"displacement\">\n";
     out << "<DataArray type=\"Int32\" Name=\"zone_depth\" format=\"ascii\">\n";
     for (int d : depth) out << d << "\n";

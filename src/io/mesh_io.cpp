@@ -63,8 +63,8 @@ MeshReadResult finishPolygonRead(TriMesh mesh, const std::string& source, const 
                                                                    "their triangles may overlap");
     if (repeats > 0)
         warnings.insert(warnings.begin(), std::to_string(repeats) + " vertices repeat an earlier one's position (split normals, texture "
-                                          "seams, the seams of a model made of pieces) and were welded into it: vertex indices (scene "
-                                          "masses, frames) are the welded mesh's, not the file's (flexfit convert writes that mesh)");
+                                          "seams, the seams of a model made of pieces) and were welded into it: a part's vertex indices "
+                                          "(scene masses, frames) stay the file's; the mesh read (flexfit convert) has the welded ones");
     return result;
 }
 
@@ -80,9 +80,10 @@ MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSou
     MeshReadResult result;
     const bool welds = formatWelds || options.weldTolerance.has_value();
     if (welds && !options.repair) requireNoCollapse(mesh, options.weldTolerance.value_or(0.0), source, lines);
+    FileVertices file{{}, mesh.vertices};
     if (welds) {  // indices change: the lines no longer match the faces
         const std::size_t before = mesh.vertices.size();
-        result.collapsedFaces = weldVertices(mesh, options.weldTolerance.value_or(0.0));
+        result.collapsedFaces = weldVertices(mesh, options.weldTolerance.value_or(0.0), &file.meshVertex);
         result.weldedVertices = before - mesh.vertices.size();
     }
     const MeshSourceLines none;
@@ -92,6 +93,11 @@ MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSou
         result.repairs = repairMesh(mesh, tolerance, source, where);
     else
         requireNoDefects(mesh, tolerance, source, where);
+    if (!result.repairs.vertexMap.empty()) {
+        if (file.meshVertex.empty()) file.meshVertex = result.repairs.vertexMap;
+        else composeVertexMap(file.meshVertex, result.repairs.vertexMap);
+    }
+    if (result.weldedVertices > 0 || !result.repairs.vertexMap.empty()) result.fileVertices = std::move(file);
     result.diagnostics = validateMesh(mesh, source);
     std::vector<std::string> warnings = result.repairs.warnings();
     if (result.collapsedFaces > 0) warnings.push_back(std::to_string(result.collapsedFaces) + " faces collapsed by welding and were removed");

@@ -200,7 +200,8 @@ std::optional<RemeshOptions> readRemesh(Table& t) {
 // (`draw = "original"`, the default) unless `draw = "simulation"`.
 struct PartMeshes {
     TriMesh simulated;
-    TriMesh drawn;  // empty: the simulated mesh is drawn
+    TriMesh drawn;      // empty: the simulated mesh is drawn
+    FileVertices file;  // the file's vertices when the read welded or removed some (not remeshed)
 };
 
 PartMeshes readPartMesh(Table& t, const std::filesystem::path& base, const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
@@ -224,10 +225,11 @@ PartMeshes readPartMesh(Table& t, const std::filesystem::path& base, const Scene
     const bool drawOriginal = draw == "original";
     if (!remesh && t.has("draw"))
         warnings.push_back({t.line("draw"), t.what() + ", key 'draw': has no effect without 'remesh' (the file's mesh is simulated and drawn)"});
-    if (!remesh) return {std::move(result.mesh), {}};
+    if (!remesh) return {std::move(result.mesh), {}, std::move(result.fileVertices)};
     try {
         TriMesh simulated = remeshForSimulation(result.mesh, *remesh, path.string()).mesh;
-        return {std::move(simulated), drawOriginal ? std::move(result.mesh) : TriMesh{}};
+        // Drawn: the file's own vertices, in its order, over the repaired faces.
+        return {std::move(simulated), drawOriginal ? inFileOrder(result.mesh, result.fileVertices) : TriMesh{}, {}};
     } catch (const InputError& e) {
         throw InputError(t.file(), t.line("remesh"), t.what() + ", key 'remesh': " + e.problem());
     }
@@ -337,11 +339,12 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     if (t.has("mesh") == t.has("generator")) t.fail("needs exactly one of 'mesh' and 'generator'");
     for (const char* key : {"repair", "remesh", "draw", "vertex_order"})
         if (t.has(key) && !t.has("mesh")) t.fail(*t.node(key), key, "applies only to a part read from a 'mesh' file");
-    PartMeshes meshes = t.has("mesh") ? readPartMesh(t, base, options, warnings) : PartMeshes{generatePartMesh(t), {}};
+    PartMeshes meshes = t.has("mesh") ? readPartMesh(t, base, options, warnings) : PartMeshes{generatePartMesh(t), {}, {}};
     TriMesh mesh = std::move(meshes.simulated);
     mesh.name = p.name;
     PartModelSettings model;
     model.drawnMesh = std::move(meshes.drawn);
+    model.fileVertices = std::move(meshes.file);
     // A file's vertices come in its exporter's order: renumbered for locality unless asked not
     // to (the scene's mass indices, frames and outputs stay in the file's order either way).
     if (t.has("mesh")) {
@@ -451,6 +454,15 @@ void checkIndices(Table& t, const std::string& key, const std::vector<Index>& in
         if (i >= count) t.fail(*t.node(key), key, "index " + std::to_string(i) + " out of range (the part has " + std::to_string(count) + ")");
 }
 
+// Masses are named by the user's vertices (the file's: PartModel::vertexCount()); one the
+// repair removed has no mass.
+void checkMasses(Table& t, const std::vector<Index>& masses, const PartModel& model) {
+    checkIndices(t, "masses", masses, model.vertexCount());
+    for (Index v : masses)
+        if (model.file && model.file->vertices.meshVertex[v] == kNoVertex)
+            t.fail(*t.node("masses"), "masses", "vertex " + std::to_string(v) + " of the part's mesh file was removed by the repair (no face uses it): it has no mass");
+}
+
 SceneAction readAction(Table& t, const Scene& scene) {
     using Kind = SceneAction::Kind;
     SceneAction a;
@@ -488,7 +500,7 @@ SceneAction readAction(Table& t, const Scene& scene) {
             a.masses = t.indices("masses");
             a.faces = t.indices("faces");
             if (a.masses.empty() && a.faces.empty()) t.fail("a force needs 'masses' or 'faces'");
-            checkIndices(t, "masses", a.masses, part.model->massCount());
+            checkMasses(t, a.masses, *part.model);
             checkIndices(t, "faces", a.faces, part.model->faceCount());
             break;
         case Kind::Velocity:
@@ -500,7 +512,7 @@ SceneAction readAction(Table& t, const Scene& scene) {
             a.linear = t.vec3("velocity", Vec3::Zero());
             a.masses = t.indices("masses");
             if (a.masses.empty()) t.fail("a kick needs 'masses'");
-            checkIndices(t, "masses", a.masses, part.model->massCount());
+            checkMasses(t, a.masses, *part.model);
             break;
     }
     t.finish();

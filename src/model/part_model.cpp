@@ -243,6 +243,27 @@ std::shared_ptr<PartModel> renumberedForLocality(const PartModel& given, const P
     return model;
 }
 
+// The file numbering of a model whose given mesh is `given`, checked: every file vertex goes to
+// a vertex of the mesh or is removed, and every mesh vertex comes from one.
+std::shared_ptr<const FileNumbering> fileNumbering(const FileVertices& file, const TriMesh& given) {
+    const auto fail = [](const std::string& problem) { throw InputError(kSettingsSource, 0, "file vertices: " + problem); };
+    if (file.positions.size() != file.count())
+        fail(std::to_string(file.count()) + " file vertices but " + std::to_string(file.positions.size()) + " positions");
+    for (std::size_t u = 0; u < file.count(); ++u) {
+        if (file.meshVertex[u] != kNoVertex && file.meshVertex[u] >= given.vertices.size())
+            fail("file vertex " + std::to_string(u) + " goes to vertex " + std::to_string(file.meshVertex[u]) + ", out of range (the mesh has " +
+                 std::to_string(given.vertices.size()) + ")");
+        if (!file.positions[u].allFinite()) fail("file vertex " + std::to_string(u) + " has a non-finite position");
+    }
+    auto numbering = std::make_shared<FileNumbering>();
+    numbering->vertices = file;
+    numbering->firstOf = firstFileVertices(file, given.vertices.size());
+    for (std::size_t v = 0; v < given.vertices.size(); ++v)
+        if (numbering->firstOf[v] == kNoVertex) fail("no file vertex goes to mesh vertex " + std::to_string(v));
+    numbering->mesh = inFileOrder(given, file);
+    return numbering;
+}
+
 }  // namespace
 
 std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings) {
@@ -256,11 +277,27 @@ std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSet
         validateMesh(settings.drawnMesh, kSettingsSource + ", drawn mesh");
         model->drawn = std::make_shared<const SurfaceEmbedding>(embedSurface(settings.drawnMesh, model->mesh, kSettingsSource));
     }
+    if (!settings.fileVertices.empty()) model->file = fileNumbering(settings.fileVertices, model->userMesh());
     return model;
+}
+
+Index PartModel::massOf(Index vertex) const {
+    if (!file) return vertex < massCount() ? massOfGivenVertex(vertex) : vertex;
+    if (vertex >= file->vertices.count()) return vertex;
+    const Index given = file->vertices.meshVertex[vertex];
+    if (given == kNoVertex)
+        throw InputError("part '" + name + "'", 0,
+                         "vertex " + std::to_string(vertex) + " of its file was removed by the repair (no face uses it): it has no mass");
+    return massOfGivenVertex(given);
+}
+
+Index PartModel::vertexOf(Index m) const {
+    const Index given = renumbered() ? vertexOfMass[m] : m;
+    return file ? file->firstOf[given] : given;
 }
 
 bool PartModel::hasSpringBlocks() const { return springBlocks != nullptr && !springBlocks->empty(); }
 
-const TriMesh& PartModel::drawnMesh() const { return drawn ? drawn->mesh : givenMesh ? *givenMesh : mesh; }
+const TriMesh& PartModel::drawnMesh() const { return drawn ? drawn->mesh : userMesh(); }
 
 }  // namespace flexfit

@@ -4,7 +4,9 @@ shuffled, written here): with --vertex-order locality (the default) the masses a
 inside, yet --force, --kick and --zone name the file's vertices (a level-4 zone at the loaded
 vertex: wider than the one the force would open, so the motion tells where it is) and the OBJ frames are the file's mesh in
 its order: the first frame is the file's vertices (exactly where nothing moved yet), and every frame matches the run with
---vertex-order as_given up to rounding. Prints "vertex order: the file's" only when all holds.
+--vertex-order as_given up to rounding. Then the same file damaged as exports are (a stray vertex no face uses in
+the middle of the list, a vertex written twice): the read removes and welds them, yet the indices and frames are the
+damaged file's, every frame vertex where the clean run put it. Prints "vertex order: the file's" only when all holds.
 
 Usage: check_vertex_order.py FLEXFIT OUT_DIR
 """
@@ -55,16 +57,34 @@ def main():
     mesh = out / "shuffled.tri"
     mesh.write_text(f"shuffled\n{len(shuffled)} {len(faces)}\n" + "".join("%.17g %.17g %.17g\n" % p for p in shuffled) +
                     "".join("%d %d %d\n" % tuple(order[k] for k in f) for f in faces))
+    # Damaged: a stray vertex inserted as vertex 10, and face 30's first corner written again at the end.
+    damaged = shuffled[:10] + [(7.0, 0.5, -2.0)] + shuffled[10:]
+    shift = [k + (k >= 10) for k in order]
+    damaged_faces = [[shift[k] for k in f] for f in faces]
+    repeated = damaged_faces[30][0]
+    damaged.append(damaged[repeated])
+    damaged_faces[30][0] = len(damaged) - 1
+    damaged_mesh = out / "damaged.tri"
+    damaged_mesh.write_text(f"damaged\n{len(damaged)} {len(faces)}\n" + "".join("%.17g %.17g %.17g\n" % p for p in damaged) +
+                            "".join("%d %d %d\n" % tuple(f) for f in damaged_faces))
     frames = {}
-    for choice in ("locality", "as_given"):
+    for choice, file, (force, kick) in (("locality", mesh, (5, 200)), ("as_given", mesh, (5, 200)), ("damaged", damaged_mesh, (5, 201))):
         prefix = out / choice
-        done = subprocess.run([flexfit, "simulate", str(mesh), "--vertex-order", choice, "--mode", "rigid-deformable",
-                               "--force", "5:0,0.5,0.2", "--kick", "200:0.3,0,0", "--zone", "5@4", "--duration", "0.2",
-                               "--obj-at", "0,0.1,0.2", "--obj-prefix", str(prefix)],
+        done = subprocess.run([flexfit, "simulate", str(file), "--vertex-order", "as_given" if choice == "as_given" else "locality",
+                               "--mode", "rigid-deformable", "--force", f"{force}:0,0.5,0.2", "--kick", f"{kick}:0.3,0,0", "--zone",
+                               f"{force}@4", "--duration", "0.2", "--obj-at", "0,0.1,0.2", "--obj-prefix", str(prefix)],
                               check=True, stdout=subprocess.PIPE, text=True)
         print(done.stdout, end="")
-        assert ("renumbered for locality" in done.stdout) == (choice == "locality"), "the run does not say whether it renumbered"
+        assert ("renumbered for locality" in done.stdout) == (choice != "as_given"), "the run does not say whether it renumbered"
         frames[choice] = [obj(pathlib.Path(f"{prefix}_{t:.4f}.obj")) for t in (0.0, 0.1, 0.2)]
+    for (va, fa), (vd, fd) in zip(frames["locality"], frames["damaged"]):
+        assert len(vd) == len(damaged), f"a frame of the damaged file has {len(vd)} vertices, the file {len(damaged)}"
+        assert all(vd[c + (c >= 10)] == va[c] for c in range(len(va))), \
+            "the damaged file's frame vertices are not where the clean run put them"
+        assert vd[-1] == vd[repeated], "the repeated vertex does not follow its first copy"
+        assert fd == [[str(k + 1) for k in f] for f in damaged_faces[:30] + [[repeated] + damaged_faces[30][1:]] + damaged_faces[31:]], \
+            "the damaged file's frame faces are not the file's"
+    assert frames["damaged"][0][0][10] == (7.0, 0.5, -2.0), "the stray vertex is not at its place in the first frame"
     rest_vertices, rest_faces = frames["locality"][0]
     file_vertices = shuffled
     file_faces = [[str(order[k] + 1) for k in f] for f in faces]

@@ -117,17 +117,23 @@ TEST(MeshRepair, DegenerateDuplicateAndUnreferencedAloneAndMixed) {
     for (unsigned mask = 1; mask < 64; ++mask) {
         TriMesh mesh = sphere;
         MeshRepairs expected;
+        // Where each vertex goes, by construction: the sphere's stay, the added ones are removed
+        // or welded into the vertex they copy.
+        VertexMap expectedMap(sphere.vertices.size());
+        std::iota(expectedMap.begin(), expectedMap.end(), Index(0));
         auto has = [&](Defect d) { return (mask >> d) & 1u; };
         if (has(kUnreferenced)) {  // two stray vertices, before the rest is appended
             mesh.vertices.push_back(Vec3(9, 9, 9));
             mesh.vertices.push_back(Vec3(-9, 0, 0));
             expected.unreferencedVertices += 2;
+            expectedMap.insert(expectedMap.end(), 2, kNoVertex);
         }
         if (has(kZeroArea)) {  // a vertex on edge (0 1): the face (0 1 x) has no area
             mesh.vertices.push_back(0.5 * (sphere.vertices[0] + sphere.vertices[1]));
             mesh.faces.push_back({0, 1, Index(mesh.vertices.size() - 1)});
             ++expected.degenerateFaces;
             ++expected.unreferencedVertices;  // used only by the dropped face
+            expectedMap.push_back(kNoVertex);
         }
         if (has(kRepeated)) {
             mesh.faces.push_back({3, 4, 3});
@@ -142,6 +148,7 @@ TEST(MeshRepair, DegenerateDuplicateAndUnreferencedAloneAndMixed) {
             mesh.vertices.push_back(sphere.vertices[sphere.faces[5][0]] + Vec3(1e-9, 0, 0));
             mesh.faces[5][0] = Index(mesh.vertices.size() - 1);
             ++expected.weldedVertices;
+            expectedMap.push_back(sphere.faces[5][0]);
         }
         if (has(kFlipped)) {
             for (std::size_t f : {11u, 12u}) mesh.faces[f] = flipped(mesh.faces[f]);
@@ -158,6 +165,10 @@ TEST(MeshRepair, DegenerateDuplicateAndUnreferencedAloneAndMixed) {
         EXPECT_EQ(mesh.vertices, sphere.vertices) << mask;
         EXPECT_EQ(mesh.faces, sphere.faces) << mask;
         EXPECT_NO_THROW(validateMesh(mesh, "repaired"));
+        if (expected.weldedVertices + expected.unreferencedVertices > 0)
+            EXPECT_EQ(r.vertexMap, expectedMap) << mask;
+        else
+            EXPECT_TRUE(r.vertexMap.empty()) << mask;
         const std::size_t kinds = (expected.weldedVertices > 0) + (expected.degenerateFaces > 0) + (expected.duplicateFaces > 0) +
                                   (expected.flippedFaces > 0) + (expected.unreferencedVertices > 0);
         EXPECT_EQ(r.warnings().size(), kinds)
@@ -178,10 +189,38 @@ TEST(MeshRepair, RandomSoupsComeOutValidOrRefused) {
         const int faces = 1 + trial % 30;
         for (int f = 0; f < faces; ++f) mesh.faces.push_back({pick(random), pick(random), pick(random)});
         const std::size_t before = mesh.faces.size();
+        const TriMesh input = mesh;
         try {
             const MeshRepairs r = repairMesh(mesh, -1.0, "soup");
             EXPECT_NO_THROW(validateMesh(mesh, "repaired")) << trial;
             EXPECT_EQ(mesh.faces.size() + r.degenerateFaces + r.duplicateFaces, before) << trial;
+            // Where each vertex went: to a vertex at its position (the soup's positions are whole
+            // numbers: welding merges only equal ones), or removed because no face left uses a
+            // vertex there; every vertex left comes from the first input vertex at its position.
+            const VertexMap map = r.vertexMap.empty() ? [&] {
+                VertexMap identity(input.vertices.size());
+                std::iota(identity.begin(), identity.end(), Index(0));
+                return identity;
+            }() : r.vertexMap;
+            ASSERT_EQ(map.size(), input.vertices.size()) << trial;
+            std::vector<bool> reached(mesh.vertices.size(), false);
+            for (std::size_t u = 0; u < map.size(); ++u) {
+                const bool usedThere = std::any_of(mesh.faces.begin(), mesh.faces.end(), [&](const Face& f) {
+                    return std::any_of(f.begin(), f.end(), [&](Index v) { return mesh.vertices[v] == input.vertices[u]; });
+                });
+                if (map[u] == kNoVertex) {
+                    EXPECT_FALSE(usedThere) << trial << " vertex " << u;
+                    continue;
+                }
+                ASSERT_LT(map[u], mesh.vertices.size()) << trial;
+                EXPECT_EQ(mesh.vertices[map[u]], input.vertices[u]) << trial << " vertex " << u;
+                if (!reached[map[u]]) {
+                    EXPECT_EQ(std::find(input.vertices.begin(), input.vertices.end(), input.vertices[u]) - input.vertices.begin(), std::ptrdiff_t(u))
+                        << trial << ": the first vertex at a position stands for it";
+                    reached[map[u]] = true;
+                }
+            }
+            EXPECT_EQ(std::count(reached.begin(), reached.end(), true), std::ptrdiff_t(mesh.vertices.size())) << trial;
             if (r.nonOrientablePieces == 0) {
                 // Every edge two faces share is run once each way (edges of three or more faces excepted).
                 std::map<std::pair<Index, Index>, int> runs;

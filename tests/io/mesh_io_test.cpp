@@ -273,5 +273,76 @@ TEST(MeshIo, TriAndObjOfTheSameMeshAgree) {
             EXPECT_EQ(tri.mesh.vertices[tri.mesh.faces[f][k]], obj.mesh.vertices[obj.mesh.faces[f][k]]);
 }
 
+// ---------------------------------------------------------------------------------------------
+// The file's vertices (MeshReadResult::fileVertices) through the format's welding and the repair
+
+// An icosphere as a file might give it: a stray vertex no face uses in the middle of the list,
+// a vertex repeated exactly (split normals; welded by OBJ / OFF / PLY's format welding, by the
+// repair in .tri) and one repeated 1e-9 away (welded by the repair), each used by one face.
+TriMesh damagedSphere() {
+    TriMesh mesh = makeIcoSphere(1.0, 1);
+    mesh.vertices.insert(mesh.vertices.begin() + 7, Vec3(5, 5, 5));
+    for (Face& f : mesh.faces)
+        for (Index& v : f) v += v >= 7 ? 1 : 0;
+    const Index exact = mesh.faces[3][1], near = mesh.faces[20][2];
+    mesh.vertices.push_back(mesh.vertices[exact]);
+    mesh.faces[3][1] = Index(mesh.vertices.size() - 1);
+    mesh.vertices.push_back(mesh.vertices[near] + Vec3(1e-9, 0, 0));
+    mesh.faces[20][2] = Index(mesh.vertices.size() - 1);
+    return mesh;
+}
+
+std::string asText(const TriMesh& mesh, const std::string& format) {
+    std::ostringstream out;
+    char line[128];
+    const std::size_t base = format == "obj" ? 1 : 0;
+    if (format == "tri") out << "damaged\n" << mesh.vertices.size() << " " << mesh.faces.size() << "\n";
+    if (format == "off") out << "OFF\n" << mesh.vertices.size() << " " << mesh.faces.size() << " 0\n";
+    if (format == "ply")
+        out << "ply\nformat ascii 1.0\nelement vertex " << mesh.vertices.size() << "\nproperty double x\nproperty double y\nproperty double z\n"
+            << "element face " << mesh.faces.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const Vec3& v : mesh.vertices) {
+        std::snprintf(line, sizeof line, "%s%.17g %.17g %.17g\n", format == "obj" ? "v " : "", v.x(), v.y(), v.z());
+        out << line;
+    }
+    for (const Face& f : mesh.faces)
+        out << (format == "obj" ? "f " : format == "tri" ? "" : "3 ") << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
+    return out.str();
+}
+
+TEST(MeshIo, FileVerticesFollowEveryWeldAndRemovalInEveryFormat) {
+    TempDir dir;
+    const TriMesh file = damagedSphere();
+    for (const std::string format : {"tri", "obj", "off", "ply"}) {
+        const MeshReadResult r = readMesh(dir.write("damaged." + format, asText(file, format)));
+        ASSERT_EQ(r.mesh.vertices.size(), file.vertices.size() - 3) << format;
+        const FileVertices& fv = r.fileVertices;
+        ASSERT_EQ(fv.count(), file.vertices.size()) << format;
+        EXPECT_EQ(fv.positions, file.vertices) << format << ": the file's positions, as read";
+        // Brute force: a vertex some face of the file uses goes to the mesh vertex closest to it
+        // (within the weld tolerance); the stray one is removed.
+        for (std::size_t u = 0; u < fv.count(); ++u) {
+            if (u == 7) {
+                EXPECT_EQ(fv.meshVertex[u], kNoVertex) << format;
+                continue;
+            }
+            std::size_t closest = 0;
+            for (std::size_t v = 1; v < r.mesh.vertices.size(); ++v)
+                if ((r.mesh.vertices[v] - file.vertices[u]).norm() < (r.mesh.vertices[closest] - file.vertices[u]).norm()) closest = v;
+            EXPECT_EQ(fv.meshVertex[u], closest) << format << " file vertex " << u;
+            EXPECT_LT((r.mesh.vertices[closest] - file.vertices[u]).norm(), 1e-8) << format;
+        }
+        // The mesh in the file's numbering has the file's faces but for the welded corners.
+        const TriMesh numbered = inFileOrder(r.mesh, fv);
+        ASSERT_EQ(numbered.faces.size(), file.faces.size()) << format;
+        std::size_t differing = 0;
+        for (std::size_t f = 0; f < file.faces.size(); ++f) differing += numbered.faces[f] != file.faces[f];
+        EXPECT_EQ(differing, 2u) << format << ": faces 3 and 20 name the first vertex at the repeated positions";
+    }
+    // A clean file: the mesh's vertices are the file's, no map.
+    const MeshReadResult clean = readMesh(dir.write("clean.obj", asText(makeIcoSphere(1.0, 1), "obj")));
+    EXPECT_TRUE(clean.fileVertices.empty());
+}
+
 }  // namespace
 }  // namespace flexfit

@@ -644,5 +644,58 @@ TEST(PartModelVertexOrder, ErrorsNameTheGivenVertex) {
     }
 }
 
+// --- PartModelSettings::fileVertices: the file's numbering, by hand on the tetrahedron read
+// from a file of 6 vertices: file 0 1 2 3 are the mesh's 0 1 2 3, file 4 repeats vertex 1,
+// file 5 was removed.
+FileVertices tetrahedronFile() {
+    FileVertices file;
+    file.meshVertex = {0, 1, 2, 3, 1, kNoVertex};
+    file.positions = {{0, 0, 0}, {1, 0, 0}, {0, 2, 0}, {0, 0, 3}, {1, 0, 0}, {9, 9, 9}};
+    return file;
+}
+
+TEST(PartModelFileVertices, IndicesInAndOutAreTheFilesWithAndWithoutRenumbering) {
+    for (const VertexOrder order : {VertexOrder::AsGiven, VertexOrder::Locality}) {
+        PartModelSettings settings;
+        settings.fileVertices = tetrahedronFile();
+        settings.vertexOrder = order;
+        const auto model = buildPartModel(tetrahedron(), settings);
+        ASSERT_TRUE(model->file);
+        EXPECT_EQ(model->vertexCount(), 6u);
+        EXPECT_FALSE(model->massesAreVertices());
+        for (Index u : {0u, 1u, 2u, 3u}) {
+            EXPECT_EQ(model->restPositions[model->massOf(u)], tetrahedronFile().positions[u]);
+            EXPECT_EQ(model->vertexOf(model->massOf(u)), u);
+        }
+        EXPECT_EQ(model->massOf(4), model->massOf(1));
+        EXPECT_EQ(model->massOf(6), 6u) << "out of range passes through";
+        EXPECT_THROW(model->massOf(5), InputError);
+        // Per-mass values in the file's order: the repeat repeats, the removed one gets its value.
+        std::vector<double> perMass(4), perVertex;
+        for (Index m = 0; m < 4; ++m) perMass[m] = double(model->vertexOf(m));
+        inVertexOrder<double>(*model, perMass, perVertex, [](Index) { return -7.0; });
+        EXPECT_EQ(perVertex, (std::vector<double>{0, 1, 2, 3, 1, -7}));
+        // The surface in the file's numbering: its positions, the faces over the first vertices.
+        EXPECT_EQ(model->userMesh().vertices, tetrahedronFile().positions);
+        EXPECT_EQ(model->userMesh().faces, tetrahedron().faces);
+        EXPECT_EQ(&model->drawnMesh(), &model->userMesh());
+    }
+}
+
+TEST(PartModelFileVertices, AMapThatDoesNotFitTheMeshIsRefused) {
+    std::vector<std::tuple<std::string, PartModelSettings, std::string>> cases;
+    auto with = [](auto change) {
+        PartModelSettings s;
+        s.fileVertices = tetrahedronFile();
+        change(s.fileVertices);
+        return s;
+    };
+    cases.emplace_back("positions", with([](FileVertices& f) { f.positions.pop_back(); }), "6 file vertices but 5 positions");
+    cases.emplace_back("range", with([](FileVertices& f) { f.meshVertex[4] = 4; }), "file vertex 4 goes to vertex 4, out of range");
+    cases.emplace_back("unreached", with([](FileVertices& f) { f.meshVertex[2] = 0; }), "no file vertex goes to mesh vertex 2");
+    cases.emplace_back("finite", with([](FileVertices& f) { f.positions[5].x() = std::nan(""); }), "file vertex 5 has a non-finite position");
+    expectEachRefused(cases);
+}
+
 }  // namespace
 }  // namespace flexfit

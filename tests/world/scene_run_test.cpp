@@ -507,13 +507,9 @@ std::vector<double> numbers(const std::string& text) {
     return out;
 }
 
-}  // namespace
-
-TEST(SceneRun, AFileMeshRenumberedForLocalityKeepsTheFilesOrderInEveryOutput) {
-    flexfit::testing::TempDir dir;
-    const TriMesh file = flexfit::testing::shuffledVertices(makeTorus(3.0, 1.0, 24, 16), 9);
-    writeMesh(file, dir.path() / "torus.tri");
-    const std::string scene = R"(
+// A ring read from `mesh`, pushed at two vertices and kicked at a third.
+std::string ringScene(const std::string& mesh, Index pushed1, Index pushed2, Index kicked) {
+    return R"(
 [world]
 time_step = 0.001
 gravity = [0, 0, 0]
@@ -521,7 +517,7 @@ duration = 0.2
 
 [[part]]
 name = "ring"
-mesh = "torus.tri"
+mesh = ")" + mesh + R"("
 mode = "rigid-deformable"
 restoration = "none"
 global_damping = 0.5
@@ -530,7 +526,7 @@ global_damping = 0.5
 time = 0.0
 type = "force"
 part = "ring"
-masses = [5, 200]
+masses = [)" + std::to_string(pushed1) + ", " + std::to_string(pushed2) + R"(]
 force = [0.3, -0.1, 0.2]
 duration = 0.1
 
@@ -538,9 +534,18 @@ duration = 0.1
 time = 0.05
 type = "kick"
 part = "ring"
-masses = [77]
+masses = [)" + std::to_string(kicked) + R"(]
 velocity = [0, 0.5, 0]
 )";
+}
+
+}  // namespace
+
+TEST(SceneRun, AFileMeshRenumberedForLocalityKeepsTheFilesOrderInEveryOutput) {
+    flexfit::testing::TempDir dir;
+    const TriMesh file = flexfit::testing::shuffledVertices(makeTorus(3.0, 1.0, 24, 16), 9);
+    writeMesh(file, dir.path() / "torus.tri");
+    const std::string scene = ringScene("torus.tri", 5, 200, 77);
     const Scene local = parseScene(scene, "scene.toml", dir.path());
     ASSERT_TRUE(local.parts[0].model->renumbered());
     const Scene asGiven = parseScene(
@@ -584,6 +589,81 @@ velocity = [0, 0.5, 0]
         ASSERT_EQ(x.size(), y.size()) << field;
         for (std::size_t i = 0; i < x.size(); ++i) ASSERT_NEAR(x[i], y[i], 1e-12) << field << " " << i;
     }
+}
+
+// A file whose vertices the read welds and removes (a repeated vertex, a stray one no face uses,
+// in the middle of the list): the scene, the frames and the drawn positions speak the file's
+// vertex indices. Reference: the same run on the clean file, whose vertex c is the damaged
+// file's vertex c + (c >= 10): the repaired mesh is the clean one, so every mass moves as in the
+// clean run, bit for bit.
+TEST(SceneRun, AFileThatLosesVerticesToTheRepairKeepsItsNumberingInEveryOutput) {
+    flexfit::testing::TempDir dir;
+    const TriMesh clean = flexfit::testing::shuffledVertices(makeTorus(3.0, 1.0, 24, 16), 9);
+    TriMesh damaged = clean;
+    const Vec3 stray(7.0, 0.5, -2.0);
+    damaged.vertices.insert(damaged.vertices.begin() + 10, stray);
+    for (Face& f : damaged.faces)
+        for (Index& v : f) v += v >= 10 ? 1 : 0;
+    const Index repeated = damaged.faces[30][0];
+    damaged.vertices.push_back(damaged.vertices[repeated]);
+    damaged.faces[30][0] = Index(damaged.vertices.size() - 1);
+    writeMesh(clean, dir.path() / "clean.tri");
+    writeMesh(damaged, dir.path() / "damaged.tri");
+    const auto fileOf = [](Index c) { return c + (c >= 10 ? 1u : 0u); };
+    const Scene cleanScene = parseScene(ringScene("clean.tri", 5, 200, 77), "scene.toml", dir.path());
+    const Scene damagedScene = parseScene(ringScene("damaged.tri", fileOf(5), fileOf(200), fileOf(77)), "scene.toml", dir.path());
+    const PartModel& model = *damagedScene.parts[0].model;
+    ASSERT_TRUE(model.file);
+    EXPECT_EQ(model.vertexCount(), damaged.vertices.size());
+    EXPECT_EQ(model.massCount(), clean.vertices.size());
+    EXPECT_EQ(model.vertexOf(model.massOf(fileOf(200))), fileOf(200));
+    EXPECT_EQ(model.massOf(Index(damaged.vertices.size() - 1)), model.massOf(repeated)) << "a repeat is its first vertex's mass";
+
+    SceneRun a(cleanScene), b(damagedScene);
+    std::vector<Vec3> drawnA, drawnB;
+    b.world().part(0).drawnWorldPositions(drawnB);
+    EXPECT_EQ(drawnB, damaged.vertices) << "at rest, the file's vertices in its order";
+    EXPECT_EQ(b.world().part(0).model().drawnMesh().faces.size(), clean.faces.size());
+    runFor(a, 0.2);
+    runFor(b, 0.2);
+    a.world().part(0).drawnWorldPositions(drawnA);
+    b.world().part(0).drawnWorldPositions(drawnB);
+    ASSERT_EQ(drawnB.size(), damaged.vertices.size());
+    for (Index c = 0; c < clean.vertices.size(); ++c) ASSERT_EQ(drawnB[fileOf(c)], drawnA[c]) << c;
+    EXPECT_EQ(drawnB.back(), drawnB[repeated]) << "the repeat follows its first vertex";
+    EXPECT_EQ(drawnB[10], b.world().part(0).pose().apply(stray)) << "the stray vertex is carried with the part";
+    EXPECT_GT((drawnB[fileOf(77)] - damaged.vertices[fileOf(77)]).norm(), 0.01) << "the kicked file vertex moved";
+
+    // VTK frames: the file's vertices (points and fields) and its faces, the repeat's corner
+    // named by its first vertex.
+    writeVtkFrame(dir.path() / "b.vtp", {{"ring", &b.world().part(0)}});
+    std::ifstream in(dir.path() / "b.vtp");
+    const std::string vtk((std::istreambuf_iterator<char>(in)), {});
+    const std::vector<double> depths = numbers(vtkSection(vtk, "Name=\"zone_depth\""));
+    ASSERT_EQ(depths.size(), damaged.vertices.size());
+    EXPECT_EQ(depths[fileOf(77)], 0.0) << "a zone is seeded at the kicked file vertex";
+    EXPECT_EQ(depths[10], -1.0) << "the stray vertex is in no zone";
+    const std::vector<double> points = numbers(vtkSection(vtk, "<Points>\n<DataArray"));
+    ASSERT_EQ(points.size(), 3 * damaged.vertices.size());
+    for (std::size_t v = 0; v < damaged.vertices.size(); ++v)
+        for (int k = 0; k < 3; ++k) ASSERT_NEAR(points[3 * v + std::size_t(k)], drawnB[v][k], 1e-12 * (1.0 + std::abs(drawnB[v][k])));
+    TriMesh expectedFaces = damaged;
+    expectedFaces.faces[30][0] = repeated;
+    const std::vector<double> connectivity = numbers(vtkSection(vtk, "Name=\"connectivity\""));
+    ASSERT_EQ(connectivity.size(), 3 * expectedFaces.faces.size());
+    for (std::size_t f = 0; f < expectedFaces.faces.size(); ++f)
+        for (int k = 0; k < 3; ++k) ASSERT_EQ(connectivity[3 * f + std::size_t(k)], double(expectedFaces.faces[f][std::size_t(k)])) << f;
+
+    // Naming the stray vertex is an error at its line: it has no mass.
+    try {
+        parseScene(ringScene("damaged.tri", 10, 1, 2), "scene.toml", dir.path());
+        ADD_FAILURE() << "a force on a removed vertex was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("key 'masses': vertex 10 of the part's mesh file was removed by the repair"), std::string::npos)
+            << e.what();
+        EXPECT_EQ(e.line(), 18u);
+    }
+    EXPECT_THROW(model.massOf(10), InputError);
 }
 
 TEST(SceneRun, VertexOrderIsCheckedAndAppliesToMeshFilesOnly) {
