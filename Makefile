@@ -52,17 +52,25 @@ bench: release
 	/usr/bin/python3 tools/bench_ratios.py bench/results/part_ratios.csv --counter a_over_b
 	build/release/bench/bench_collision $(BENCH_FLAGS) --benchmark_out=bench/results/collision.csv
 	/usr/bin/python3 tools/bench_ratios.py bench/results/collision.csv \
-	  --pair BM_FclObbrssQuery/0 BM_FlexfitQuery/0/1 --pair BM_FclObbrssQuery/1 BM_FlexfitQuery/1/1 \
-	  --pair BM_FclObbrssQuery/2 BM_FlexfitQuery/2/1 --pair BM_FclObbrssQuery/3 BM_FlexfitQuery/3/1 \
-	  --pair BM_FlexfitQuery/1/0 BM_FlexfitQuery/1/1 --pair BM_FclAabbRefit BM_FlexfitRefitLocal/1 \
+	  --pair BM_FclObbrssQuery/0 BM_FlexfitQuery/0/1/4 --pair BM_FclObbrssQuery/1 BM_FlexfitQuery/1/1/4 \
+	  --pair BM_FclObbrssQuery/2 BM_FlexfitQuery/2/1/4 --pair BM_FclObbrssQuery/3 BM_FlexfitQuery/3/1/4 \
+	  --pair BM_FlexfitQuery/1/0/4 BM_FlexfitQuery/1/1/4 --pair BM_FclAabbRefit BM_FlexfitRefitLocal/1 \
+	  --pair BM_FlexfitQuery/0/0/1 BM_FlexfitQuery/0/0/4 --pair BM_FlexfitQuery/0/1/1 BM_FlexfitQuery/0/1/4 \
+	  --pair BM_FlexfitQuery/1/0/1 BM_FlexfitQuery/1/0/4 --pair BM_FlexfitQuery/1/1/1 BM_FlexfitQuery/1/1/4 \
 	  --pair BM_BroadPhase/1 BM_BroadPhase/0 --pair BM_DeformingPairFclAabb/iterations:3/manual_time BM_DeformingPairFlexfit/iterations:3/manual_time \
 	  --pair BM_DeformingPairFclObbrss/iterations:1/manual_time BM_DeformingPairFlexfit/iterations:3/manual_time \
-	  --pair BM_ToolIntoPart/0/1/iterations:3/manual_time BM_ToolIntoPart/0/0/iterations:3/manual_time \
-	  --pair BM_ToolIntoPart/1/1/iterations:3/manual_time BM_ToolIntoPart/1/0/iterations:3/manual_time \
-	  --pair BM_ToolIntoPart/2/1/iterations:3/manual_time BM_ToolIntoPart/2/0/iterations:3/manual_time \
-	  --pair BM_ToolIntoPart/0/2/iterations:3/manual_time BM_ToolIntoPart/0/0/iterations:3/manual_time \
-	  --pair BM_ToolIntoPart/1/2/iterations:3/manual_time BM_ToolIntoPart/1/0/iterations:3/manual_time \
-	  --pair BM_ToolIntoPart/2/2/iterations:3/manual_time BM_ToolIntoPart/2/0/iterations:3/manual_time
+	  --pair BM_ToolIntoPart/0/1/4/iterations:3/manual_time BM_ToolIntoPart/0/0/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/1/1/4/iterations:3/manual_time BM_ToolIntoPart/1/0/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/2/1/4/iterations:3/manual_time BM_ToolIntoPart/2/0/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/0/2/1/iterations:3/manual_time BM_ToolIntoPart/0/0/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/1/2/1/iterations:3/manual_time BM_ToolIntoPart/1/0/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/2/2/1/iterations:3/manual_time BM_ToolIntoPart/2/0/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/0/0/1/iterations:3/manual_time BM_ToolIntoPart/0/0/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/0/1/1/iterations:3/manual_time BM_ToolIntoPart/0/1/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/1/0/1/iterations:3/manual_time BM_ToolIntoPart/1/0/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/1/1/1/iterations:3/manual_time BM_ToolIntoPart/1/1/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/2/0/1/iterations:3/manual_time BM_ToolIntoPart/2/0/4/iterations:3/manual_time \
+	  --pair BM_ToolIntoPart/2/1/1/iterations:3/manual_time BM_ToolIntoPart/2/1/4/iterations:3/manual_time
 	build/release/bench/bench_zone_coverage $(BENCH_FLAGS) --benchmark_out=bench/results/zone_coverage.csv
 	build/release/bench/bench_implicit_step --benchmark_repetitions=3 --benchmark_report_aggregates_only=true --benchmark_min_time=0.2 --benchmark_out_format=csv --benchmark_out=bench/results/implicit_step.csv
 	build/release/bench/bench_stiffness_limit --benchmark_out_format=csv --benchmark_out=bench/results/stiffness_limit.csv

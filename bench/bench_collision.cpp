@@ -23,6 +23,7 @@
 //          the traversal 6d7824d made every step) and FCL AABB (endUpdateModel + collide).
 //          same_contacts: the coherent query's face pairs equal the full query's at every step
 //          and FCL's at the last.
+#include "collision/pair_query.hpp"
 #include "flexfit/flexfit.hpp"
 
 #include <benchmark/benchmark.h>
@@ -114,7 +115,9 @@ void setQueryCounters(benchmark::State& state, const std::string& label, std::si
     state.counters["same_contacts"] = same ? 1.0 : 0.0;
 }
 
+// range(0): the scene; range(1): 0 spheres, 1 boxes; range(2): the leaf group (pair_query.hpp).
 void BM_FlexfitQuery(benchmark::State& state) {
+    const flexfit::detail::ScopedLeafGroup group(std::size_t(state.range(2)));
     const Scene& s = sceneByIndex(int(state.range(0)));
     const auto kind = state.range(1) == 0 ? BoundingVolumeKind::Sphere : BoundingVolumeKind::Aabb;
     PartSettings rigid;
@@ -135,7 +138,8 @@ void BM_FlexfitQuery(benchmark::State& state) {
     const auto fa = fclModel<fcl::OBBRSSd>(*s.a), fb = fclModel<fcl::OBBRSSd>(*s.b);
     QueryStats check;
     const bool same = ourContacts(a, ca, b, cb, check) == fclContacts(s, fa, fb, &fclCount);
-    setQueryCounters(state, s.name + " / " + toString(kind), contacts.size(), stats.volumeTests, same);
+    setQueryCounters(state, s.name + " / " + toString(kind) + ", leaf group " + std::to_string(state.range(2)), contacts.size(),
+                     stats.volumeTests, same);
 }
 
 void BM_FclObbrssQuery(benchmark::State& state) {
@@ -386,8 +390,10 @@ std::set<std::pair<Index, Index>> facePairs(const std::vector<Contact>& contacts
     return pairs;
 }
 
-// range(0): subdivision levels (0, 1, 2); range(1): 0 coherent, 1 full, 2 FCL AABB.
+// range(0): subdivision levels (0, 1, 2); range(1): 0 coherent, 1 full, 2 FCL AABB; range(2):
+// the traversal's leaf group (pair_query.hpp; 1: every node pair descended).
 void BM_ToolIntoPart(benchmark::State& state) {
+    const flexfit::detail::ScopedLeafGroup group(std::size_t(state.range(2)));
     const auto model = thirdPartyPart(int(state.range(0)));
     if (!model) {
         state.SkipWithError("assimp-testmodels is not installed (Debian package)");
@@ -445,7 +451,8 @@ void BM_ToolIntoPart(benchmark::State& state) {
         }
     }
     static const char* const kMethods[] = {"coherent", "full query", "fcl aabb, endUpdateModel + collide"};
-    setPairCounters(state, fmt::format("wuson x{} ({} faces) pressed by a tool / {}", 1 << (2 * state.range(0)), model->faceCount(), kMethods[method]),
+    setPairCounters(state, fmt::format("wuson x{} ({} faces) pressed by a tool / {}{}", 1 << (2 * state.range(0)), model->faceCount(), kMethods[method],
+                                       method == 2 ? "" : fmt::format(", leaf group {}", state.range(2))),
                     contacts, same);
 }
 
@@ -472,7 +479,7 @@ void BM_BroadPhase(benchmark::State& state) {
     setQueryCounters(state, settings.broadPhase == BroadPhaseUpdate::Refit ? "200 parts / refit" : "200 parts / rebuild", pairs, 0, true);
 }
 
-BENCHMARK(BM_FlexfitQuery)->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1})->Args({2, 0})->Args({2, 1})->Args({3, 0})->Args({3, 1});
+BENCHMARK(BM_FlexfitQuery)->ArgsProduct({{0, 1, 2, 3}, {0, 1}, {1, 4}});
 BENCHMARK(BM_FclObbrssQuery)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 BENCHMARK(BM_FlexfitRefitLocal)->Arg(0)->Arg(1);
 BENCHMARK(BM_FclAabbRefit);
@@ -480,7 +487,17 @@ BENCHMARK(BM_BroadPhase)->Arg(0)->Arg(1);
 BENCHMARK(BM_DeformingPairFlexfit)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(3);
 BENCHMARK(BM_DeformingPairFclObbrss)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(1);
 BENCHMARK(BM_DeformingPairFclAabb)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(3);
-BENCHMARK(BM_ToolIntoPart)->ArgsProduct({{0, 1, 2}, {0, 1, 2}})->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(3);
+BENCHMARK(BM_ToolIntoPart)
+    ->Apply([](benchmark::internal::Benchmark* b) {
+        for (int level : {0, 1, 2}) {
+            for (int method : {0, 1})
+                for (int group : {1, 2, 4, 8}) b->Args({level, method, group});
+            b->Args({level, 2, 1});
+        }
+    })
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->Iterations(3);
 
 }  // namespace
 

@@ -49,6 +49,7 @@ public:
         leafOf_.assign(leafVolumes.size(), 0);
         if (leafVolumes.empty()) return;
         nodes_.reserve(2 * leafVolumes.size());
+        subtreeEnd_.assign(2 * leafVolumes.size() - 1, 0);
         std::vector<Index> items(leafVolumes.size());
         std::iota(items.begin(), items.end(), Index(0));
         buildNode(leafVolumes, items, 0, items.size(), -1, 0);
@@ -96,6 +97,10 @@ public:
     }
 
     const std::vector<Node>& nodes() const { return nodes_; }
+    // Node n's subtree is nodes [n, subtreeEnd(n)) (children follow their parent), holding
+    // itemCount(n) leaves.
+    std::int32_t subtreeEnd(std::int32_t n) const { return subtreeEnd_[std::size_t(n)]; }
+    std::size_t itemCount(std::int32_t n) const { return std::size_t(subtreeEnd_[std::size_t(n)] - n + 1) / 2; }
     const BV& leafVolume(Index item) const { return nodes_[leafOf_[item]].volume; }
     bool empty() const { return nodes_.empty(); }
     const BV& rootVolume() const { return nodes_.front().volume; }
@@ -113,6 +118,7 @@ private:
             nodes_[std::size_t(index)].volume = leaves[items[begin]];
             nodes_[std::size_t(index)].item = items[begin];
             leafOf_[items[begin]] = Index(index);
+            subtreeEnd_[std::size_t(index)] = index + 1;
             return index;
         }
         nodes_[std::size_t(index)].volume = encloseAll(leaves, range);
@@ -121,6 +127,7 @@ private:
         const std::int32_t right = buildNode(leaves, items, middle, end, index, std::uint16_t(depth + 1));
         nodes_[std::size_t(index)].left = left;
         nodes_[std::size_t(index)].right = right;
+        subtreeEnd_[std::size_t(index)] = std::int32_t(nodes_.size());
         return index;
     }
 
@@ -143,6 +150,7 @@ private:
 
     std::vector<Node> nodes_;
     std::vector<Index> leafOf_;          // item -> leaf node
+    std::vector<std::int32_t> subtreeEnd_;  // (nodes) one past the last node of each subtree
     IndexSet dirty_;                     // (nodes) ancestors to merge in a refit
     std::size_t refitNodes_ = 0;
 };

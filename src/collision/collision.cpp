@@ -134,6 +134,14 @@ std::size_t PartCollider::refitNodeCount() const {
 }
 
 namespace detail {
+namespace {
+std::size_t chosenLeafGroup = kDefaultLeafGroup;
+}  // namespace
+
+std::size_t leafGroup() { return chosenLeafGroup; }
+ScopedLeafGroup::ScopedLeafGroup(std::size_t items) { chosenLeafGroup = std::max<std::size_t>(items, 1); }
+ScopedLeafGroup::~ScopedLeafGroup() { chosenLeafGroup = kDefaultLeafGroup; }
+
 RestPlaneFilter::Scratch& restPlaneScratch() {
     thread_local RestPlaneFilter::Scratch scratch;
     return scratch;

@@ -30,23 +30,72 @@ inline Aabb grown(const Aabb& b, double margin) { return {b.min.array() - margin
 // over several queries); traverse() is one whole traversal.
 using NodePairStack = std::vector<std::pair<std::int32_t, std::int32_t>>;
 
+// Leaf groups: a node pair whose subtrees hold at most leafGroup() items each is not descended
+// node by node; each of its leaf pairs is tested directly (the same leaf-volume test, then
+// leafPair), in a tight loop over the subtrees' node ranges, without the internal node pairs'
+// tests and stack traffic. The contacts are the same: a pair of leaves that overlap has
+// overlapping ancestors (every node encloses its children), and a leaf pair a prune would have
+// cut below is handed to leafPair, whose exact test rejects it (RestPlaneFilter: a subtree is
+// pruned only when each of its triangles would be). Asking the prune of each leaf pair instead
+// was measured slower (the exact test's own plane test repeats it). The group size was chosen
+// by measurement (BM_ToolIntoPart and BM_FlexfitQuery in bench/results/collision.csv).
+inline constexpr std::size_t kDefaultLeafGroup = 4;
+std::size_t leafGroup();  // kDefaultLeafGroup unless a ScopedLeafGroup chose another
+// Benchmarks and tests: every traversal in this scope groups `items` (>= 1; 1 descends every
+// node pair). Not thread-safe; scopes must not overlap.
+class ScopedLeafGroup {
+public:
+    explicit ScopedLeafGroup(std::size_t items);
+    ~ScopedLeafGroup();
+    ScopedLeafGroup(const ScopedLeafGroup&) = delete;
+    ScopedLeafGroup& operator=(const ScopedLeafGroup&) = delete;
+};
+
+// A's volume (grown by the margin when kGrown) against B's.
+template <bool kGrown, class VA, class VB>
+bool volumesOverlap(const VA& a, const VB& b, const RelativePose& bInA, double margin) {
+    if constexpr (kGrown) return overlap(grown(a, margin), b, bInA);
+    return overlap(a, b, bInA);
+}
+
+// Every leaf pair of the subtrees of nodes i (of A) and j (of B), by the leaves' volumes.
+template <bool kGrown, class BA, class BB, class LeafPair>
+void testLeafGroup(std::int32_t i, std::int32_t j, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, QueryStats& stats,
+                   LeafPair& leafPair, double margin) {
+    const auto& na = a.nodes();
+    const auto& nb = b.nodes();
+    for (std::int32_t p = i; p < a.subtreeEnd(i); ++p) {
+        const auto& x = na[std::size_t(p)];
+        if (!x.isLeaf()) continue;
+        for (std::int32_t q = j; q < b.subtreeEnd(j); ++q) {
+            const auto& y = nb[std::size_t(q)];
+            if (!y.isLeaf()) continue;
+            ++stats.volumeTests;
+            if (!volumesOverlap<kGrown>(x.volume, y.volume, bInA, margin)) continue;
+            ++stats.candidatePairs;
+            leafPair(x.item, y.item);
+        }
+    }
+}
+
 template <bool kGrown, class BA, class BB, class LeafPair, class Prune>
 void traverseFromImpl(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA,
                       QueryStats& stats, LeafPair& leafPair, Prune& prune, double margin) {
     const auto& na = a.nodes();
     const auto& nb = b.nodes();
+    const std::size_t group = leafGroup();
     for (std::size_t visited = 0; !stack.empty() && visited < budget; ++visited) {
         const auto [i, j] = stack.back();
         stack.pop_back();
         const auto& x = na[std::size_t(i)];
         const auto& y = nb[std::size_t(j)];
         ++stats.volumeTests;
-        if constexpr (kGrown) {
-            if (!overlap(grown(x.volume, margin), y.volume, bInA)) continue;
-        } else {
-            if (!overlap(x.volume, y.volume, bInA)) continue;
-        }
+        if (!volumesOverlap<kGrown>(x.volume, y.volume, bInA, margin)) continue;
         if (x.isLeaf() && !y.isLeaf() && prune(x.item, y.volume)) continue;
+        if (!(x.isLeaf() && y.isLeaf()) && a.itemCount(i) <= group && b.itemCount(j) <= group) {
+            testLeafGroup<kGrown>(i, j, a, b, bInA, stats, leafPair, margin);
+            continue;
+        }
         if (x.isLeaf() && y.isLeaf()) {
             ++stats.candidatePairs;
             leafPair(x.item, y.item);

@@ -105,3 +105,30 @@ TEST(BoundingVolume, EnclosuresContainTheirMembers) {
     EXPECT_TRUE(thesis.centre.isApprox(Vec3(2, 0.5, 0)));  // midpoint of the box
     EXPECT_NEAR(thesis.radius, std::sqrt(4.0 + 0.25), 1e-12);  // to the farthest point
 }
+
+TEST(BoundingVolume, EachSubtreeIsTheNodeRangeItsLeavesAreIn) {
+    // Brute force over parent links: leaf l is in node n's subtree when n is l or an ancestor.
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<double> u(-3, 3);
+    for (std::size_t count : {1u, 2u, 3u, 7u, 50u}) {
+        std::vector<Aabb> leaves;
+        for (std::size_t i = 0; i < count; ++i) {
+            const Vec3 c(u(rng), u(rng), u(rng));
+            leaves.push_back({c.array() - 0.1, c.array() + 0.1});
+        }
+        Bvh<Aabb> tree;
+        tree.build(leaves);
+        const auto& nodes = tree.nodes();
+        ASSERT_EQ(nodes.size(), 2 * count - 1);
+        for (std::int32_t n = 0; n < std::int32_t(nodes.size()); ++n) {
+            std::size_t below = 0;
+            for (std::int32_t l = 0; l < std::int32_t(nodes.size()); ++l) {
+                bool inSubtree = false;
+                for (std::int32_t m = l; m >= 0 && !inSubtree; m = nodes[std::size_t(m)].parent) inSubtree = m == n;
+                EXPECT_EQ(inSubtree, l >= n && l < tree.subtreeEnd(n)) << "node " << n << ", node " << l;
+                below += inSubtree && nodes[std::size_t(l)].isLeaf();
+            }
+            EXPECT_EQ(tree.itemCount(n), below) << "node " << n;
+        }
+    }
+}

@@ -4,6 +4,7 @@
 // parts; both bounding volumes and both exact tests. Then what makes it coherent: a pair at
 // rest stops traversing, a moving pair traverses far less often than it queries, and a
 // rebuilt hierarchy is never answered from the old candidates.
+#include "collision/pair_query.hpp"
 #include "collision/triangle_queries.hpp"
 #include "flexfit/flexfit.hpp"
 #include "same_contacts.hpp"
@@ -61,6 +62,7 @@ Pose nudged(const Pose& pose, std::mt19937& rng, double shift, double turn) {
 struct Variant {
     BoundingVolumeKind kind;
     ExactTest test;
+    std::size_t leafGroup = detail::kDefaultLeafGroup;  // the traversals' (pair_query.hpp)
 };
 
 class CoherentQuery : public ::testing::TestWithParam<Variant> {};
@@ -73,8 +75,10 @@ struct PairRun {
     PartCollider ca, cb;
     ExactTest test;
     PairCoherence coherence;
+    detail::ScopedLeafGroup group;
 
-    PairRun(Part& a_, Part& b_, Variant v) : a(a_), b(b_), ca(a_, v.kind, v.test), cb(b_, v.kind, v.test), test(v.test) {}
+    PairRun(Part& a_, Part& b_, Variant v)
+        : a(a_), b(b_), ca(a_, v.kind, v.test), cb(b_, v.kind, v.test), test(v.test), group(v.leafGroup) {}
 
     void refit() {
         for (auto [part, collider] : {std::pair{&a, &ca}, std::pair{&b, &cb}}) {
@@ -165,9 +169,12 @@ TEST_P(CoherentQuery, TwoDeformingPartsGetTheFullQuerysContacts) {
 INSTANTIATE_TEST_SUITE_P(VolumesAndTests, CoherentQuery,
                          ::testing::Values(Variant{BoundingVolumeKind::Aabb, ExactTest::TriangleTriangle},
                                            Variant{BoundingVolumeKind::Sphere, ExactTest::TriangleTriangle},
-                                           Variant{BoundingVolumeKind::Aabb, ExactTest::SphereTriangle}),
+                                           Variant{BoundingVolumeKind::Aabb, ExactTest::SphereTriangle},
+                                           Variant{BoundingVolumeKind::Aabb, ExactTest::TriangleTriangle, 1},
+                                           Variant{BoundingVolumeKind::Sphere, ExactTest::TriangleTriangle, 8}),
                          [](const auto& variant) {
-                             return std::string(toString(variant.param.kind)) + "_" + std::string(toString(variant.param.test));
+                             return std::string(toString(variant.param.kind)) + "_" + std::string(toString(variant.param.test)) + "_group" +
+                                    std::to_string(variant.param.leafGroup);
                          });
 
 TEST(CoherentQueryCost, APairAtRestStopsTraversing) {

@@ -1,5 +1,6 @@
 // The narrow phase against brute force over every face pair, for random and perturbed meshes
 // in random poses, both volumes and both exact tests; frame invariance; refit against rebuild.
+#include "collision/pair_query.hpp"
 #include "collision/triangle_queries.hpp"
 #include "flexfit/flexfit.hpp"
 
@@ -73,9 +74,16 @@ FacePairs contactPairs(const std::vector<Contact>& contacts) {
 
 }  // namespace
 
-TEST(NarrowPhase, PlanePruningKeepsEveryContact) {
+// The traversal's leaf groups (pair_query.hpp) change which volume tests run, never the result:
+// the brute-force comparisons run with every node pair descended (1), small groups and one
+// larger than the trees' lower levels.
+class NarrowPhaseByLeafGroup : public ::testing::TestWithParam<std::size_t> {};
+INSTANTIATE_TEST_SUITE_P(LeafGroups, NarrowPhaseByLeafGroup, ::testing::Values(1, 2, 4, 64));
+
+TEST_P(NarrowPhaseByLeafGroup, PlanePruningKeepsEveryContact) {
     // Without a candidate list the query prunes by the rest planes of A's faces: the contacts
     // must still be exactly the brute force's, also where A's faces are deformed (not at rest).
+    const detail::ScopedLeafGroup grouping(GetParam());
     std::mt19937 rng(11);
     int withContacts = 0;
     for (int trial = 0; trial < 16; ++trial) {
@@ -102,7 +110,8 @@ TEST(NarrowPhase, PlanePruningKeepsEveryContact) {
     EXPECT_GT(withContacts, 8);
 }
 
-TEST(NarrowPhase, CandidatesAndContactsEqualBruteForce) {
+TEST_P(NarrowPhaseByLeafGroup, CandidatesAndContactsEqualBruteForce) {
+    const detail::ScopedLeafGroup grouping(GetParam());
     std::mt19937 rng(10);
     const BoundingVolumeKind kinds[2] = {BoundingVolumeKind::Sphere, BoundingVolumeKind::Aabb};
     int withContacts = 0;
