@@ -8,8 +8,12 @@
 // element the header declares, in its order, with properties of any of the eight scalar types
 // (`char`..`double` and their `int8`..`float64` names) and lists. The `vertex` element's x, y
 // and z give the vertices; the `face` element's `vertex_indices` (or `vertex_index`) list the
-// polygons, triangulated as in OBJ. Other elements and properties (colours, normals, texture
-// coordinates, edges, materials) are read past. ASCII files hold one element per line.
+// polygons, triangulated as in OBJ; a `tristrips` element's `vertex_indices` lists triangle
+// strips (as scanners of the Stanford repository's era wrote them), -1 ending a strip: triangle
+// k of a strip is (s_k, s_k+1, s_k+2), every other one turned to keep the strip's winding, and
+// those with a repeated corner (how strips join and turn) are part of the encoding, not faces.
+// Other elements and properties (colours, normals, texture coordinates, edges, materials) are
+// read past. ASCII files hold one element per line.
 // Header lines that are not PLY are read past with a warning (Blender 2.4 wrote one).
 // Refused, each with its place: a missing `ply` line, an unknown format or type, a header
 // without `end_header`, no x/y/z, no faces (point clouds), a face of fewer than 3 corners or with
@@ -157,13 +161,21 @@ PlyHeader readHeader(std::string_view text, const std::string& source) {
     return header;
 }
 
-// The vertex and face elements located, and checked for what the mesh needs.
+// A face or strip element's list of vertex indices, checked.
+void locateCorners(PlyElement& e, const std::string& source) {
+    e.corners = propertyIndex(e, {"vertex_indices", "vertex_index"});
+    if (e.corners < 0 || !e.properties[std::size_t(e.corners)].countType || isFloating(e.properties[std::size_t(e.corners)].type))
+        throw InputError(source, 0, "the " + e.name + " element needs a vertex_indices list of integers");
+}
+
+// The vertex, face and tristrips elements located, and checked for what the mesh needs.
 void locateMesh(PlyHeader& header, const std::string& source) {
     PlyElement* vertex = nullptr;
     PlyElement* face = nullptr;
+    PlyElement* strips = nullptr;
     PlyElement* unused = nullptr;
     for (PlyElement& e : header.elements) {
-        PlyElement*& slot = e.name == "vertex" ? vertex : e.name == "face" ? face : unused;
+        PlyElement*& slot = e.name == "vertex" ? vertex : e.name == "face" ? face : e.name == "tristrips" ? strips : unused;
         if (&slot != &unused && slot != nullptr) throw InputError(source, 0, "two '" + e.name + "' elements: one of each is read");
         slot = &e;
     }
@@ -176,11 +188,10 @@ void locateMesh(PlyHeader& header, const std::string& source) {
             throw InputError(source, 0, "the vertex element needs x, y and z properties (not lists)");
     if (vertex->count > std::int64_t(std::numeric_limits<Index>::max()))
         throw InputError(source, 0, std::to_string(vertex->count) + " vertices exceed the supported maximum");
-    if (face == nullptr || face->count == 0) throw InputError(source, 0, "no faces: a point cloud cannot be simulated");
-    face->corners = propertyIndex(*face, {"vertex_indices", "vertex_index"});
-    if (face->corners < 0 || !face->properties[std::size_t(face->corners)].countType ||
-        isFloating(face->properties[std::size_t(face->corners)].type))
-        throw InputError(source, 0, "the face element needs a vertex_indices list of integers");
+    if ((face == nullptr || face->count == 0) && (strips == nullptr || strips->count == 0))
+        throw InputError(source, 0, "no faces: a point cloud cannot be simulated");
+    for (PlyElement* e : {face, strips})
+        if (e != nullptr) locateCorners(*e, source);
 }
 
 // What the elements give the mesh, and where each polygon came from.
@@ -330,14 +341,30 @@ void readVertex(const PlyElement& e, ValueSource& in, PlyContent& out) {
     if (in.line() > 0) out.lines.vertexLine.push_back(in.line());
 }
 
-void readFace(const PlyElement& e, std::int64_t vertexCount, ValueSource& in, PlyContent& out) {
+// Triangle k of a strip is (s_k, s_k+1, s_k+2), odd ones turned so the strip keeps one winding;
+// a triangle with a repeated corner joins or turns the strip and is no face.
+void addStrip(const std::vector<Index>& s, std::vector<Face>& faces) {
+    for (std::size_t k = 0; k + 2 < s.size(); ++k) {
+        const Face f = k % 2 == 0 ? Face{s[k], s[k + 1], s[k + 2]} : Face{s[k + 1], s[k], s[k + 2]};
+        if (f[0] != f[1] && f[1] != f[2] && f[0] != f[2]) faces.push_back(f);
+    }
+}
+
+// An instance of a face or strip element: its other properties read past, its list of vertex
+// indices handed to corners(count, property) to read.
+template <class Corners>
+void readCornerList(const PlyElement& e, ValueSource& in, Corners corners) {
     for (std::size_t i = 0; i < e.properties.size(); ++i) {
         const PlyProperty& property = e.properties[i];
-        if (int(i) != e.corners) {
+        if (int(i) == e.corners)
+            corners(in.integer(*property.countType), property);
+        else
             in.skip(property);
-            continue;
-        }
-        const std::int64_t n = in.integer(*property.countType);
+    }
+}
+
+void readFace(const PlyElement& e, std::int64_t vertexCount, ValueSource& in, PlyContent& out) {
+    readCornerList(e, in, [&](std::int64_t n, const PlyProperty& property) {
         if (n < 3) in.fail("a face needs 3 corners, found " + std::to_string(n));
         out.corners.clear();
         for (std::int64_t k = 0; k < n; ++k) {
@@ -347,9 +374,28 @@ void readFace(const PlyElement& e, std::int64_t vertexCount, ValueSource& in, Pl
                         " vertices, numbered from 0)");
             out.corners.push_back(Index(v));
         }
-    }
+    });
     // The corners are checked against the vertex count, but the vertices come first only when
     // the header says so: triangulated once every element is read.
+}
+
+// A tristrips instance's strips as triangles (into out.mesh.faces, vertices checked later).
+void readStrips(const PlyElement& e, std::int64_t vertexCount, ValueSource& in, PlyContent& out) {
+    readCornerList(e, in, [&](std::int64_t n, const PlyProperty& property) {
+        std::vector<Index> strip;
+        for (std::int64_t k = 0; k <= n; ++k) {
+            const std::int64_t v = k < n ? in.integer(property.type) : -1;
+            if (v == -1) {
+                addStrip(strip, out.mesh.faces);
+                strip.clear();
+                continue;
+            }
+            if (v < 0 || v >= vertexCount)
+                in.fail("strip corner " + std::to_string(v) + " out of range (the file has " + std::to_string(vertexCount) +
+                        " vertices, numbered from 0; -1 ends a strip)");
+            strip.push_back(Index(v));
+        }
+    });
 }
 
 }  // namespace
@@ -367,6 +413,7 @@ MeshReadResult parsePly(std::string_view text, const std::string& source, const 
         std::size_t line;
     };
     std::vector<Polygon> polygons;
+    std::vector<std::size_t> stripLines;  // (strip triangles) the line of each, ASCII only
     for (const PlyElement& e : header.elements) {
         if (e.properties.empty()) continue;  // its instances take no bytes, no values
         for (std::int64_t i = 0; i < e.count; ++i) {
@@ -378,6 +425,9 @@ MeshReadResult parsePly(std::string_view text, const std::string& source, const 
             } else if (e.name == "face") {
                 readFace(e, vertexCount, in, content);
                 polygons.push_back({content.corners, in.line()});
+            } else if (e.name == "tristrips") {
+                readStrips(e, vertexCount, in, content);
+                if (in.line() > 0) stripLines.resize(content.mesh.faces.size(), in.line());
             } else {
                 for (const PlyProperty& p : e.properties) in.skip(p);
             }
@@ -385,6 +435,8 @@ MeshReadResult parsePly(std::string_view text, const std::string& source, const 
         }
     }
     in.requireEnd();
+    // The strips' triangles first (read into the faces), then the polygons'.
+    content.lines.faceLine = std::move(stripLines);
     for (const Polygon& polygon : polygons) {
         if (!detail::triangulatePolygon(content.mesh.vertices, polygon.corners, content.mesh.faces)) ++content.fanned;
         if (polygon.line > 0) content.lines.faceLine.resize(content.mesh.faces.size(), polygon.line);

@@ -19,6 +19,8 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <set>
+#include <cmath>
 #include <string>
 
 namespace flexfit {
@@ -140,6 +142,98 @@ TEST(PlyIo, AHeaderLineThatIsNotPlyIsReadPastWithAWarning) {
                                                          "property list uchar uint vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
     ASSERT_FALSE(r.diagnostics.warnings.empty());
     EXPECT_TRUE(contains(r.diagnostics.warnings[0], "line 3")) << r.diagnostics.warnings[0];
+}
+
+// Triangle strips: a height field of (kColumns + 1) x (kRows + 1) vertices, one strip per row of
+// cells zig-zagging between the row's upper (a) and lower (b) vertices, -1 between rows. The
+// reference is each cell's two triangles written out, both wound with +z up.
+constexpr Index kColumns = 5, kRows = 3;
+Index gridVertex(Index column, Index row) { return row * (kColumns + 1) + column; }
+
+std::vector<Vec3> gridVertices() {
+    std::vector<Vec3> vertices;
+    for (Index row = 0; row <= kRows; ++row)
+        for (Index column = 0; column <= kColumns; ++column)
+            vertices.push_back(Vec3(column, row, 0.1 * std::sin(double(column + 2 * row))));
+    return vertices;
+}
+
+std::vector<std::int64_t> gridStrips() {
+    std::vector<std::int64_t> strips;
+    for (Index row = 0; row < kRows; ++row) {
+        if (row > 0) strips.push_back(-1);
+        for (Index column = 0; column <= kColumns; ++column) {
+            strips.push_back(gridVertex(column, row + 1));
+            strips.push_back(gridVertex(column, row));
+        }
+    }
+    strips.push_back(gridVertex(kColumns, kRows - 1));  // a repeated corner: a degenerate triangle, no face
+    return strips;
+}
+
+// A triangle as its corners turned to start at the smallest index (same winding).
+Face canonical(Face f) {
+    std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
+    return f;
+}
+
+std::set<Face> canonicalFaces(const std::vector<Face>& faces) {
+    std::set<Face> out;
+    for (const Face& f : faces) out.insert(canonical(f));
+    return out;
+}
+
+TEST(PlyIo, TriangleStripsGiveEachCellsTwoTrianglesInTheStripsWinding) {
+    std::vector<Face> expected;
+    for (Index row = 0; row < kRows; ++row)
+        for (Index column = 0; column < kColumns; ++column) {
+            const Index a = gridVertex(column, row + 1), b = gridVertex(column, row);
+            const Index a1 = gridVertex(column + 1, row + 1), b1 = gridVertex(column + 1, row);
+            expected.push_back({a, b, a1});
+            expected.push_back({a1, b, b1});
+        }
+    const std::vector<Vec3> vertices = gridVertices();
+    const std::vector<std::int64_t> strips = gridStrips();
+    std::string ascii = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(vertices.size()) +
+                        "\nproperty double x\nproperty double y\nproperty double z\nelement tristrips 1\n"
+                        "property list int int vertex_indices\nend_header\n";
+    char line[96];
+    for (const Vec3& v : vertices) {
+        std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", v.x(), v.y(), v.z());
+        ascii += line;
+    }
+    ascii += std::to_string(strips.size());
+    for (std::int64_t v : strips) {
+        ascii += ' ';
+        ascii += std::to_string(v);
+    }
+    ascii += "\n";
+    std::string binary = "ply\nformat binary_big_endian 1.0\nelement vertex " + std::to_string(vertices.size()) +
+                         "\nproperty double x\nproperty double y\nproperty double z\nelement tristrips 1\n"
+                         "property list uint short vertex_indices\nend_header\n";
+    for (const Vec3& v : vertices)
+        for (int k = 0; k < 3; ++k) put(binary, v[k], true);
+    put(binary, std::uint32_t(strips.size()), true);
+    for (std::int64_t v : strips) put(binary, std::int16_t(v), true);
+    TempDir dir;
+    for (const auto& [name, text] : {std::pair<std::string, std::string>{"strips.ply", ascii}, {"strips_binary.ply", binary}}) {
+        const MeshReadResult r = readMesh(dir.write(name, text));
+        EXPECT_EQ(r.mesh.vertices, vertices) << name;
+        EXPECT_EQ(r.mesh.faces.size(), expected.size()) << name;
+        EXPECT_EQ(canonicalFaces(r.mesh.faces), canonicalFaces(expected)) << name;
+        // Nothing repaired (no face dropped or flipped): only the grid's border is reported.
+        ASSERT_EQ(r.diagnostics.warnings.size(), 1u) << name << ": " << r.diagnostics.warnings[0];
+        EXPECT_TRUE(contains(r.diagnostics.warnings[0], std::to_string(2 * (kColumns + kRows)) + " boundary edges")) << r.diagnostics.warnings[0];
+    }
+    // A strip corner out of range is named with its line; a file of strips that give no
+    // triangle has no faces.
+    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                               "element tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+    testing::expectReadErrors("m.ply", {
+        {header + "4 0 1 -1 5\n", 13, "strip corner 5 out of range"},
+        {header + "4 0 1 -1 -2\n", 13, "strip corner -2 out of range"},
+        {header + "3 0 1 1\n", 0, "no triangles"},
+    });
 }
 
 TEST(PlyIo, ProblemsNameTheirLine) {
