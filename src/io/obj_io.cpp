@@ -7,8 +7,9 @@
 // refer forward), polygons of more than 3 corners triangulated in their own plane (Newell's
 // normal): a convex one as a fan from its first corner, a concave one by ear clipping (a
 // self-intersecting one, which has no proper triangulation, as a fan). Ignored: comments (`#` to the end of any line), texture
-// coordinates and normals, groups, objects, smoothing groups, materials. Refused: points and
-// lines (`p`, `l`) and free-form geometry, which cannot be triangulated.
+// coordinates and normals, groups, objects, smoothing groups, materials. A `\` ending a line
+// continues the statement on the next (problems are named at its first line). Refused: points
+// and lines (`p`, `l`) and free-form geometry, which cannot be triangulated.
 #include "flexfit/mesh_io.hpp"
 #include "io_internal.hpp"
 #include "polygons.hpp"
@@ -61,6 +62,23 @@ void readFace(const detail::TextLine& line, std::size_t vertexCount, const std::
     polygons.push_back(std::move(polygon));
 }
 
+// The next statement: a line with its comment cut, and the lines a trailing `\` continues it
+// on. False at the end of the text.
+bool nextStatement(detail::LineCursor& cursor, detail::TextLine& statement) {
+    if (!cursor.next(statement)) return false;
+    detail::cutComment(statement);  // `f 1 2 3 # a note` is a face
+    detail::TextLine more;
+    while (!statement.tokens.empty() && statement.tokens.back().ends_with('\\')) {
+        std::string_view& last = statement.tokens.back();
+        last.remove_suffix(1);
+        if (last.empty()) statement.tokens.pop_back();
+        if (!cursor.next(more)) break;
+        detail::cutComment(more);
+        statement.tokens.insert(statement.tokens.end(), more.tokens.begin(), more.tokens.end());
+    }
+    return true;
+}
+
 }  // namespace
 
 MeshReadResult parseObj(std::string_view text, const std::string& source, const MeshReadOptions& options) {
@@ -69,8 +87,7 @@ MeshReadResult parseObj(std::string_view text, const std::string& source, const 
     TriMesh mesh;
     MeshSourceLines lines;
     std::vector<RawPolygon> polygons;
-    for (detail::TextLine line; cursor.next(line);) {
-        detail::cutComment(line);  // `f 1 2 3 # a note` is a face
+    for (detail::TextLine line; nextStatement(cursor, line);) {
         if (line.tokens.empty()) continue;
         const std::string_view keyword = line.tokens[0];
         if (keyword == "v") {

@@ -136,6 +136,22 @@ TEST(ObjIo, CommentsEndAnyLine) {
     EXPECT_TRUE(r.diagnostics.closed());
 }
 
+TEST(ObjIo, ABackslashEndingALineContinuesItsStatement) {
+    // The tetrahedron of CommentsEndAnyLine with statements split over lines, the backslash
+    // alone or after a token, a comment after a continued part; and the same file unsplit.
+    TempDir dir;
+    const MeshReadResult split = readMesh(dir.write("split.obj", "v 0 0 \\\n  0\nv 1\\\n 0 0\nv 0 1 0\nv 0 0 1\n"
+                                                                   "f 1 3 \\\n2 # bottom\nf \\\n 1 \\\n 2 \\\n 4\nf 2 3 4\nf 1 4 3 \\\n"));
+    const MeshReadResult whole = readMesh(dir.write("whole.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n"));
+    EXPECT_EQ(split.mesh.vertices, whole.mesh.vertices);
+    EXPECT_EQ(split.mesh.faces, whole.mesh.faces);
+    EXPECT_EQ(split.mesh.faces, (std::vector<Face>{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}));
+    // A problem in a continued statement is named at its first line.
+    const InputError e = readError("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 \\\n 2 \\\n 9\n");
+    EXPECT_EQ(e.line(), 4u) << e.what();
+    EXPECT_TRUE(contains(e.problem(), "face corner 9 out of range")) << e.what();
+}
+
 TEST(ObjIo, ProblemsNameTheirLine) {
     struct Case {
         const char* text;
