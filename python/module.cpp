@@ -299,9 +299,10 @@ void addPartReaders(Class& c, Get get) {
                                "The part's model (shared, immutable).")
         .def_property_readonly("positions", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().positions, self, true); },
                                "Mass positions in the part frame (the mesh's vertex order), a read-only (n, 3) view of the state, or a read-only copy when "
-                               "the model's masses are renumbered (non-moving masses at rest).")
+                               "the masses are not the vertices (renumbered, or a file whose vertices were welded or removed: then vertex_count rows; "
+                               "non-moving masses at rest).")
         .def_property_readonly("velocities", [get](py::object self) { return vertexRows(get(self).model(), get(self).state().velocities, self, false); },
-                               "Mass velocities (part frame, the mesh's vertex order), a read-only (n, 3) view, or a copy when the masses are renumbered.")
+                               "Mass velocities (part frame, the mesh's vertex order), a read-only (n, 3) view, or a copy when the masses are not the vertices.")
         .def_property_readonly("moving_masses", [get](py::object self) {
             const Part& part = get(self);
             std::vector<Index> vertices;
@@ -428,7 +429,7 @@ PYBIND11_MODULE(_flexfit, m) {
         }, "The simulation mesh as given (rest shape, part frame; for a scene part whose file lost vertices to welding or repair, "
            "the file's vertices with the repaired faces over them).")
         .def_property_readonly("rest_positions", [](py::object self) { return vertexRows(self.cast<const PartModel&>(), self.cast<const PartModel&>().restPositions, self, true); },
-                               "Rest positions, a read-only (n, 3) array (a view unless the masses are renumbered).")
+                               "Rest positions, a read-only (n, 3) array (a view unless the masses are not the vertices).")
         .def_property_readonly("renumbered", &PartModel::renumbered, "Whether the masses are the mesh's vertices renumbered (vertex_order='locality').")
         .def_property_readonly("mass_of_vertex", [](const PartModel& model) {
             std::vector<std::int64_t> masses(model.vertexCount());

@@ -176,7 +176,7 @@ void showPart(const Part& part, const std::vector<Vec3>& massNormals, const std:
     if (!drawn) {  // the masses, in the user's vertex order (drawnMesh()'s faces)
         part.drawnPositions(out.positions);
         inVertexOrder<Vec3>(model, massNormals, out.normals, [](Index) { return Vec3(Vec3::UnitY()); });
-        inVertexOrder<Vec3>(model, massColours, out.colours);
+        inVertexOrder<Vec3>(model, massColours, out.colours);  // a removed file vertex: black, in no face
         return;
     }
     part.drawnPositions(out.positions);

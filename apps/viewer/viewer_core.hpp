@@ -124,8 +124,9 @@ struct ShownSurface {
     std::vector<Vec3> positions, normals, colours;
 };
 // `massNormals`: the simulated surface's normals (SurfaceNormals), used when the part has no
-// drawn mesh of its own. A model whose masses are renumbered (VertexOrder::Locality) shows
-// them in its given mesh's vertex order, the order of drawnMesh()'s faces.
+// drawn mesh of its own. A model whose masses are renumbered (VertexOrder::Locality) or whose
+// file lost vertices to welding or repair shows them in the user's vertex order (the file's),
+// the order of drawnMesh()'s faces.
 void showPart(const Part& part, const std::vector<Vec3>& massNormals, const std::vector<Vec3>& massColours, ShownSurface& out);
 
 // The model a material change restarts a part with: the same mesh as given, its masses on the

@@ -73,8 +73,9 @@ struct FileVertices {
     std::size_t count() const { return meshVertex.size(); }
 };
 
-// The file's vertices (all of them, at the file's positions) with `mesh`'s faces, each corner
-// named by the first file vertex that became it: the mesh as the user's file numbers it.
+// The file's vertices (all of them: each at the position of the mesh vertex it became, a removed
+// one at its file position) with `mesh`'s faces, each corner named by the first file vertex
+// that became it: the mesh as the user's file numbers it.
 TriMesh inFileOrder(const TriMesh& mesh, const FileVertices& file);
 // For each mesh vertex, the first file vertex that became it (kNoVertex: none did).
 VertexMap firstFileVertices(const FileVertices& file, std::size_t meshVertexCount);

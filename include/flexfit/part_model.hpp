@@ -135,15 +135,17 @@ struct PartModel {
     bool hasSpringBlocks() const;
     // The drawn mesh tied to the simulation surface; null when the simulation mesh is drawn.
     std::shared_ptr<const SurfaceEmbedding> drawn;
-    // What the part looks like at rest: the drawn mesh, else the simulation mesh as given.
+    // What the part looks like at rest: the drawn mesh, else the simulation mesh as the user
+    // numbers it (userMesh()).
     const TriMesh& drawnMesh() const;
 
     // The masses' order (VertexOrder::Locality). When the build renumbered the given mesh's
     // vertices, mass massOfVertex[v] is its vertex v and vertexOfMass[m] is mass m's vertex;
     // `mesh`, restPositions, topology and every per-mass and per-spring array are in mass order
-    // (faces keep their order and indices), and givenMesh is the mesh as given, which drawnMesh()
-    // returns when there is no drawn mesh: frames and the viewer show the user's vertices in their
-    // order. Empty (and givenMesh null): mass i is vertex i.
+    // (faces keep their order and indices), and givenMesh is the mesh as given, which userMesh()
+    // and drawnMesh() return when there is neither a file numbering nor a drawn mesh: frames and
+    // the viewer show the user's vertices in their order. Empty (and givenMesh null): mass i is
+    // vertex i.
     std::vector<Index> massOfVertex;  // (V or 0)
     std::vector<Index> vertexOfMass;  // (V or 0)
     std::shared_ptr<const TriMesh> givenMesh;
@@ -195,7 +197,7 @@ void inGivenVertexOrder(const PartModel& model, std::span<const T> perMass, std:
 
 // Per-mass values in the user's vertex order (PartModel::vertexCount() of them): a file
 // vertex welded into another repeats its value; a removed one gets removed(vertex), by default
-// T{} (no displacement, no velocity, no zone).
+// zero (no displacement, no velocity; Eigen's T{} would be uninitialised).
 template <class T, class Removed>
 void inVertexOrder(const PartModel& model, std::span<const T> perMass, std::vector<T>& out, Removed removed) {
     if (!model.file) return inGivenVertexOrder(model, perMass, out);
@@ -206,7 +208,12 @@ void inVertexOrder(const PartModel& model, std::span<const T> perMass, std::vect
 }
 template <class T>
 void inVertexOrder(const PartModel& model, std::span<const T> perMass, std::vector<T>& out) {
-    inVertexOrder(model, perMass, out, [](Index) { return T{}; });
+    inVertexOrder(model, perMass, out, [](Index) {
+        if constexpr (requires { T::Zero(); })
+            return T(T::Zero());
+        else
+            return T{};
+    });
 }
 
 }  // namespace flexfit

@@ -179,7 +179,7 @@ bool stillTooFast(const PartCollider& colliderA, const PartCollider& colliderB, 
 }
 
 // The next list's walk: started at kWalkStart of the margin, 1 / kWalkShare of the last
-// traversal's node pairs a query (at least kMinWalkNodes).
+// traversal's volume tests a query (at least kMinWalkNodes).
 constexpr double kWalkStart = 0.25;
 constexpr std::size_t kWalkShare = 8;
 constexpr std::size_t kMinWalkNodes = 256;

@@ -26,7 +26,7 @@ inline Aabb grown(const Aabb& b, double margin) { return {b.min.array() - margin
 // prune(faceA, volumeB) may cut a subtree of B that cannot touch A's leaf face. A margin > 0
 // grows A's volumes by it (for the coherent query's candidates); which side descends depends
 // on the volumes alone, not on the margin. traverseFrom() goes on from the node pairs left in
-// `stack`, at most `budget` of them, and can be resumed (the coherent query spreads a traversal
+// `stack` for about `budget` volume tests, and can be resumed (the coherent query spreads a traversal
 // over several queries); traverse() is one whole traversal.
 using NodePairStack = std::vector<std::pair<std::int32_t, std::int32_t>>;
 
@@ -59,11 +59,13 @@ bool volumesOverlap(const VA& a, const VB& b, const RelativePose& bInA, double m
 }
 
 // Every leaf pair of the subtrees of nodes i (of A) and j (of B), by the leaves' volumes.
+// Returns the volume tests made.
 template <bool kGrown, class BA, class BB, class LeafPair>
-void testLeafGroup(std::int32_t i, std::int32_t j, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, QueryStats& stats,
-                   LeafPair& leafPair, double margin) {
+std::size_t testLeafGroup(std::int32_t i, std::int32_t j, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, QueryStats& stats,
+                          LeafPair& leafPair, double margin) {
     const auto& na = a.nodes();
     const auto& nb = b.nodes();
+    const std::size_t before = stats.volumeTests;
     for (std::int32_t p = i; p < a.subtreeEnd(i); ++p) {
         const auto& x = na[std::size_t(p)];
         if (!x.isLeaf()) continue;
@@ -76,6 +78,7 @@ void testLeafGroup(std::int32_t i, std::int32_t j, const Bvh<BA>& a, const Bvh<B
             leafPair(x.item, y.item);
         }
     }
+    return stats.volumeTests - before;
 }
 
 template <bool kGrown, class BA, class BB, class LeafPair, class Prune>
@@ -84,6 +87,7 @@ void traverseFromImpl(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a
     const auto& na = a.nodes();
     const auto& nb = b.nodes();
     const std::size_t group = leafGroup();
+    // `budget` counts volume tests: a leaf group's tests count each.
     for (std::size_t visited = 0; !stack.empty() && visited < budget; ++visited) {
         const auto [i, j] = stack.back();
         stack.pop_back();
@@ -93,7 +97,7 @@ void traverseFromImpl(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a
         if (!volumesOverlap<kGrown>(x.volume, y.volume, bInA, margin)) continue;
         if (x.isLeaf() && !y.isLeaf() && prune(x.item, y.volume)) continue;
         if (!(x.isLeaf() && y.isLeaf()) && a.itemCount(i) <= group && b.itemCount(j) <= group) {
-            testLeafGroup<kGrown>(i, j, a, b, bInA, stats, leafPair, margin);
+            visited += testLeafGroup<kGrown>(i, j, a, b, bInA, stats, leafPair, margin);
             continue;
         }
         if (x.isLeaf() && y.isLeaf()) {

@@ -237,6 +237,8 @@ TriMesh inFileOrder(const TriMesh& mesh, const FileVertices& file) {
     if (file.empty()) return mesh;
     const VertexMap first = firstFileVertices(file, mesh.vertices.size());
     TriMesh out{mesh.name, file.positions, mesh.faces};
+    for (std::size_t u = 0; u < file.count(); ++u)
+        if (file.meshVertex[u] != kNoVertex) out.vertices[u] = mesh.vertices[file.meshVertex[u]];
     for (Face& f : out.faces)
         for (Index& v : f) v = first[v];
     return out;

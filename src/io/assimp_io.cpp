@@ -94,7 +94,7 @@ MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadO
         if (!mesh.vertices[v].allFinite())
             throw InputError(file, lineOfNonFiniteToken(path), "a vertex has a NaN or infinite coordinate");
 
-    return finishRead(std::move(mesh), file, {}, options, true);  // one vertex per corner in STL: weld identical ones
+    return finishRead(std::move(mesh), file, {}, options, FormatWelding::PerCorner);  // one vertex per corner in STL: weld identical ones
 }
 
 }  // namespace flexfit

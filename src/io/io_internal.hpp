@@ -27,9 +27,18 @@ using TextMeshParser = MeshReadResult (*)(std::string_view text, const std::stri
 // A text file parsed by `parse`, the mesh named after the file's stem.
 MeshReadResult readTextMesh(const std::filesystem::path& path, const MeshReadOptions& options, TextMeshParser parse);
 
+// The welding a format needs before the repair (identical positions merged).
+enum class FormatWelding {
+    None,        // the file's vertices are distinct (.tri)
+    Repeats,     // a file that lists shared vertices repeats some (OBJ, OFF, PLY): the file's
+                 // numbering is kept through the weld (MeshReadResult::fileVertices)
+    PerCorner,   // one vertex per face corner (STL, through assimp): the welded vertices, in
+                 // first-use order, are the file's numbering
+};
+
 // What every reader does with the mesh it parsed (`lines`: where its vertices and faces were,
-// when known): the asked-for welding (or the format's, `formatWelds`: identical positions),
-// then the repair or the strict check, then validation.
+// when known): the asked-for welding (or the format's: identical positions), then the repair or
+// the strict check, then validation.
 MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSourceLines& lines, const MeshReadOptions& options,
-                          bool formatWelds);
+                          FormatWelding formatWelding);
 }

@@ -56,7 +56,7 @@ MeshReadResult finishPolygonRead(TriMesh mesh, const std::string& source, const 
                                  std::size_t fanned) {
     if (mesh.faces.empty()) throw InputError(source, 0, "empty mesh: no triangles");
     const std::size_t repeats = repeatedPositions(mesh.vertices);
-    MeshReadResult result = finishRead(std::move(mesh), source, lines, options, repeats > 0);
+    MeshReadResult result = finishRead(std::move(mesh), source, lines, options, repeats > 0 ? FormatWelding::Repeats : FormatWelding::None);
     std::vector<std::string>& warnings = result.diagnostics.warnings;
     if (fanned > 0)
         warnings.insert(warnings.begin(), std::to_string(fanned) + " polygons cross themselves (or are flat) and were split as fans: "
@@ -75,10 +75,10 @@ MeshReadResult readTextMesh(const std::filesystem::path& path, const MeshReadOpt
 }
 
 MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSourceLines& lines, const MeshReadOptions& options,
-                          bool formatWelds) {
+                          FormatWelding formatWelding) {
     detail::requireWellFormed(mesh, source, lines);
     MeshReadResult result;
-    const bool welds = formatWelds || options.weldTolerance.has_value();
+    const bool welds = formatWelding != FormatWelding::None || options.weldTolerance.has_value();
     if (welds && !options.repair) requireNoCollapse(mesh, options.weldTolerance.value_or(0.0), source, lines);
     FileVertices file{{}, mesh.vertices};
     if (welds) {  // indices change: the lines no longer match the faces
@@ -86,6 +86,7 @@ MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSou
         result.collapsedFaces = weldVertices(mesh, options.weldTolerance.value_or(0.0), &file.meshVertex);
         result.weldedVertices = before - mesh.vertices.size();
     }
+    if (formatWelding == FormatWelding::PerCorner) file = {{}, mesh.vertices};  // numbered as welded
     const MeshSourceLines none;
     const MeshSourceLines& where = welds ? none : lines;
     const double tolerance = options.weldTolerance.value_or(-1.0);  // < 0: near-duplicates
@@ -97,7 +98,8 @@ MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSou
         if (file.meshVertex.empty()) file.meshVertex = result.repairs.vertexMap;
         else composeVertexMap(file.meshVertex, result.repairs.vertexMap);
     }
-    if (result.weldedVertices > 0 || !result.repairs.vertexMap.empty()) result.fileVertices = std::move(file);
+    if (!file.meshVertex.empty() && (file.count() != mesh.vertices.size() || !result.repairs.vertexMap.empty()))
+        result.fileVertices = std::move(file);
     result.diagnostics = validateMesh(mesh, source);
     std::vector<std::string> warnings = result.repairs.warnings();
     if (result.collapsedFaces > 0) warnings.push_back(std::to_string(result.collapsedFaces) + " faces collapsed by welding and were removed");

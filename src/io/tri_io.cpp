@@ -116,7 +116,7 @@ MeshReadResult parseTri(std::string_view text, const std::string& source, const 
         throw InputError(source, extra.number, "unexpected data after the last face: the header's counts (" +
                                                    std::to_string(vertexCount) + " vertices, " + std::to_string(faceCount) +
                                                    " faces) do not match the file");
-    return finishRead(std::move(mesh), source, lines, options, false);  // .tri shares vertices: no format welding
+    return finishRead(std::move(mesh), source, lines, options, FormatWelding::None);  // .tri shares vertices: no format welding
 }
 
 MeshReadResult readTri(const std::filesystem::path& path, const MeshReadOptions& options) {

@@ -12,8 +12,8 @@ SceneRun::SceneRun(const Scene& scene) : scene_(scene), world_(std::make_unique<
 
 namespace {
 
-// A scene's mass index names the given mesh's vertex (PartModel::massOf); one out of range (a
-// scene built in code) passes through for the world to refuse.
+// A scene's mass index names the user's vertex (the file's: PartModel::massOf); one out of range
+// (a scene built in code) passes through for the world to refuse.
 Index massOfVertexOf(const World& world, BodyId body, Index vertex) {
     return body < world.bodyCount() ? world.part(body).model().massOf(vertex) : vertex;
 }

@@ -344,5 +344,39 @@ TEST(MeshIo, FileVerticesFollowEveryWeldAndRemovalInEveryFormat) {
     EXPECT_TRUE(clean.fileVertices.empty());
 }
 
+// STL stores one vertex per face corner: its welded vertices (first-use order) are the file's
+// numbering, so a clean STL has no map, and one whose repair welds a near-duplicate maps the
+// welded vertices, not its 3F corners.
+TEST(MeshIo, StlIsNumberedByItsWeldedVertices) {
+    TempDir dir;
+    TriMesh sphere = makeIcoSphere(1.0, 1);
+    const auto stl = [](const TriMesh& mesh) {
+        std::ostringstream out;
+        out << "solid s\n";
+        char line[160];
+        for (const Face& f : mesh.faces) {
+            out << "facet normal 0 0 0\nouter loop\n";
+            for (Index v : f) {
+                std::snprintf(line, sizeof line, "vertex %.9g %.9g %.9g\n", mesh.vertices[v].x(), mesh.vertices[v].y(), mesh.vertices[v].z());
+                out << line;
+            }
+            out << "endloop\nendfacet\n";
+        }
+        out << "endsolid s\n";
+        return out.str();
+    };
+    const MeshReadResult clean = readMesh(dir.write("clean.stl", stl(sphere)));
+    EXPECT_EQ(clean.mesh.vertices.size(), sphere.vertices.size());
+    EXPECT_TRUE(clean.fileVertices.empty());
+    // Face 7's first corner written 1e-6 away (a crack the repair welds; float-exact apart).
+    TriMesh cracked = sphere;
+    cracked.vertices.push_back(sphere.vertices[sphere.faces[7][0]] + Vec3(1e-6, 0, 0));
+    cracked.faces[7][0] = Index(cracked.vertices.size() - 1);
+    const MeshReadResult r = readMesh(dir.write("cracked.stl", stl(cracked)));
+    EXPECT_EQ(r.mesh.vertices.size(), sphere.vertices.size());
+    EXPECT_EQ(r.repairs.weldedVertices, 1u);
+    EXPECT_EQ(r.fileVertices.count(), sphere.vertices.size() + 1) << "the welded vertices, not the 3F corners";
+}
+
 }  // namespace
 }  // namespace flexfit

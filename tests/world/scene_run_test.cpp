@@ -643,6 +643,12 @@ TEST(SceneRun, AFileThatLosesVerticesToTheRepairKeepsItsNumberingInEveryOutput) 
     ASSERT_EQ(depths.size(), damaged.vertices.size());
     EXPECT_EQ(depths[fileOf(77)], 0.0) << "a zone is seeded at the kicked file vertex";
     EXPECT_EQ(depths[10], -1.0) << "the stray vertex is in no zone";
+    for (const char* field : {"Name=\"displacement\"", "Name=\"velocity\""}) {
+        const std::vector<double> values = numbers(vtkSection(vtk, field));
+        ASSERT_EQ(values.size(), 3 * damaged.vertices.size()) << field;
+        EXPECT_EQ(Vec3(values[30], values[31], values[32]), Vec3::Zero()) << field << ": the stray vertex does not deform";
+        EXPECT_GT(Vec3(values[3 * fileOf(77)], values[3 * fileOf(77) + 1], values[3 * fileOf(77) + 2]).norm(), 0.0) << field;
+    }
     const std::vector<double> points = numbers(vtkSection(vtk, "<Points>\n<DataArray"));
     ASSERT_EQ(points.size(), 3 * damaged.vertices.size());
     for (std::size_t v = 0; v < damaged.vertices.size(); ++v)
