@@ -371,15 +371,29 @@ PYBIND11_MODULE(_flexfit, m) {
         }, "Vertex indices of each face, a read-only (m, 3) view.")
         .def("__repr__", [](const TriMesh& mesh) { return "<flexfit.Mesh '" + mesh.name + "': " + std::to_string(mesh.vertices.size()) + " vertices, " + std::to_string(mesh.faces.size()) + " faces>"; });
 
-    m.def("read_mesh", [](const std::filesystem::path& path, bool strict, std::optional<double> weld) {
+    py::class_<FileVertices>(m, "FileVertices", "Where each vertex of a mesh file went when the read welded or removed some "
+                                                "(read_mesh(..., file_vertices=True)); give it to PartModel to keep the file's vertex numbering.")
+        .def_property_readonly("count", &FileVertices::count, "The file's vertex count.")
+        .def_property_readonly("mesh_vertex", [](const FileVertices& f) {
+            std::vector<std::int64_t> v(f.count());
+            for (std::size_t u = 0; u < v.size(); ++u) v[u] = f.meshVertex[u] == kNoVertex ? -1 : std::int64_t(f.meshVertex[u]);
+            return py::array_t<std::int64_t>(py::ssize_t(v.size()), v.data());
+        }, "The mesh vertex each file vertex became (-1: removed, no face used it), a new array.")
+        .def_property_readonly("positions", [](const FileVertices& f) { return vec3Copy(f.positions); }, "The file's vertex positions, a new (n, 3) array.");
+
+    m.def("read_mesh", [](const std::filesystem::path& path, bool strict, std::optional<double> weld, bool fileVertices) {
         MeshReadOptions options;
         options.repair = !strict;
         options.weldTolerance = weld;
         MeshReadResult r = readMesh(path, options);
-        return py::make_tuple(std::move(r.mesh), r.diagnostics.warnings);
-    }, py::arg("path"), py::arg("strict") = false, py::arg("weld") = py::none(),
+        if (!fileVertices) return py::make_tuple(std::move(r.mesh), r.diagnostics.warnings);
+        py::object numbering = r.fileVertices.empty() ? py::object(py::none()) : py::cast(std::move(r.fileVertices));
+        return py::make_tuple(std::move(r.mesh), r.diagnostics.warnings, numbering);
+    }, py::arg("path"), py::arg("strict") = false, py::arg("weld") = py::none(), py::kw_only(), py::arg("file_vertices") = false,
           "Reads a mesh (.tri, OBJ, STL, PLY, OFF, glTF, ...). Returns (mesh, warnings): geometric defects are repaired and listed, "
-          "or refused with strict=True. Raises InputError naming the file and line.");
+          "or refused with strict=True. With file_vertices=True, (mesh, warnings, numbering): a FileVertices when the read welded or "
+          "removed vertices (None otherwise), for PartModel(..., file_vertices=numbering) to keep the file's vertex indices. Raises "
+          "InputError naming the file and line.");
     m.def("write_mesh", &writeMesh, py::arg("mesh"), py::arg("path"), "Writes a mesh; the format follows the extension (.tri, .obj, ...).");
     m.def("torus", &makeTorus, py::arg("major"), py::arg("minor"), py::arg("u"), py::arg("v"), "A torus of u x v vertices about the y axis.");
     m.def("sphere", &makeIcoSphere, py::arg("radius"), py::arg("level"), "An icosphere subdivided `level` times.");
@@ -404,8 +418,9 @@ PYBIND11_MODULE(_flexfit, m) {
     py::class_<PartModel, std::shared_ptr<PartModel>>(m, "PartModel", "A part's immutable model: its mesh, masses and springs.")
         .def(py::init([](TriMesh mesh, std::optional<std::string> material, std::optional<std::pair<double, double>> springs, double vertexMass,
                          std::optional<double> youngsModulus, std::optional<double> thickness, std::optional<double> density, double poissonRatio,
-                         double dampingRatio, bool bendingSprings, const std::string& vertexOrder) {
+                         double dampingRatio, bool bendingSprings, const std::string& vertexOrder, std::optional<FileVertices> fileVertices) {
                  PartModelSettings settings = modelSettings(material, springs, vertexMass, youngsModulus, thickness, density, poissonRatio, dampingRatio, bendingSprings);
+                 if (fileVertices) settings.fileVertices = std::move(*fileVertices);
                  if (vertexOrder != "as_given" && vertexOrder != "locality")
                      throw InputError("vertex_order", 0, "unknown value '" + vertexOrder + "' (expected 'as_given' or 'locality')");
                  settings.vertexOrder = vertexOrder == "locality" ? VertexOrder::Locality : VertexOrder::AsGiven;
@@ -414,14 +429,16 @@ PYBIND11_MODULE(_flexfit, m) {
              py::arg("mesh"), py::arg("material") = py::none(), py::arg("springs") = py::none(), py::arg("vertex_mass") = 1.0, py::kw_only(),
              py::arg("youngs_modulus") = py::none(), py::arg("thickness") = py::none(), py::arg("density") = py::none(), py::arg("poisson_ratio") = 0.35,
              py::arg("damping_ratio") = 0.1, py::arg("bending_springs") = false, py::arg("vertex_order") = "as_given",
+             py::arg("file_vertices") = py::none(),
              "Builds a model from a mesh: material a preset name ('elastic'), or springs=(stiffness, damping) with vertex_mass in kg, or a "
              "physical material (SI units): youngs_modulus, thickness, density, poisson_ratio, damping_ratio, bending_springs. "
              "vertex_order='locality' renumbers the masses for memory locality when that makes the step faster (a mesh from a file); "
-             "every index and per-mass array in Python stays in the mesh's own vertex order either way.")
+             "every index and per-mass array in Python stays in the mesh's own vertex order either way. file_vertices (from "
+             "read_mesh(..., file_vertices=True)) makes them the file's vertices, through the read's welds and removals.")
         .def_property_readonly("mass_count", &PartModel::massCount, "Number of masses (the mesh's vertices).")
         .def_property_readonly("vertex_count", &PartModel::vertexCount,
-                               "Number of the user's vertices: the rows of per-vertex arrays (mass_count, or the file's vertex count for a scene "
-                               "part whose file lost vertices to welding or repair).")
+                               "Number of the user's vertices: the rows of per-vertex arrays (mass_count, or the file's vertex count for a model "
+                               "built with file_vertices or a scene part whose file lost vertices to welding or repair).")
         .def_property_readonly("spring_count", [](const PartModel& model) { return model.springCount(); }, "Number of springs (edges, and bending springs of a physical material).")
         .def_property_readonly("mesh", [](py::object self) {
             const PartModel& model = self.cast<const PartModel&>();

@@ -497,3 +497,52 @@ def test_a_worlds_mass_calls_name_the_meshs_vertices_when_renumbered():
     np.testing.assert_allclose(a.positions, b.positions, rtol=0, atol=1e-12)
     np.testing.assert_array_equal(a.zone_depths, b.zone_depths)
     assert a.zone_depths[7] == 0 and a.zone_depths[9] >= 0  # zones at the loaded and kicked file vertices
+
+
+def test_a_model_built_with_the_files_vertices_speaks_the_files_indices(tmp_path):
+    # An icosphere written as OBJ with a stray vertex (no face uses it) as vertex 3 and face 5's
+    # first corner written again at the end: the read removes and welds them. With the file's
+    # numbering, every per-vertex row and index is the file's; against the clean mesh's run, row
+    # for row at the shifted indices, bit for bit (the repaired mesh is the clean one).
+    sphere = flexfit.sphere(1.0, 2)
+    vertices = np.insert(np.asarray(sphere.vertices), 3, [5.0, 5.0, 5.0], axis=0)
+    faces = np.asarray(sphere.faces).astype(np.int64)
+    faces = faces + (faces >= 3)
+    repeated = int(faces[5, 0])
+    vertices = np.vstack([vertices, vertices[repeated]])
+    faces[5, 0] = len(vertices) - 1
+    path = tmp_path / "damaged.obj"
+    path.write_text("".join("v %.17g %.17g %.17g\n" % tuple(v) for v in vertices) + "".join("f %d %d %d\n" % tuple(f + 1) for f in faces))
+    mesh, warnings, numbering = flexfit.read_mesh(path, file_vertices=True)
+    assert len(mesh.vertices) == len(sphere.vertices) and any("used by no face" in w for w in warnings)
+    assert numbering.count == len(vertices)
+    expected = list(range(len(sphere.vertices)))
+    mesh_vertex = list(numbering.mesh_vertex)
+    assert mesh_vertex[3] == -1 and mesh_vertex[-1] == mesh_vertex[repeated]
+    assert [mesh_vertex[c + (c >= 3)] for c in expected] == expected
+    np.testing.assert_array_equal(numbering.positions, vertices)
+    assert flexfit.read_mesh(path)[0].vertices.shape == mesh.vertices.shape  # the two-element form is unchanged
+
+    numbered = flexfit.PartModel(mesh, springs=(0.1, 0.01), vertex_order="locality", file_vertices=numbering)
+    clean = flexfit.PartModel(sphere, springs=(0.1, 0.01), vertex_order="locality")
+    assert numbered.vertex_count == len(vertices) and numbered.mass_count == len(sphere.vertices)
+    assert numbered.mass_of_vertex[3] == -1
+    np.testing.assert_array_equal(numbered.rest_positions, vertices)
+    parts = []
+    for model, at in ((numbered, lambda c: c + (c >= 3)), (clean, lambda c: c)):
+        part = flexfit.Part(model, mode="rigid-deformable", restoration="none", global_damping=0.5)
+        for _ in range(20):
+            part.apply_force(at(7), [0, 0.3, 0.1])
+            part.step()
+        part.kick_mass(at(40), [0.2, 0, 0])
+        part.step()
+        parts.append(part)
+    a, b = parts
+    rows = [c + (c >= 3) for c in expected]
+    np.testing.assert_array_equal(a.positions[rows], b.positions)
+    np.testing.assert_array_equal(a.positions[3], vertices[3])  # the stray vertex stays where the file has it
+    np.testing.assert_array_equal(a.velocities[3], [0, 0, 0])
+    np.testing.assert_array_equal(a.positions[-1], a.positions[repeated])
+    assert a.zone_depths[3] == -1 and a.zone_depths[7 + 1] == 0
+    with pytest.raises(flexfit.InputError, match="removed by the repair"):
+        a.apply_force(3, [1, 0, 0])
