@@ -316,10 +316,8 @@ void addPartReaders(Class& c, Get get) {
             return py::array_t<int>(py::ssize_t(depths.size()), depths.data());
         }, "Each mass's depth in the zones covering it (0 = seed, -1 = at rest), a new int array.")
         .def("world_positions", [get](py::object self) {
-            std::vector<Vec3> w, rows;
-            const Part& part = get(self);
-            part.worldPositions(w);
-            inVertexOrder<Vec3>(part.model(), w, rows, [&](Index v) { return part.pose().apply(part.model().file->vertices.positions[v]); });
+            std::vector<Vec3> rows;
+            get(self).vertexWorldPositions(rows);
             return vec3Copy(rows);
         }, "Mass positions in the world, a new (n, 3) array.")
         .def_property_readonly("zone_count", [get](py::object self) { return get(self).zoneCount(); }, "Zones open on the part.")

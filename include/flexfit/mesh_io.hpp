@@ -46,8 +46,8 @@ struct MeshReadResult {
     std::size_t collapsedFaces = 0;  // faces removed because that welding collapsed them
     MeshRepairs repairs;             // what the repair changed (nothing when strict)
     // The file's vertices, when the welding or the repair merged or removed some (mesh.hpp).
-    // OBJ, OFF, PLY and .tri: the vertices the file lists; STL: its face corners (assimp keeps
-    // their order); glTF and the other assimp formats: the vertices assimp gives.
+    // OBJ, OFF, PLY and .tri: the vertices the file lists; STL, glTF and the other assimp
+    // formats: the vertices after the format's welding, in first-use order.
     FileVertices fileVertices;
 };
 

@@ -180,11 +180,18 @@ public:
     // no drawn mesh of its own).
     void drawnPositions(std::vector<Vec3>& out) const;
     void drawnWorldPositions(std::vector<Vec3>& out) const;
+    // The mass positions in the user's vertex order (PartModel::vertexCount() of them), in the
+    // part frame / the world: a welded file vertex at its survivor's, a removed one carried
+    // rigidly at its file position.
+    void vertexPositions(std::vector<Vec3>& out) const;
+    void vertexWorldPositions(std::vector<Vec3>& out) const;
     // Depth of each mass in the zones covering it (minimum; 0 = seed), -1 when not moving.
     void zoneDepths(std::vector<int>& out) const;
     double time() const { return state_.time; }
 
 private:
+    // Part-frame points to the world, in place.
+    void toWorld(std::vector<Vec3>& points) const;
     struct Zone;  // its seeds, level and members (part.cpp)
 
     void cover(const Zone& zone);

@@ -349,14 +349,28 @@ void Part::worldPositions(std::vector<Vec3>& out) const {
 
 void Part::drawnPositions(std::vector<Vec3>& out) const {
     if (model_->drawn) return embeddedPositions(*model_->drawn, model_->mesh.faces, state_.positions, out);
-    inVertexOrder(*model_, std::span<const Vec3>(state_.positions), out, [&](Index v) { return model_->file->vertices.positions[v]; });
+    vertexPositions(out);
 }
 
 void Part::drawnWorldPositions(std::vector<Vec3>& out) const {
-    if (!model_->drawn && model_->massesAreVertices()) return worldPositions(out);
+    if (!model_->drawn) return vertexWorldPositions(out);
     drawnPositions(out);
+    toWorld(out);
+}
+
+void Part::vertexPositions(std::vector<Vec3>& out) const {
+    inVertexOrder(*model_, std::span<const Vec3>(state_.positions), out, [&](Index v) { return model_->file->vertices.positions[v]; });
+}
+
+void Part::vertexWorldPositions(std::vector<Vec3>& out) const {
+    if (model_->massesAreVertices()) return worldPositions(out);
+    vertexPositions(out);
+    toWorld(out);
+}
+
+void Part::toWorld(std::vector<Vec3>& points) const {
     const Eigen::Matrix3d r = pose_.rotation.toRotationMatrix();
-    for (Vec3& p : out) p = r * p + pose_.translation;
+    for (Vec3& p : points) p = r * p + pose_.translation;
 }
 
 void Part::zoneDepths(std::vector<int>& out) const {

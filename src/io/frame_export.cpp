@@ -72,9 +72,8 @@ void appendPiece(std::ostringstream& out, const FramePart& named) {
     // The simulation surface in the user's vertex order (PartModel::userMesh()); a file vertex
     // the repair removed is carried rigidly, undisplaced, outside every zone.
     const auto& faces = model.userMesh().faces;
-    std::vector<Vec3> world, perMass(n), points, displacement, velocity;
-    part.worldPositions(world);
-    inVertexOrder<Vec3>(model, world, points, [&](Index v) { return part.pose().apply(model.file->vertices.positions[v]); });
+    std::vector<Vec3> perMass(n), points, displacement, velocity;
+    part.vertexWorldPositions(points);
     for (std::size_t m = 0; m < n; ++m) perMass[m] = part.pose().rotate(part.state().positions[m] - model.restPositions[m]);
     inVertexOrder<Vec3>(model, perMass, displacement);
     for (std::size_t m = 0; m < n; ++m) perMass[m] = part.pose().rotate(part.state().velocities[m]);
