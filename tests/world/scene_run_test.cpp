@@ -350,6 +350,11 @@ TEST(SceneRun, FrictionSlowsTheBallThroughTheMouthButItStillPasses) {
 }
 
 TEST(SceneRun, WholeRunIsDeterministic) {
+#if defined(__SANITIZE_ADDRESS__)
+    // Five runs of one scene check no memory the golden runs do not (GoldenHashWithEveryKernel
+    // runs it under the sanitizers); determinism is checked by the Release build.
+    GTEST_SKIP() << "Release only: the same scene runs under the sanitizers in GoldenHashWithEveryKernel";
+#endif
     auto hashOf = [](double startOffset, RigidDeformableQuery query = RigidDeformableQuery::Faces) {
         Scene scene = exampleScene("ball_torus.toml");
         scene.world.collision.rigidDeformable = query;
