@@ -249,10 +249,14 @@ struct PointShellCoherence {
     std::size_t traversalCost = 0;                     // its nodes
     std::uint64_t traversals = 0;                      // walks completed
     Walk walk;                                         // the next list, under way
-    // By mass of B: the point (A's frame) and distance of its last sample as a moving mass
-    // (distance -1: none).
-    std::vector<Vec3> lastPoint;
-    std::vector<double> lastDistance;
+    // By mass of B, its last sample as a moving mass: the point (A's frame), and the square of
+    // the motion from it over which the mass stays clear (SignedDistanceField::
+    // squaredClearReach; -1: none, infinity: outside the grid). One record, so one cache line.
+    struct LastSample {
+        Vec3 point = Vec3::Zero();
+        double squaredReach = -1.0;
+    };
+    std::vector<LastSample> lastSamples;
 };
 
 // queryPointShell()'s contacts, in the same order, sampling only the masses that may touch.

@@ -78,8 +78,15 @@ public:
     bool clearOf(const Vec3& centre, double radius) const;
     // True when no point within `moved` of one that sampled `distance` samples <= 0 (the
     // interpolant's slope is at most sqrt(3); the float nodes' rounding is covered as in clearOf).
-    bool staysClear(double distance, double moved) const {
-        return distance - std::sqrt(3.0) * moved * (1.0 + 1e-9) > 1e-6 * (fine_.box.max - fine_.box.min).norm();
+    bool staysClear(double distance, double moved) const { return distance > clearDistance(moved); }
+    // The distance above which a sample stays clear over a motion of `moved` (staysClear).
+    double clearDistance(double moved) const { return clearTolerance_ + kSlope * moved; }
+    // The square of the motion below which a point that sampled `distance` stays clear (the
+    // same bound solved for the motion, squared so a caller needs no square root); -1 when
+    // none does.
+    double squaredClearReach(double distance) const {
+        const double reach = (distance - clearTolerance_) / kSlope;
+        return reach > 0.0 ? reach * reach : -1.0;
     }
     double cellSize() const { return fine_.cell; }
 
@@ -107,6 +114,10 @@ private:
     std::vector<Vec3> vertexNormal_;                // (V)
     Bvh<Aabb> bvh_;
     mutable Grid fine_, coarse_;
+    // staysClear's bound: the interpolant's slope with room for rounding, and the float nodes'
+    // rounding as a distance (1e-6 of the grid's diagonal).
+    static constexpr double kSlope = 1.7320508075688772 * (1.0 + 1e-9);
+    double clearTolerance_ = 0.0;
 };
 
 }  // namespace flexfit

@@ -75,6 +75,7 @@ SignedDistanceField::SignedDistanceField(const TriMesh& mesh, const Topology& to
     bvh_.build(leaves);
 
     setUpGrid(fine_, cellSize > 0.0 ? cellSize : 0.125 * edgeSum / double(3 * faces_.size()), std::size_t(1) << 21);
+    clearTolerance_ = 1e-6 * (fine_.box.max - fine_.box.min).norm();
     fillBand(fine_, kBandCells);
     setUpGrid(coarse_, 8.0 * fine_.cell, std::size_t(1) << 15);
     for (int k = 0; k < coarse_.dims[2]; ++k)

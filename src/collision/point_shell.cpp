@@ -187,19 +187,14 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
     const RelativePose bInA = relativePose(a, b);
     MassSampler sampler(idA, a, fieldA, idB, b, bInA, contacts, stats);
     const std::size_t massCount = b.model().massCount();
-    if (c.lastDistance.size() != massCount) {
-        c.lastDistance.assign(massCount, -1.0);  // none yet
-        c.lastPoint.assign(massCount, Vec3::Zero());
-    }
+    if (c.lastSamples.size() != massCount) c.lastSamples.assign(massCount, {});  // none yet
     // Moving masses: skipped while they stay closer to their last sample than it was far from
     // the surface (slope sqrt(3)); any other is sampled, and that sample kept.
     for (Index m : b.movingMasses()) {
         const Vec3 p = sampler.pointOf(m);
-        if (c.lastDistance[m] > 0.0 && fieldA.staysClear(c.lastDistance[m], (p - c.lastPoint[m]).norm())) continue;
-        if (!sampler.queue(m, p)) {
-            c.lastDistance[m] = std::numeric_limits<double>::infinity();  // nothing there can touch
-            c.lastPoint[m] = p;
-        }
+        PointShellCoherence::LastSample& last = c.lastSamples[m];
+        if ((p - last.point).squaredNorm() < last.squaredReach) continue;
+        if (!sampler.queue(m, p)) last = {p, std::numeric_limits<double>::infinity()};  // nothing there can touch
     }
     const std::size_t movingQueued = sampler.queuedCount();
     // Masses at rest: those the list's walk reached with the margin, while B's rest sphere has
@@ -207,8 +202,7 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
     // clear over that motion.
     const auto keepMovingSamples = [&](std::size_t k, double distance) {
         if (k >= movingQueued) return;
-        c.lastDistance[sampler.queuedMass(k)] = distance;
-        c.lastPoint[sampler.queuedMass(k)] = sampler.queuedPoint(k);
+        c.lastSamples[sampler.queuedMass(k)] = {sampler.queuedPoint(k), fieldA.squaredClearReach(distance)};
     };
     if (restPointsB.empty()) return sampler.sampleQueued(keepMovingSamples);
     const double margin = kMarginCells * fieldA.cellSize();
@@ -231,9 +225,9 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
             }
         }
     }
+    const double clearAbove = fieldA.clearDistance(motion);  // staysClear(distance, motion), once
     for (const auto& [m, distance] : c.restMasses) {
-        if (b.isMoving(m)) continue;
-        if (fieldA.staysClear(distance, motion)) continue;
+        if (distance > clearAbove || b.isMoving(m)) continue;
         sampler.queue(m, sampler.pointOf(m));
     }
     sampler.sampleQueued(keepMovingSamples);

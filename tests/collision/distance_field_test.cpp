@@ -132,6 +132,45 @@ TEST(SignedDistanceField, ClearOfNeverHidesASampledContact) {
     EXPECT_GT(kept, 200);
 }
 
+TEST(SignedDistanceField, NoPointWithinASamplesClearReachTouches) {
+    // The coherent point shell skips a mass while it stays within squaredClearReach of its last
+    // sample: every point that close samples > 0, down the gradient and at random. And the
+    // squared reach is staysClear's bound: a motion just inside it stays clear, one outside not.
+    const SignedDistanceField field = fieldOf(makeIcoSphere(2.0, 2));
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-2.8, 2.8), unit(-1.0, 1.0);
+    int reached = 0, none = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 centre(u(rng), u(rng), u(rng));
+        if (!field.inGrid(centre)) continue;
+        const SignedDistanceField::Interpolated s = field.sample(centre);
+        const double squaredReach = field.squaredClearReach(s.distance);
+        if (squaredReach < 0.0) {
+            ++none;
+            EXPECT_FALSE(field.staysClear(s.distance, 0.0)) << s.distance;
+            continue;
+        }
+        ++reached;
+        const double reach = std::sqrt(squaredReach);
+        EXPECT_TRUE(field.staysClear(s.distance, reach * (1.0 - 1e-6)));
+        EXPECT_FALSE(field.staysClear(s.distance, reach * (1.0 + 1e-6)));
+        const Vec3 down = centre - reach * s.gradient.normalized();
+        if (field.inGrid(down)) {
+            ASSERT_GT(field.sample(down).distance, 0.0) << centre.transpose();
+        }
+        for (int k = 0; k < 50; ++k) {
+            Vec3 d(unit(rng), unit(rng), unit(rng));
+            if (d.norm() > 1.0) d.normalize();
+            const Vec3 p = centre + reach * d;
+            if (field.inGrid(p)) {
+                ASSERT_GT(field.sample(p).distance, 0.0) << centre.transpose();
+            }
+        }
+    }
+    EXPECT_GT(reached, 500);
+    EXPECT_GT(none, 20);
+}
+
 TEST(SignedDistanceField, OpenFlippedOrInsideOutMeshIsRefused) {
     TriMesh open = unitCube();
     open.faces.pop_back();
