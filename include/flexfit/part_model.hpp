@@ -161,8 +161,9 @@ struct PartModel {
     std::size_t vertexCount() const { return file ? file->vertices.count() : massCount(); }
     // Whether mass i is the user's vertex i (no renumbering, no file numbering).
     bool massesAreVertices() const { return !renumbered() && !file; }
-    // The mass of the user's vertex. An index out of range passes through unchanged, for the
-    // call it goes to to refuse; a removed file vertex throws InputError naming the part.
+    // The mass of the user's vertex. Without a file numbering an index out of range passes
+    // through unchanged, for the call it goes to to refuse; with one, an index past the file's
+    // vertices or a removed file vertex throws InputError naming the part.
     Index massOf(Index vertex) const;
     // The user's vertex of mass m (with a file numbering, the first file vertex that became it).
     Index vertexOf(Index m) const;

@@ -283,7 +283,10 @@ std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSet
 
 Index PartModel::massOf(Index vertex) const {
     if (!file) return vertex < massCount() ? massOfGivenVertex(vertex) : vertex;
-    if (vertex >= file->vertices.count()) return vertex;
+    if (vertex >= file->vertices.count())  // the step's own check would give the mass count as the bound
+        throw InputError("part '" + name + "'", 0,
+                         "vertex " + std::to_string(vertex) + " does not exist (its file has " + std::to_string(file->vertices.count()) +
+                             " vertices)");
     const Index given = file->vertices.meshVertex[vertex];
     if (given == kNoVertex)
         throw InputError("part '" + name + "'", 0,

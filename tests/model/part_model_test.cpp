@@ -668,7 +668,13 @@ TEST(PartModelFileVertices, IndicesInAndOutAreTheFilesWithAndWithoutRenumbering)
             EXPECT_EQ(model->vertexOf(model->massOf(u)), u);
         }
         EXPECT_EQ(model->massOf(4), model->massOf(1));
-        EXPECT_EQ(model->massOf(6), 6u) << "out of range passes through";
+        // Past the file's vertices: refused with the file's count, not the 4 masses.
+        try {
+            model->massOf(6);
+            FAIL() << "expected InputError";
+        } catch (const InputError& e) {
+            EXPECT_TRUE(contains(e.what(), "vertex 6 does not exist (its file has 6 vertices)")) << e.what();
+        }
         EXPECT_THROW(model->massOf(5), InputError);
         // Per-mass values in the file's order: the repeat repeats, the removed one gets its value.
         std::vector<double> perMass(4), perVertex;
