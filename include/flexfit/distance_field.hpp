@@ -80,12 +80,12 @@ public:
     // interpolant's slope is at most sqrt(3); the float nodes' rounding is covered as in clearOf).
     bool staysClear(double distance, double moved) const { return distance > clearDistance(moved); }
     // The distance above which a sample stays clear over a motion of `moved` (staysClear).
-    double clearDistance(double moved) const { return clearTolerance_ + kSlope * moved; }
+    double clearDistance(double moved) const { return fine_.roundingReach + kSlope * moved; }
     // The square of the motion below which a point that sampled `distance` stays clear (the
     // same bound solved for the motion, squared so a caller needs no square root); -1 when
     // none does.
     double squaredClearReach(double distance) const {
-        const double reach = (distance - clearTolerance_) / kSlope;
+        const double reach = (distance - fine_.roundingReach) / kSlope;
         return reach > 0.0 ? reach * reach : -1.0;
     }
     double cellSize() const { return fine_.cell; }
@@ -97,6 +97,7 @@ private:
         std::array<int, 3> dims{0, 0, 0};
         Aabb box;
         std::vector<float> values;
+        double roundingReach = 0.0;  // the float nodes' rounding as a distance: 1e-6 of the box's diagonal
         float& node(int i, int j, int k) {
             return values[(std::size_t(k) * std::size_t(dims[1]) + std::size_t(j)) * std::size_t(dims[0]) + std::size_t(i)];
         }
@@ -114,10 +115,9 @@ private:
     std::vector<Vec3> vertexNormal_;                // (V)
     Bvh<Aabb> bvh_;
     mutable Grid fine_, coarse_;
-    // staysClear's bound: the interpolant's slope with room for rounding, and the float nodes'
-    // rounding as a distance (1e-6 of the grid's diagonal).
+    // staysClear's bound: the interpolant's slope with room for rounding (and the fine grid's
+    // roundingReach).
     static constexpr double kSlope = 1.7320508075688772 * (1.0 + 1e-9);
-    double clearTolerance_ = 0.0;
 };
 
 }  // namespace flexfit

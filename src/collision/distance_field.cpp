@@ -75,7 +75,6 @@ SignedDistanceField::SignedDistanceField(const TriMesh& mesh, const Topology& to
     bvh_.build(leaves);
 
     setUpGrid(fine_, cellSize > 0.0 ? cellSize : 0.125 * edgeSum / double(3 * faces_.size()), std::size_t(1) << 21);
-    clearTolerance_ = 1e-6 * (fine_.box.max - fine_.box.min).norm();
     fillBand(fine_, kBandCells);
     setUpGrid(coarse_, 8.0 * fine_.cell, std::size_t(1) << 15);
     for (int k = 0; k < coarse_.dims[2]; ++k)
@@ -99,6 +98,7 @@ void SignedDistanceField::setUpGrid(Grid& grid, double cell, std::size_t maxNode
     }
     grid.cell = cell;
     for (int d = 0; d < 3; ++d) grid.box.max[d] = grid.box.min[d] + cell * (grid.dims[std::size_t(d)] - 1);
+    grid.roundingReach = 1e-6 * (grid.box.max - grid.box.min).norm();
     grid.values.assign(std::size_t(grid.dims[0]) * std::size_t(grid.dims[1]) * std::size_t(grid.dims[2]),
                        std::numeric_limits<float>::quiet_NaN());
 }
@@ -283,7 +283,7 @@ bool SignedDistanceField::clearOf(Grid& grid, const Vec3& centre, double radius,
     // (sqrt(3) per unit), or the exact distance's (1 per unit) plus the sample's error at both
     // ends (sqrt(3) cells each).
     const double fall = std::min(std::sqrt(3.0) * (radius + outside), radius + outside + 2.0 * std::sqrt(3.0) * grid.cell);
-    const double reach = fall * (1.0 + 1e-9) + slack + 1e-6 * (grid.box.max - grid.box.min).norm();
+    const double reach = fall * (1.0 + 1e-9) + slack + grid.roundingReach;
     return sample(grid, clamped).distance > reach;
 }
 
