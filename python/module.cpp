@@ -47,7 +47,8 @@ py::array_t<double> vec3Copy(const std::vector<Vec3>& v) {
 
 // Python speaks the user's vertex indices (the file's, for a scene part whose file lost vertices
 // to welding or repair): a model renumbered for locality translates them to masses here
-// (PartModel::massOf; an index out of range passes through for the C++ call to refuse).
+// (PartModel::massOf, which refuses an index past a file's vertices; without a file numbering one
+// out of range passes through for the C++ call to refuse).
 // Per-mass rows in the user's vertex order: a read-only view of the state when the masses are
 // the vertices, else a read-only copy. A file vertex the repair removed reads its file position
 // (part frame, `positions`) or zero.

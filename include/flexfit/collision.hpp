@@ -251,7 +251,8 @@ struct PointShellCoherence {
     Walk walk;                                         // the next list, under way
     // By mass of B, its last sample as a moving mass: the point (A's frame), and the square of
     // the motion from it over which the mass stays clear (SignedDistanceField::
-    // squaredClearReach; -1: none, infinity: outside the grid). One record, so one cache line.
+    // squaredClearReach; -1: none; outside the grid, the squared distance to it; infinity: a
+    // free vertex, which never touches). One record of 32 bytes.
     struct LastSample {
         Vec3 point = Vec3::Zero();
         double squaredReach = -1.0;

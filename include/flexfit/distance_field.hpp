@@ -74,6 +74,11 @@ public:
     bool inGrid(const Vec3& p) const {
         return (p.array() >= fine_.box.min.array()).all() && (p.array() <= fine_.box.max.array()).all();
     }
+    // The squared distance from p to the grid (0 inside): a point outside stays outside while
+    // it moves less than that.
+    double squaredDistanceToGrid(const Vec3& p) const {
+        return (p - p.cwiseMax(fine_.box.min).cwiseMin(fine_.box.max)).squaredNorm();
+    }
     // True when no point within `radius` of `centre` samples a distance <= 0.
     bool clearOf(const Vec3& centre, double radius) const;
     // True when no point within `moved` of one that sampled `distance` samples <= 0 (the

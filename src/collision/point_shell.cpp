@@ -194,7 +194,11 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
         const Vec3 p = sampler.pointOf(m);
         PointShellCoherence::LastSample& last = c.lastSamples[m];
         if ((p - last.point).squaredNorm() < last.squaredReach) continue;
-        if (!sampler.queue(m, p)) last = {p, std::numeric_limits<double>::infinity()};  // nothing there can touch
+        if (sampler.queue(m, p)) continue;
+        // Not sampled: a free vertex never touches; one outside the grid is not sampled again
+        // until it can have entered it (the margin covers rounding in the two squares).
+        const bool free = b.model().topology.facesOf(m).empty();
+        last = {p, free ? std::numeric_limits<double>::infinity() : fieldA.squaredDistanceToGrid(p) * (1.0 - 1e-9)};
     }
     const std::size_t movingQueued = sampler.queuedCount();
     // Masses at rest: those the list's walk reached with the margin, while B's rest sphere has

@@ -13,7 +13,7 @@ SceneRun::SceneRun(const Scene& scene) : scene_(scene), world_(std::make_unique<
 namespace {
 
 // A scene's mass index names the user's vertex (the file's: PartModel::massOf); one out of range
-// (a scene built in code) passes through for the world to refuse.
+// (a scene built in code) is refused there with a file numbering, else by the world.
 Index massOfVertexOf(const World& world, BodyId body, Index vertex) {
     return body < world.bodyCount() ? world.part(body).model().massOf(vertex) : vertex;
 }

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 
@@ -79,6 +80,28 @@ TEST(PointShellCoherent, AWanderingBallOverADeformingTorusGetsTheFullQuerysConta
     }
     EXPECT_GT(contacts, 0u);
     EXPECT_LT(coherence.traversals, 300u / 2) << "the rest masses' list is reused";
+}
+
+TEST(PointShellCoherent, MovingMassesOutsideTheGridAreSampledOnceTheBallComes) {
+    // A zone moves masses of the tube far below the ball, outside its field's grid;
+    // the ball then comes down and presses them: the coherent query must sample them again
+    // when they enter the grid (an earlier version skipped them for good).
+    BallOverTorus s;
+    const Vec3 far(1.0, -3.0, 0.0), over(1.0, -0.9, 0.0);  // mass 12: (1, -0.35, 0), the tube's underside at u = 0
+    s.ball.setPose(Pose{Eigen::Quaterniond::Identity(), far});
+    PointShellCoherence coherence;
+    std::size_t movingContacts = 0;
+    for (int step = 0; step < 60; ++step) {
+        s.torus.applyForce(12, Vec3(0.0, -0.5, 0.0));  // keeps the zone around mass 12 moving
+        s.torus.step();
+        const double t = std::clamp((step - 10) / 30.0, 0.0, 1.0);
+        s.ball.setPose(Pose{Eigen::Quaterniond::Identity(), (1.0 - t) * far + t * over});
+        QueryStats stats;
+        const std::vector<Contact> got = s.coherent(coherence, stats);
+        expectSameContacts(got, s.full(), step);
+        for (const Contact& c : got) movingContacts += s.torus.isMoving(c.massB);
+    }
+    EXPECT_GT(movingContacts, 0u);
 }
 
 TEST(PointShellCoherent, ABallHeldStillSamplesOnlyTheMassesNearIt) {
