@@ -31,16 +31,17 @@ public:
 
     Vec3 pointOf(Index m) const { return bInA_.apply(b_.state().positions[m]); }
 
-    // Queues mass m at p (A's frame) for sampling; returns false, queuing nothing, when it
-    // cannot touch: a free vertex (no surface to push) or outside the grid.
-    bool queue(Index m, const Vec3& p) {
-        if (b_.model().topology.facesOf(m).empty()) return false;
+    // Queues mass m at p (A's frame) for sampling, unless it cannot touch: a free vertex (no
+    // surface to push) or outside the grid. Says which.
+    enum class Queued { Yes, FreeVertex, OutsideGrid };
+    Queued queue(Index m, const Vec3& p) {
+        if (b_.model().topology.facesOf(m).empty()) return Queued::FreeVertex;
         ++stats_.candidatePairs;
-        if (!field_.inGrid(p)) return false;
+        if (!field_.inGrid(p)) return Queued::OutsideGrid;
         ++stats_.exactTests;
         batch_.masses.push_back(m);
         batch_.points.push_back(p);
-        return true;
+        return Queued::Yes;
     }
 
     // Samples the queued masses; a contact for each at <= 0. done(k, distance) sees the k-th
@@ -194,11 +195,13 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
         const Vec3 p = sampler.pointOf(m);
         PointShellCoherence::LastSample& last = c.lastSamples[m];
         if ((p - last.point).squaredNorm() < last.squaredReach) continue;
-        if (sampler.queue(m, p)) continue;
         // Not sampled: a free vertex never touches; one outside the grid is not sampled again
         // until it can have entered it (the margin covers rounding in the two squares).
-        const bool free = b.model().topology.facesOf(m).empty();
-        last = {p, free ? std::numeric_limits<double>::infinity() : fieldA.squaredDistanceToGrid(p) * (1.0 - 1e-9)};
+        switch (sampler.queue(m, p)) {
+            case MassSampler::Queued::Yes: break;
+            case MassSampler::Queued::FreeVertex: last = {p, std::numeric_limits<double>::infinity()}; break;
+            case MassSampler::Queued::OutsideGrid: last = {p, fieldA.squaredDistanceToGrid(p) * (1.0 - 1e-9)}; break;
+        }
     }
     const std::size_t movingQueued = sampler.queuedCount();
     // Masses at rest: those the list's walk reached with the margin, while B's rest sphere has
