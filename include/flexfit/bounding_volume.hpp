@@ -61,7 +61,14 @@ struct RelativePose {
 
 // Overlap of a volume in frame A with a volume in frame B (touching counts as overlap).
 bool overlap(const Sphere& a, const Sphere& b, const RelativePose& bInA);
-bool overlap(const Aabb& a, const Aabb& b, const RelativePose& bInA);
+bool overlapRotated(const Aabb& a, const Aabb& b, const RelativePose& bInA);  // the oriented-box case
+// Inline: the traversals call it per node pair, and parts not turned against each other (a
+// tool moved without rotation, parts at rest) need only the plain box test.
+inline bool overlap(const Aabb& a, const Aabb& b, const RelativePose& bInA) {
+    if (!bInA.pureTranslation) return overlapRotated(a, b, bInA);
+    const Vec3 bMin = b.min + bInA.translation, bMax = b.max + bInA.translation;
+    return (a.min.array() <= bMax.array()).all() && (bMin.array() <= a.max.array()).all();
+}
 bool overlap(const Sphere& a, const Aabb& b, const RelativePose& bInA);
 bool overlap(const Aabb& a, const Sphere& b, const RelativePose& bInA);
 

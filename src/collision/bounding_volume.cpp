@@ -42,11 +42,7 @@ bool overlap(const Sphere& a, const Sphere& b, const RelativePose& bInA) {
 }
 
 // Separating-axis test of two oriented boxes: A's box axis-aligned in frame A, B's in frame B.
-bool overlap(const Aabb& a, const Aabb& b, const RelativePose& bInA) {
-    if (bInA.pureTranslation) {  // parts not rotated against each other: plain box overlap
-        const Vec3 bMin = b.min + bInA.translation, bMax = b.max + bInA.translation;
-        return (a.min.array() <= bMax.array()).all() && (bMin.array() <= a.max.array()).all();
-    }
+bool overlapRotated(const Aabb& a, const Aabb& b, const RelativePose& bInA) {
     const Vec3 ea = a.halfExtents(), eb = b.halfExtents();
     const Eigen::Matrix3d& r = bInA.rotation;
     const Eigen::Matrix3d& ar = bInA.absRotation;

@@ -32,7 +32,7 @@ struct Interval {
     double min, max;
 };
 
-Interval project(const Triangle& t, const Vec3& axis) {
+[[gnu::always_inline]] inline Interval project(const Triangle& t, const Vec3& axis) {
     const double a = t.a.dot(axis), b = t.b.dot(axis), c = t.c.dot(axis);
     return {std::min({a, b, c}), std::max({a, b, c})};
 }
@@ -59,6 +59,27 @@ struct PointSet {
 bool strictlyOneSide(const Triangle& t, const Vec3& n, double d, double tolerance) {
     const double a = n.dot(t.a) - d, b = n.dot(t.b) - d, c = n.dot(t.c) - d;
     return (a > tolerance && b > tolerance && c > tolerance) || (a < -tolerance && b < -tolerance && c < -tolerance);
+}
+
+// An edge-edge axis (unnormalised: no square root) along which the triangles lie apart by
+// clearly more than the rounding of this test and of intersectTriangles' normalised one:
+// gap / |axis| > 1e-12 * the largest vertex norm, where both roundings stay below 1e-14 times
+// it. intersectTriangles' own loop rejects every such pair too, so asking this first changes
+// no result; it spares the loop's square roots for most pairs that pass the plane tests.
+bool clearlyApartOnAnEdgeAxis(const Triangle& first, const Triangle& second, const std::array<Vec3, 3>& e1, const std::array<Vec3, 3>& e2,
+                              double scale) {
+    const double reach2 = std::max({first.a.squaredNorm(), first.b.squaredNorm(), first.c.squaredNorm(), second.a.squaredNorm(),
+                                    second.b.squaredNorm(), second.c.squaredNorm()});
+    for (const Vec3& a : e1)
+        for (const Vec3& b : e2) {
+            const Vec3 axis = a.cross(b);
+            const double length2 = axis.squaredNorm();
+            if (!(length2 > 1e-24 * scale * scale)) continue;
+            const Interval i1 = project(first, axis), i2 = project(second, axis);
+            const double gap = std::max(i2.min - i1.max, i1.min - i2.max);
+            if (gap > 0.0 && gap * gap > 1e-24 * reach2 * length2) return true;
+        }
+    return false;
 }
 
 }  // namespace
@@ -149,6 +170,7 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
     if (strictlyOneSide(second, n1, n1.dot(first.a), tolerance * n1.norm()) ||
         strictlyOneSide(first, n2, n2.dot(second.a), tolerance * n2.norm()))
         return std::nullopt;
+    if (clearlyApartOnAnEdgeAxis(first, second, e1, e2, scale)) return std::nullopt;
     std::array<Vec3, 17> axes;
     std::size_t axisCount = 0;
     axes[axisCount++] = n1;

@@ -138,6 +138,19 @@ TEST(TriangleTriangle, CoplanarAndTouching) {
     EXPECT_NEAR(pierce->point.z(), 0.0, 1e-9);
 }
 
+// Two edges crossing at exactly one point, each triangle on its own side of the other's edge:
+// the edge-edge axis shows a gap of exactly 0. Touching counts as intersecting, so neither the
+// unnormalised early rejection nor the normalised loop may reject it; a hair apart, both do.
+TEST(TriangleTriangle, EdgesTouchingAtAPointIntersect) {
+    const Triangle below{{-1, 0, 0}, {1, 0, 0}, {0, 0, -1}};
+    const Triangle above{{0, -1, 0}, {0, 1, 0}, {0, 0, 1}};
+    const auto touch = intersectTriangles(below, above);
+    ASSERT_TRUE(touch);
+    EXPECT_EQ(touch->depth, 0.0);
+    EXPECT_FALSE(intersectTriangles(below, shifted(above, {0, 0, 1e-9})));
+    EXPECT_TRUE(intersectTriangles(below, shifted(above, {0, 0, -1e-9})));
+}
+
 TEST(TriangleGap, ALowerBoundOnTheDistanceThatKeepsPairsApart) {
     // Random pairs: intersecting ones have no gap; separated ones a gap no wider than their
     // distance (sampled: the closest sampled point of one to each vertex and edge sample of the
