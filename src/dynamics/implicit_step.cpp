@@ -183,7 +183,13 @@ int solve(std::size_t masses, std::size_t springs, const ImplicitSettings& setti
     for (std::size_t i = n; i < n + 3; ++i) p[i] = 0.0;  // the held slot: held masses do not move
     const double rhsNorm = std::sqrt(dot(n, r, r));
     relativeResidual = 0.0;
-    if (!(rhsNorm > 0.0)) return 0;  // nothing acts: dv = 0 (or a NaN the divergence check reports)
+    if (!std::isfinite(rhsNorm)) {
+        // A non-finite force or state: kept in the velocity change of the masses it is in, so
+        // the divergence check names them (a dv of 0 would drop a NaN force silently).
+        for (std::size_t i = 0; i < n; ++i) dv[i] = std::isfinite(r[i]) ? 0.0 : r[i];
+        return 0;
+    }
+    if (!(rhsNorm > 0.0)) return 0;  // nothing acts: dv = 0
     double rz = dot(n, r, z);
     int iterations = 0;
     relativeResidual = 1.0;
