@@ -35,8 +35,9 @@ void checkMassesFinite(const PartModel& model, const SimulationSettings& setting
 void checkAllMassesFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
                           std::optional<BodyId> body, double time);
 // checkMassesFinite over a region's moving masses after stepActiveRegion: its whole octets in
-// contiguous passes over their positions and velocities (the step consumed their forces), its
-// other masses gathered.
+// contiguous passes, its other masses gathered, over their positions (and velocities with
+// explicit Euler) only, as checkAllMassesFinite: the step consumed their forces, and a
+// non-finite force or velocity has made the position non-finite in the same step.
 void checkRegionFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
                        const ActiveRegion& region, std::optional<BodyId> body, double time);
 
