@@ -92,21 +92,24 @@ void PartCollider::rebuild(const Part& part) {
 }
 
 void PartCollider::updateDisplacementBound(const Part& part) {
-    maxDisplacement_ = 0.0;
+    // The largest squared norm, then one square root: sqrt is monotonic and correctly rounded,
+    // so this is exactly the largest norm, without a root per moving mass every refit.
+    double largest2 = 0.0;
     for (Index m : part.movingMasses())
-        maxDisplacement_ = std::max(maxDisplacement_, (part.state().positions[m] - part.model().restPositions[m]).norm());
+        largest2 = std::max(largest2, (part.state().positions[m] - part.model().restPositions[m]).squaredNorm());
+    maxDisplacement_ = std::sqrt(largest2);
 }
 
 void PartCollider::refit(const Part& part, std::span<const Index> changedMasses) {
     const PartModel& model = part.model();
-    double moved = 0.0;
+    double moved2 = 0.0;  // the largest squared move (one root below, as updateDisplacementBound)
     changedFaces_.clear();
     for (Index m : changedMasses) {
-        moved = std::max(moved, (part.state().positions[m] - seenPositions_[m]).norm());
+        moved2 = std::max(moved2, (part.state().positions[m] - seenPositions_[m]).squaredNorm());
         seenPositions_[m] = part.state().positions[m];
         for (Index f : model.topology.facesOf(m)) changedFaces_.insert(f);
     }
-    vertexDrift_ += moved;
+    vertexDrift_ += std::sqrt(moved2);
     const std::span<const Vec3> positions = part.state().positions;
     std::visit(
         [&](auto& bvh) {
