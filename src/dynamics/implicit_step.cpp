@@ -185,9 +185,15 @@ int solve(std::size_t masses, std::size_t springs, const ImplicitSettings& setti
     relativeResidual = 0.0;
     if (!std::isfinite(rhsNorm)) {
         // A non-finite force or state: kept in the velocity change of the masses it is in, so
-        // the divergence check names them (a dv of 0 would drop a NaN force silently).
-        for (std::size_t i = 0; i < n; ++i) dv[i] = std::isfinite(r[i]) ? 0.0 : r[i];
-        return 0;
+        // the divergence check names them (a dv of 0 would drop a NaN force silently). A norm
+        // that only overflowed (every entry finite) goes on to the solve as before.
+        bool nonFinite = false;
+        for (std::size_t i = 0; i < n; ++i)
+            if (!std::isfinite(r[i])) {
+                dv[i] = r[i];
+                nonFinite = true;
+            }
+        if (nonFinite) return 0;
     }
     if (!(rhsNorm > 0.0)) return 0;  // nothing acts: dv = 0
     double rz = dot(n, r, z);

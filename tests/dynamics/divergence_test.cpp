@@ -154,6 +154,21 @@ TEST(Divergence, RegionCheckFindsWhatTheMassByMassTestFinds) {
             EXPECT_TRUE(finds(byVelocity, of)) << labelOf(settings->integrator) << ": " << byVelocity;
             EXPECT_TRUE(finds(byForce, of)) << labelOf(settings->integrator) << ": " << byForce;
         }
+    // A finite force so large that the implicit solve's right-hand side norm overflows is not
+    // taken for a non-finite one: the step acts on it (the mass moves), or it diverges and is
+    // reported; it is never dropped.
+    {
+        PartState state = PartState::atRest(*model);
+        state.forces[100].x() = 1e160;
+        stepActiveRegion(*model, implicitEuler, region, state);
+        bool reported = false;
+        try {
+            detail::checkRegionFinite(*model, implicitEuler, state, region, BodyId(2), 0.5);
+        } catch (const DivergenceError&) {
+            reported = true;
+        }
+        EXPECT_TRUE(reported || state.velocities[100].x() != 0.0);
+    }
     // Explicit Euler moves the position with the old velocity: a bad force shows in the velocity.
     EXPECT_TRUE(finds(throwsFor(explicitEuler, [&](PartState& s) { s.forces[100].z() = nan; }), "velocity of mass 100"));
     EXPECT_EQ(throwsFor(semiImplicit, [&](PartState& s) { s.positions[200].x() = nan; }, false), "");  // not moving: not checked
