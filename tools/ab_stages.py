@@ -1,10 +1,11 @@
 #!/usr/bin/python3
 """Two or more flexfit binaries on the same scenes, side by side: in-contact step and stages.
 
-For each scene and round, runs `flexfit run SCENE` with every binary, alternating their order
+For each scene and round, runs `flexfit run SCENE` with every binary, rotating their order
 from round to round so the VM's drift falls on each alike. From each run's metrics.csv, over
-the steps with contacts: the world step's p50 / p99 / max (nearest rank; older binaries without
-us_world_step: the sum of the stage columns) and each stage's mean. Prints the medians over the
+the steps with contacts: the world step's p50 / p99 / max (nearest rank) and each stage's mean.
+Older binaries have no us_world_step column: their step is then the sum of the stage columns
+(column `step_source` says which), a little less than the whole step's own timer. Prints the medians over the
 rounds and each binary's ratio to the first (first / this: above 1 means this one is faster),
 and the state hash each printed: a different hash means the binaries did not simulate the same
 thing, and their times are not a like-for-like comparison.
@@ -39,7 +40,7 @@ def measure(flexfit, scene, directory):
         raise SystemExit(f"{scene}: no step with contacts under {flexfit}")
     stages = [k for k in rows[0] if k.startswith("us_") and k != "us_world_step"]
     steps = sorted(float(r["us_world_step"]) if "us_world_step" in r else sum(float(r[k]) for k in stages) for r in rows)
-    figures = {"contact_steps": len(rows), "contacts": statistics.mean(float(r["contacts"]) for r in rows),
+    figures = {"step_source": "us_world_step" if "us_world_step" in rows[0] else "sum of stages", "contact_steps": len(rows), "contacts": statistics.mean(float(r["contacts"]) for r in rows),
                "us_step_p50": percentile(steps, 50), "us_step_p99": percentile(steps, 99), "us_step_max": steps[-1]}
     figures.update({k: statistics.mean(float(r[k]) for r in rows) for k in stages})
     return figures, found.group(1) if found else "?"
@@ -60,19 +61,20 @@ def main():
         for scene in args.scene:
             runs, hashes = {}, {}
             for r in range(args.rounds):
-                for name, path in binaries if r % 2 == 0 else binaries[::-1]:
+                for name, path in binaries[r % len(binaries):] + binaries[: r % len(binaries)]:
                     figures, state = measure(path, scene, directory)
                     runs.setdefault(name, []).append(figures)
                     hashes.setdefault(name, set()).add(state)
             first = None
             for name, _ in binaries:
-                keys = runs[name][0].keys()
-                median = {k: statistics.median(run[k] for run in runs[name]) for k in keys}
+                keys = [k for k in runs[name][0] if k != "step_source"]
+                median = {"step_source": runs[name][0]["step_source"]}
+                median.update({k: statistics.median(run[k] for run in runs[name]) for k in keys})
                 first = first or median
                 row = {"scene": os.path.basename(scene), "binary": name, "state_hash": " ".join(sorted(hashes[name]))}
-                row.update(median)
                 row["p50_ratio"] = first["us_step_p50"] / median["us_step_p50"]
                 row["p99_ratio"] = first["us_step_p99"] / median["us_step_p99"]
+                row.update(median)
                 rows.append(row)
     keys = list(dict.fromkeys(k for row in rows for k in row))
     report([{k: row.get(k, float("nan")) for k in keys} for row in rows], args.csv)
