@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <vector>
 
 namespace flexfit {
@@ -66,19 +67,16 @@ bool strictlyOneSide(const Triangle& t, const Vec3& n, double d, double toleranc
 // gap / |axis| > 1e-12 * the largest vertex norm, where both roundings stay below 1e-14 times
 // it. intersectTriangles' own loop rejects every such pair too, so asking this first changes
 // no result; it spares the loop's square roots for most pairs that pass the plane tests.
-bool clearlyApartOnAnEdgeAxis(const Triangle& first, const Triangle& second, const std::array<Vec3, 3>& e1, const std::array<Vec3, 3>& e2,
-                              double scale) {
+bool clearlyApartOnAnEdgeAxis(const Triangle& first, const Triangle& second, std::span<const Vec3> edgeAxes, double scale) {
     const double reach2 = std::max({first.a.squaredNorm(), first.b.squaredNorm(), first.c.squaredNorm(), second.a.squaredNorm(),
                                     second.b.squaredNorm(), second.c.squaredNorm()});
-    for (const Vec3& a : e1)
-        for (const Vec3& b : e2) {
-            const Vec3 axis = a.cross(b);
-            const double length2 = axis.squaredNorm();
-            if (!(length2 > 1e-24 * scale * scale)) continue;
-            const Interval i1 = project(first, axis), i2 = project(second, axis);
-            const double gap = std::max(i2.min - i1.max, i1.min - i2.max);
-            if (gap > 0.0 && gap * gap > 1e-24 * reach2 * length2) return true;
-        }
+    for (const Vec3& axis : edgeAxes) {
+        const double length2 = axis.squaredNorm();
+        if (!(length2 > 1e-24 * scale * scale)) continue;  // the loop skips it too
+        const Interval i1 = project(first, axis), i2 = project(second, axis);
+        const double gap = std::max(i2.min - i1.max, i1.min - i2.max);
+        if (gap > 0.0 && gap * gap > 1e-24 * reach2 * length2) return true;
+    }
     return false;
 }
 
@@ -170,13 +168,13 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
     if (strictlyOneSide(second, n1, n1.dot(first.a), tolerance * n1.norm()) ||
         strictlyOneSide(first, n2, n2.dot(second.a), tolerance * n2.norm()))
         return std::nullopt;
-    if (clearlyApartOnAnEdgeAxis(first, second, e1, e2, scale)) return std::nullopt;
     std::array<Vec3, 17> axes;
     std::size_t axisCount = 0;
     axes[axisCount++] = n1;
     axes[axisCount++] = n2;
     for (const Vec3& a : e1)
         for (const Vec3& b : e2) axes[axisCount++] = a.cross(b);
+    if (clearlyApartOnAnEdgeAxis(first, second, std::span<const Vec3>(axes).subspan(2, 9), scale)) return std::nullopt;
     const bool coplanar = n1.cross(n2).squaredNorm() <= 1e-24 * n1.squaredNorm() * n2.squaredNorm();
     if (coplanar)
         for (const auto* edges : {&e1, &e2})
