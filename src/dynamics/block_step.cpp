@@ -104,13 +104,14 @@ void blockForces(const SpringBlocks& blocks, const double* x, const double* v, d
     }
 }
 
-void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                        const double* x, const double* v, double* f, BlockKernel kernel) {
 #if defined(FLEXFIT_X86_KERNELS)
-    if (kernel == BlockKernel::Avx512) return regionBlockForcesAvx512(blocks, fullBlocks, cover, x, v, f);
+    if (kernel == BlockKernel::Avx512) return regionBlockForcesAvx512(blocks, vectorBlocks, cover, x, v, f);
+    if (kernel == BlockKernel::Avx2) return regionBlockForcesAvx2(blocks, vectorBlocks, cover, x, v, f);
 #endif
     (void)kernel;
-    for (const Index q : fullBlocks) {
+    for (const Index q : vectorBlocks) {
         const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
         double g[W][3];
         for (std::size_t i = 0; i < W; ++i) {

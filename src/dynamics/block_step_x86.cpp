@@ -187,10 +187,37 @@ FLEXFIT_AVX512 std::size_t holdAtRest512(const PartModel& model, const std::uint
     return n;
 }
 
-FLEXFIT_AVX512 void regionBlocks512(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+// A row block (offset 1) of a region: masses a0 .. a0 + 8, each of a0 + 1 .. a0 + 7 both a first
+// and a second end. Stored and reloaded as two passes (as below for other offsets), the second
+// pass's loads would straddle the first one's stores and wait for them; here both updates are
+// made in registers, in the same order per mass (+ g_i, then - g_(i-1), each where the mass
+// moves), so the bits are the same.
+FLEXFIT_AVX512 inline void regionRowBlock(const Flat24& g, std::size_t a0, const std::uint16_t* cover, double* f) {
+    const std::uint32_t movingA = kSpread3[~heldBits8(cover + a0) & 0xffu];
+    const unsigned secondEnds = ~heldBits8(cover + a0 + 1) & 0xffu;  // mass a0 + 1 + i is lane i's second end
+    const std::uint32_t movingB = kSpread3[(secondEnds << 1) & 0xffu];  // as masses a0 + i, lanes 1..7
+    const Flat24 shifted = shiftOneMass(g, _mm512_setzero_pd());
+    double* fa = f + 3 * a0;
+    for (std::size_t j = 0; j < 3; ++j) {
+        const __m512d old = _mm512_loadu_pd(fa + 8 * j);
+        const __m512d added = _mm512_mask_add_pd(old, __mmask8((movingA >> (8 * j)) & 0xffu), old, g.v[j]);
+        _mm512_storeu_pd(fa + 8 * j, _mm512_mask_sub_pd(added, __mmask8((movingB >> (8 * j)) & 0xffu), added, shifted.v[j]));
+    }
+    if ((secondEnds & 0x80u) != 0) {  // mass a0 + 8: - g_7 (lanes 5-7 of the last vector)
+        alignas(64) double last[8];
+        _mm512_store_pd(last, g.v[2]);
+        for (int c = 0; c < 3; ++c) fa[24 + c] -= last[5 + c];
+    }
+}
+
+FLEXFIT_AVX512 void regionBlocks512(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                                     const double* x, const double* v, double* f) {
-    for (const Index q : fullBlocks) {
+    for (const Index q : vectorBlocks) {
         const Flat24 g = blockSpringForces(blocks, q, x, v);
+        if (blocks.offset[q] == 1) {
+            regionRowBlock(g, blocks.first[q], cover, f);
+            continue;
+        }
         const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
         const std::uint32_t movingA = kSpread3[~heldBits8(cover + a0) & 0xffu];
         const std::uint32_t movingB = kSpread3[~heldBits8(cover + b0) & 0xffu];
@@ -362,19 +389,26 @@ FLEXFIT_AVX2 inline __m256d shiftOneMass4(__m256d a, __m256d b) {
     return _mm256_shuffle_pd(a, _mm256_permute2f128_pd(a, b, 0x21), 0b0101);
 }
 
+// Block q's forces g_i on its first ends as the 24 doubles of 8 masses, in g[0..5].
+FLEXFIT_AVX2 inline void blockSpringForces256(const SpringBlocks& blocks, std::size_t q, const double* x, const double* v,
+                                              __m256d g[6]) {
+    const std::size_t a = 3 * std::size_t(blocks.first[q]), b = a + 3 * std::size_t(blocks.offset[q]);
+    for (std::size_t half = 0; half < 2; ++half) {
+        const std::size_t o = 12 * half, lane = W * q + 4 * half;
+        const Lanes4 forces = springForces4(difference4(x + a + o, x + b + o), difference4(v + a + o, v + b + o),
+                                            _mm256_loadu_pd(blocks.stiffness.data() + lane),
+                                            _mm256_loadu_pd(blocks.damping.data() + lane),
+                                            _mm256_loadu_pd(blocks.restLength.data() + lane));
+        interleave4(forces, g + 3 * half);
+    }
+}
+
 FLEXFIT_AVX2 void blockForces256(const SpringBlocks& blocks, const double* x, const double* v, double* f) {
     __m256d carry = _mm256_setzero_pd();  // previous row block's last vector (g_7 in lanes 1-3)
     for (std::size_t q = 0; q < blocks.blockCount(); ++q) {
-        const std::size_t a = 3 * std::size_t(blocks.first[q]), b = a + 3 * std::size_t(blocks.offset[q]);
+        const std::size_t a = 3 * std::size_t(blocks.first[q]);
         __m256d g[6];  // the block's 24 doubles
-        for (std::size_t half = 0; half < 2; ++half) {
-            const std::size_t o = 12 * half, lane = W * q + 4 * half;
-            const Lanes4 forces = springForces4(difference4(x + a + o, x + b + o), difference4(v + a + o, v + b + o),
-                                                _mm256_loadu_pd(blocks.stiffness.data() + lane),
-                                                _mm256_loadu_pd(blocks.damping.data() + lane),
-                                                _mm256_loadu_pd(blocks.restLength.data() + lane));
-            interleave4(forces, g + 3 * half);
-        }
+        blockSpringForces256(blocks, q, x, v, g);
         double* fa = f + a;
         if (blocks.offset[q] == 1) {
             __m256d previous = blocks.continuesRow(q) ? carry : _mm256_setzero_pd();
@@ -391,9 +425,71 @@ FLEXFIT_AVX2 void blockForces256(const SpringBlocks& blocks, const double* x, co
             }
             continue;
         }
-        double* fb = f + b;
+        double* fb = f + a + 3 * std::size_t(blocks.offset[q]);
         for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fa + 4 * j, _mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]));
         for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fb + 4 * j, _mm256_sub_pd(_mm256_loadu_pd(fb + 4 * j), g[j]));
+    }
+}
+
+// Bit i set for each of the masses cover[0..7] that moves (cover count non-zero).
+inline unsigned movingBits8(const std::uint16_t* cover) {
+    unsigned bits = 0;
+    for (unsigned i = 0; i < 8; ++i) bits |= unsigned(cover[i] != 0) << i;
+    return bits;
+}
+
+// All-ones 64-bit lanes for the bits of k (bit l: lane l), for the 16 values of k.
+alignas(32) constexpr std::array<std::array<std::int64_t, 4>, 16> kLaneMasks4 = [] {
+    std::array<std::array<std::int64_t, 4>, 16> table{};
+    for (unsigned k = 0; k < 16; ++k)
+        for (unsigned l = 0; l < 4; ++l) table[k][l] = (k >> l) & 1u ? -1 : 0;
+    return table;
+}();
+
+// Vector j (doubles 4j..4j+3 of 8 masses) of the lane mask whose bits kSpread3 gives.
+FLEXFIT_AVX2 inline __m256d laneMask4(std::uint32_t lanes, int j) {
+    return _mm256_load_pd(reinterpret_cast<const double*>(kLaneMasks4[(lanes >> (4 * j)) & 0xfu].data()));
+}
+
+// The AVX-512 region kernel's method (regionBlocks512) with 4-double vectors: each sum is made
+// in every lane and kept only where the mass moves (a blend), so a lane equals the scalar
+// conditional sum; row blocks update their 9 masses in registers.
+FLEXFIT_AVX2 void regionBlocks256(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
+                                  const double* x, const double* v, double* f) {
+    for (const Index q : vectorBlocks) {
+        __m256d g[6];
+        blockSpringForces256(blocks, q, x, v, g);
+        const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
+        const std::uint32_t movingA = kSpread3[movingBits8(cover + a0)];
+        double* fa = f + 3 * a0;
+        if (blocks.offset[q] == 1) {
+            const unsigned secondEnds = movingBits8(cover + a0 + 1);  // mass a0 + 1 + i is lane i's second end
+            const std::uint32_t movingB = kSpread3[(secondEnds << 1) & 0xffu];
+            __m256d previous = _mm256_setzero_pd();
+            for (int j = 0; j < 6; ++j) {
+                const __m256d old = _mm256_loadu_pd(fa + 4 * j);
+                const __m256d added = _mm256_blendv_pd(old, _mm256_add_pd(old, g[j]), laneMask4(movingA, j));
+                const __m256d shifted = shiftOneMass4(previous, g[j]);
+                _mm256_storeu_pd(fa + 4 * j, _mm256_blendv_pd(added, _mm256_sub_pd(added, shifted), laneMask4(movingB, j)));
+                previous = g[j];
+            }
+            if ((secondEnds & 0x80u) != 0) {  // mass a0 + 8: - g_7 (lanes 1-3 of the last vector)
+                alignas(32) double last[4];
+                _mm256_store_pd(last, g[5]);
+                for (int c = 0; c < 3; ++c) fa[24 + c] -= last[1 + c];
+            }
+            continue;
+        }
+        const std::uint32_t movingB = kSpread3[movingBits8(cover + b0)];
+        for (int j = 0; j < 6; ++j) {
+            const __m256d old = _mm256_loadu_pd(fa + 4 * j);
+            _mm256_storeu_pd(fa + 4 * j, _mm256_blendv_pd(old, _mm256_add_pd(old, g[j]), laneMask4(movingA, j)));
+        }
+        double* fb = f + 3 * b0;  // after the first ends' stores: the ranges overlap when offset < 8
+        for (int j = 0; j < 6; ++j) {
+            const __m256d old = _mm256_loadu_pd(fb + 4 * j);
+            _mm256_storeu_pd(fb + 4 * j, _mm256_blendv_pd(old, _mm256_sub_pd(old, g[j]), laneMask4(movingB, j)));
+        }
     }
 }
 
@@ -579,9 +675,13 @@ void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::
 void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state) {
     integrate512(model, update, state, octets.data(), octets.size());
 }
-void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
+                           const double* x, const double* v, double* f) {
+    regionBlocks256(blocks, vectorBlocks, cover, x, v, f);
+}
+void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                              const double* x, const double* v, double* f) {
-    regionBlocks512(blocks, fullBlocks, cover, x, v, f);
+    regionBlocks512(blocks, vectorBlocks, cover, x, v, f);
 }
 std::size_t holdAtRestAvx512(const PartModel& model, const std::uint16_t* cover, PartState& state) {
     return holdAtRest512(model, cover, state);

@@ -54,11 +54,10 @@ void stepAllMasses(const PartModel& model, const SimulationSettings& settings, s
 // selection, so every kernel gives the same bits.
 void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, PartState& state, BlockKernel kernel);
 
-// The region step's whole blocks (ActiveRegion::fullBlocks), in that order: block q's forces
+// The region step's vector blocks (ActiveRegion::vectorBlocks), in that order: block q's forces
 // g_i, then f[a0 + i] += g_i for each first end that moves, then f[a0 + offset + i] -= g_i for
-// each second end that moves (cover count non-zero). AVX-512 or scalar (the AVX2 choice runs the
-// scalar kernel); the same bits.
-void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+// each second end that moves (cover count non-zero). Scalar, AVX2 or AVX-512: the same bits.
+void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                        const double* x, const double* v, double* f, BlockKernel kernel);
 
 // Listed springs in list order: g on the first end, -g on the second (f[a] += g, f[b] -= g), or
@@ -87,7 +86,9 @@ std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Ind
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state);
 // The same, 8 at a time; the masses whose `held` count is 0 (when given) left at rest.
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held);
-void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> fullBlocks, const std::uint16_t* cover,
+void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
+                           const double* x, const double* v, double* f);
+void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                              const double* x, const double* v, double* f);
 void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state);
 void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state);
