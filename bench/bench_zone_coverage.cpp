@@ -51,7 +51,9 @@ void step(benchmark::State& state, Part& part) {
     // The counts fullStepCostsLess weighs (simulation.hpp), to fit its costs to these timings.
     const ActiveRegion& region = part.region();
     state.counters["computed_springs"] = double(part.computedSprings().size());
-    state.counters["springs_in_whole_blocks"] = double(region.fullBlocks().size() * 8);  // 8 springs a block
+    const RegionWork work = RegionWork::of(region);
+    state.counters["loose_springs"] = double(work.looseSprings);
+    state.counters["block_lanes"] = double(work.blockLanes);  // 8 a vector block
     state.counters["moving_masses"] = double(part.movingMasses().size());
 }
 

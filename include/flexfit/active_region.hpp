@@ -8,11 +8,17 @@
 // retiring a zone costs what it changes. Members keep the order in which they joined until one
 // leaves (swap-remove), so the same calls always give the same order (determinism).
 //
-// For the region step's vector kernels the region also keeps its whole groups of 8: the spring
-// blocks (the full step's vector layout, on models that have them) all of whose springs are
-// computed, and the octets of masses 8k..8k+7 that all move. The step runs those by the vector
-// kernels and the other ("loose") springs and masses one at a time. O(8) more per joining or
-// leaving spring or mass.
+// For the region step's vector kernels the region also keeps its groups of 8 that the vector
+// kernels run: the spring blocks (the full step's vector layout, on models that have them) with
+// at least kMinimumBlockSprings of their 8 springs computed, and the octets of masses 8k..8k+7
+// that all move. The block kernel evaluates all 8 springs of a block and adds each force only
+// to the ends that move: a spring that is not computed has no moving end, so it adds nothing.
+// A block costs about what 5 springs one at a time cost (the kernels are bound by the square
+// root and division of each lane); minimums of 2 to 5 were measured on torus1, torus2, the heart
+// and the renumbered shuffled heart at levels 4-16: with AVX-512, 5 made the region step 0-14 %
+// faster than whole blocks only, and with AVX2 (4 lanes) it was the smallest minimum that was
+// never slower by more than noise. The step runs the other ("loose") springs and masses one at a
+// time. O(8) more per joining or leaving spring or mass.
 //
 // Known limit: a mass can be covered by at most 65,535 zones at once (the count is 16-bit, to
 // keep the per-mass mask that the region step reads small).
@@ -47,27 +53,31 @@ public:
     const IndexSet& springs() const { return springs_; }  // the computed springs
     // (V) the zones covering each mass: non-zero exactly for the moving masses.
     std::span<const std::uint16_t> coverCounts() const { return coverCount_; }
-    // Blocks (indices into the model's spring blocks) all 8 of whose springs are computed, and
-    // the computed springs in no such block; without blocks, every computed spring is loose.
-    const IndexSet& fullBlocks() const { return blockGroups_.whole; }
+    // Blocks (indices into the model's spring blocks) with at least kMinimumBlockSprings of their
+    // springs computed, and the computed springs in no such block; without blocks, every
+    // computed spring is loose.
+    static constexpr std::uint8_t kMinimumBlockSprings = 5;
+    const IndexSet& vectorBlocks() const { return blockGroups_.vector; }
     const IndexSet& looseSprings() const { return blocks_ != nullptr ? blockGroups_.loose : springs_; }
     // Octets k (masses 8k..8k+7) whose masses all move, and the moving masses in no such octet.
-    const IndexSet& fullOctets() const { return octets_.whole; }
+    const IndexSet& fullOctets() const { return octets_.vector; }
     const IndexSet& looseMasses() const { return octets_.loose; }
 
 private:
-    // Members (springs, masses) in groups of 8: which groups have all 8 in the region, and which
-    // members of the region are in no such group.
-    struct WholeGroups {
+    // Members (springs, masses) in groups of 8: which groups have at least `minimum` members in
+    // the region, and which members of the region are in no such group.
+    struct VectorGroups {
+        std::uint8_t minimum = 8;
         std::vector<std::uint8_t> count;  // (groups) members in the region
-        IndexSet whole;                   // (groups)
+        IndexSet vector;                  // (groups) those with at least `minimum`
         IndexSet loose;                   // (members)
-        void reset(std::size_t groups, std::size_t members);
+        void reset(std::size_t groups, std::size_t members, std::uint8_t minimumMembers);
         // `group` is kNoGroup for a member of no group; memberOf(group, i) is its i-th member.
+        // Called after the member joined or left; inRegion(m) says whether m is in the region.
         template <class MemberOf>
         void join(Index member, Index group, MemberOf memberOf);
-        template <class MemberOf>
-        void leave(Index member, Index group, MemberOf memberOf);
+        template <class MemberOf, class InRegion>
+        void leave(Index member, Index group, MemberOf memberOf, InRegion inRegion);
     };
     static constexpr Index kNoGroup = ~Index(0);
     void springJoins(Index spring);
@@ -82,8 +92,8 @@ private:
     IndexSet masses_;                        // (V)
     IndexSet springs_;                       // (E)
     const SpringBlocks* blocks_ = nullptr;   // the model's, when it has any
-    WholeGroups blockGroups_;                // spring blocks (with blocks_)
-    WholeGroups octets_;                     // mass octets
+    VectorGroups blockGroups_;               // spring blocks (with blocks_)
+    VectorGroups octets_;                    // mass octets
 };
 
 }  // namespace flexfit

@@ -124,7 +124,7 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings,
 // Advances only an active region (active_region.hpp): its moving masses and computed springs.
 // Masses outside the region are read (at their current, rest, positions) but never written.
 // Two passes over the compact arrays: springs, then masses. O(|moving| + |computed|). On models
-// with spring blocks, the region's whole blocks (ActiveRegion::fullBlocks) run by the full
+// with spring blocks, the region's vector blocks (ActiveRegion::vectorBlocks) run by the full
 // step's vector kernel (AVX-512 where the CPU has it, else scalar; the same bits), then its
 // other springs by the listed-spring kernel (AVX2 or AVX-512 CPUs, else scalar; the same bits);
 // forces are summed in that order. With Integrator::ImplicitEuler, one implicit step of the
@@ -141,19 +141,24 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
 void stepRegionByFullModel(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                            PartState& state, StepCounters* counters = nullptr);
 
-// Whether stepRegionByFullModel costs less than stepActiveRegion for a region of
-// `computedSprings` springs (`springsInWholeBlocks` of them in whole spring blocks,
-// ActiveRegion::fullBlocks) and `movingMasses` masses. A rule on counts alone, so every machine
-// chooses alike and a run's bits do not depend on the CPU: per spring, the region step costs
-// about 11.5 ns listed (in the order the zones grew: its ends and constants are random reads)
-// and 2.9 ns in whole blocks, plus 2 ns per moving mass; the full step about 2.8 ns by spring
-// blocks and 5.8 ns listed (in index order), plus 0.3 ns per mass put back (fitted on this
-// project's machine, AVX-512, to both steps timed at 4-7 coverages on torus1, torus2, the heart,
-// the shuffled heart and the same renumbered for locality, 2026-12-03). The cheaper estimate
-// wins: near the crossover both cost the same. On CPUs without AVX2 both steps run scalar, at
-// 2-3 times these costs in about the same ratios.
-bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses,
-                       std::size_t springsInWholeBlocks = 0);
+// What a region step computes, for the cost rule below: its loose springs (one at a time), the
+// lanes of its vector blocks (8 a block, whether each spring is computed or not) and its moving
+// masses.
+struct RegionWork {
+    std::size_t looseSprings = 0, blockLanes = 0, movingMasses = 0;
+    static RegionWork of(const ActiveRegion& region);
+};
+
+// Whether stepRegionByFullModel costs less than stepActiveRegion for a region doing `work`. A
+// rule on counts alone, so every machine chooses alike and a run's bits do not depend on the
+// CPU: the region step costs about 11.5 ns a loose spring (in the order the zones grew: its ends
+// and constants are random reads), 2.9 ns a block lane and 2 ns a moving mass; the full step
+// about 2.8 ns a spring by spring blocks and 5.8 ns listed (in index order), plus 0.3 ns per mass
+// put back (fitted on this project's machine, AVX-512, to both steps timed at 4-7 coverages on
+// torus1, torus2, the heart, the shuffled heart and the same renumbered for locality,
+// 2026-12-03). The cheaper estimate wins: near the crossover both cost the same. On CPUs without
+// AVX2 both steps run scalar, at 2-3 times these costs in about the same ratios.
+bool fullStepCostsLess(const PartModel& model, const RegionWork& work);
 
 // Total kinetic + spring + anchor potential energy (no gravity), and linear momentum.
 double totalEnergy(const PartModel& model, const SimulationSettings& settings, const PartState& state);

@@ -5,32 +5,34 @@
 
 namespace flexfit {
 
-void ActiveRegion::WholeGroups::reset(std::size_t groups, std::size_t members) {
+void ActiveRegion::VectorGroups::reset(std::size_t groups, std::size_t members, std::uint8_t minimumMembers) {
+    minimum = minimumMembers;
     count.assign(groups, 0);
-    whole.reset(groups);
+    vector.reset(groups);
     loose.reset(members);
 }
 
 template <class MemberOf>
-void ActiveRegion::WholeGroups::join(Index member, Index group, MemberOf memberOf) {
-    if (group == kNoGroup || ++count[group] < 8) {
+void ActiveRegion::VectorGroups::join(Index member, Index group, MemberOf memberOf) {
+    if (group == kNoGroup || ++count[group] < minimum) {
         loose.insert(member);
         return;
     }
-    whole.insert(group);  // its last member joined: the group runs whole
-    for (Index i = 0; i < 8; ++i)
-        if (memberOf(group, i) != member) loose.erase(memberOf(group, i));
+    if (count[group] > minimum) return;  // the group already runs in the vector kernel
+    vector.insert(group);  // it reached the minimum: its members in the region leave the loose list
+    for (Index i = 0; i < 8; ++i) loose.erase(memberOf(group, i));
 }
 
-template <class MemberOf>
-void ActiveRegion::WholeGroups::leave(Index member, Index group, MemberOf memberOf) {
-    if (group == kNoGroup || count[group]-- < 8) {
+template <class MemberOf, class InRegion>
+void ActiveRegion::VectorGroups::leave(Index member, Index group, MemberOf memberOf, InRegion inRegion) {
+    if (group == kNoGroup || count[group]-- < minimum) {
         loose.erase(member);
         return;
     }
-    whole.erase(group);  // the group breaks up: its other members are loose again
+    if (count[group] >= minimum) return;  // it still runs in the vector kernel
+    vector.erase(group);  // below the minimum: its members still in the region are loose again
     for (Index i = 0; i < 8; ++i)
-        if (memberOf(group, i) != member) loose.insert(memberOf(group, i));
+        if (inRegion(memberOf(group, i))) loose.insert(memberOf(group, i));
 }
 
 namespace {
@@ -43,10 +45,10 @@ ActiveRegion::ActiveRegion(const PartModel& model)
       movingEnds_(model.springCount(), 0),
       masses_(model.massCount()),
       springs_(model.springCount()) {
-    octets_.reset(model.massCount() / 8, model.massCount());
+    octets_.reset(model.massCount() / 8, model.massCount(), 8);
     if (!model.hasSpringBlocks()) return;
     blocks_ = model.springBlocks.get();
-    blockGroups_.reset(blocks_->blockCount(), model.springCount());
+    blockGroups_.reset(blocks_->blockCount(), model.springCount(), kMinimumBlockSprings);
 }
 
 bool ActiveRegion::cover(Index mass) {
@@ -61,7 +63,7 @@ bool ActiveRegion::cover(Index mass) {
 bool ActiveRegion::uncover(Index mass) {
     if (--coverCount_[mass] != 0) return false;
     masses_.erase(mass);
-    octets_.leave(mass, octetOf(mass), massOfOctet);
+    octets_.leave(mass, octetOf(mass), massOfOctet, [this](Index m) { return moves(m); });
     for (Index e : model_->springsAt(mass))
         if (--movingEnds_[e] == 0) springLeaves(e);
     return true;
@@ -79,7 +81,9 @@ void ActiveRegion::springJoins(Index e) {
 
 void ActiveRegion::springLeaves(Index e) {
     springs_.erase(e);
-    if (blocks_ != nullptr) blockGroups_.leave(e, blockOf(e), [this](Index q, Index i) { return springOfBlock(q, i); });
+    if (blocks_ != nullptr)
+        blockGroups_.leave(e, blockOf(e), [this](Index q, Index i) { return springOfBlock(q, i); },
+                           [this](Index spring) { return movingEnds_[spring] != 0; });
 }
 
 Index ActiveRegion::springOfBlock(Index block, Index i) const { return blocks_->laneSpring[SpringBlocks::kWidth * block + i]; }

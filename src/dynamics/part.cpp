@@ -266,8 +266,7 @@ void Part::advance(const StepContext& context, StepCounters* counters) {
         stepFullModel(*model_, s, {}, state_, counters);
     // The implicit solve holds a region's edge fixed; the full step would solve for it too.
     else if (settings_.zones.fullStepWhenCheaper && s.integrator != Integrator::ImplicitEuler &&
-             fullStepCostsLess(*model_, region_.springs().size(), region_.masses().size(),
-                                                                     SpringBlocks::kWidth * region_.fullBlocks().size()))
+             fullStepCostsLess(*model_, RegionWork::of(region_)))
         stepRegionByFullModel(*model_, s, region_, state_, counters);
     else {
         fullModelStepped_ = false;

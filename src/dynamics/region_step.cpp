@@ -4,6 +4,9 @@
 #include "full_step.hpp"
 #include "implicit_step.hpp"
 #include "mass_update.hpp"
+#include "model/spring_blocks.hpp"
+
+#include <algorithm>
 
 namespace flexfit {
 
@@ -18,10 +21,10 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
     const std::uint16_t* mask = region.coverCounts().data();
     const std::span<const Index> computed = region.springs().members(), moving = region.masses().members();
 
-    // Springs: forces reach only the moving ends (a fixed end is held by the rigid body). Whole
-    // spring blocks by the block kernel, then the others by the listed-spring kernel.
-    if (!region.fullBlocks().empty())
-        detail::regionBlockForces(*model.springBlocks, region.fullBlocks().members(), mask, x, v, f,
+    // Springs: forces reach only the moving ends (a fixed end is held by the rigid body). The
+    // vector blocks by the block kernel, then the others by the listed-spring kernel.
+    if (!region.vectorBlocks().empty())
+        detail::regionBlockForces(*model.springBlocks, region.vectorBlocks().members(), mask, x, v, f,
                                   detail::fullStepKernel());
     detail::listedSpringForces(model, region.looseSprings().members(), mask, x, v, f, detail::fullStepKernel());
     // Moving masses: body forces, integration, restoration; pending forces consumed. Whole
@@ -41,22 +44,24 @@ void stepRegionByFullModel(const PartModel& model, const SimulationSettings& set
     detail::stepAllMasses(model, settings, {}, region.coverCounts().data(), state, counters);
 }
 
-bool fullStepCostsLess(const PartModel& model, std::size_t computedSprings, std::size_t movingMasses,
-                       std::size_t springsInWholeBlocks) {
+RegionWork RegionWork::of(const ActiveRegion& region) {
+    return {region.looseSprings().size(), SpringBlocks::kWidth * region.vectorBlocks().size(), region.masses().size()};
+}
+
+bool fullStepCostsLess(const PartModel& model, const RegionWork& work) {
     // Costs in ns on the reference machine (simulation.hpp); only their ratios matter.
-    constexpr double kRegionSpring = 11.5, kRegionBlockSpring = 2.9, kRegionMass = 2.0;
+    constexpr double kRegionSpring = 11.5, kRegionBlockLane = 2.9, kRegionMass = 2.0;
     constexpr double kBlockSpring = 2.8, kListedSpring = 5.8, kPutBack = 0.3;
     // No margin: near the crossover the two cost the same, and a margin towards the region step
     // let a renumbered heart's zones at 66 % cost 1.13x its whole model. (In a world the full
     // step's streaming also evicts what the collision stages keep in cache: measured on the
     // haptic scene, ~35 % of the springs, no difference either way.)
-    constexpr double kMargin = 1.0;
-    const double region = kRegionSpring * double(computedSprings - springsInWholeBlocks) +
-                          kRegionBlockSpring * double(springsInWholeBlocks) + kRegionMass * double(movingMasses);
+    const double region = kRegionSpring * double(work.looseSprings) + kRegionBlockLane * double(work.blockLanes) +
+                          kRegionMass * double(work.movingMasses);
     const std::size_t blocked = model.springBlocks->blockCount() * SpringBlocks::kWidth;
     const double full = kBlockSpring * double(blocked) + kListedSpring * double(model.springCount() - blocked) +
-                        kPutBack * double(model.massCount() - movingMasses);
-    return full < kMargin * region;
+                        kPutBack * double(model.massCount() - std::min(work.movingMasses, model.massCount()));
+    return full < region;
 }
 
 }  // namespace flexfit

@@ -223,8 +223,7 @@ TEST(Part, ALargeRegionTakesTheCheaperFullStepWithTheSameTrajectory) {
     for (Part* p : {&a, &b})
         for (Index m : {Index(0), Index(1500), Index(3000), Index(4500), Index(6000)}) p->openZone(ZoneSeed::mass(m), 30);
     ASSERT_FALSE(b.region().coversEveryMass());
-    ASSERT_TRUE(fullStepCostsLess(*model, b.computedSprings().size(), b.movingMasses().size(),
-                                  SpringBlocks::kWidth * b.region().fullBlocks().size()));
+    ASSERT_TRUE(fullStepCostsLess(*model, RegionWork::of(b.region())));
     StepCounters first;
     b.step(&first);
     a.step();
@@ -418,7 +417,7 @@ TEST(Part, GoldenHashUnderLoad) {
         part.step();
         if (i != 999) continue;
         EXPECT_GT(part.movingMasses().size(), 0u);
-        EXPECT_EQ(flexfit::testing::hex(stateHash(part.state())), "abf43bf7d128b97f") << "deformed, at 1 s";
+        EXPECT_EQ(flexfit::testing::hex(stateHash(part.state())), "36ace93eed162067") << "deformed, at 1 s";
     }
     EXPECT_EQ(part.zoneCount(), 0u);
     EXPECT_EQ(flexfit::testing::hex(stateHash(part.state())), "9c2a1c379137e0ff");
