@@ -48,7 +48,7 @@ void step(benchmark::State& state, Part& part) {
     }
     state.SetLabel(kNames[state.range(0)]);
     state.counters["coverage"] = double(part.computedSprings().size()) / double(part.model().springCount());
-    // The counts fullStepCostsLess weighs (simulation.hpp), to fit its costs to these timings.
+    // The region's size, and the counts fullStepCostsLess weighs (RegionWork), to fit its costs to these timings.
     const ActiveRegion& region = part.region();
     state.counters["computed_springs"] = double(part.computedSprings().size());
     const RegionWork work = RegionWork::of(region);

@@ -13,12 +13,13 @@
 // at least kMinimumBlockSprings of their 8 springs computed, and the octets of masses 8k..8k+7
 // that all move. The block kernel evaluates all 8 springs of a block and adds each force only
 // to the ends that move: a spring that is not computed has no moving end, so it adds nothing.
-// A block costs about what 5 springs one at a time cost (the kernels are bound by the square
-// root and division of each lane); minimums of 2 to 5 were measured on torus1, torus2, the heart
-// and the renumbered shuffled heart at levels 4-16: with AVX-512, 5 made the region step 0-14 %
-// faster than whole blocks only, and with AVX2 (4 lanes) it was the smallest minimum that was
-// never slower by more than noise. The step runs the other ("loose") springs and masses one at a
-// time. O(8) more per joining or leaving spring or mass.
+// A block costs about 20 ns however many of its springs are computed (the kernels are bound by
+// each lane's square root and division). The minimum was measured, 2 to 5 against 8 (whole
+// blocks only), on torus1, torus2, the heart and the renumbered shuffled heart at levels 4-16:
+// with AVX-512 every minimum made the region step faster (5: by 0-14 %), but with AVX2, whose
+// loose springs are relatively cheaper, 2-4 made it up to 1.16-1.45x slower at low coverage,
+// and 5 was the smallest within noise of 8 or faster. The step runs the other ("loose") springs
+// and masses one at a time. O(8) more per joining or leaving spring or mass.
 //
 // Known limit: a mass can be covered by at most 65,535 zones at once (the count is 16-bit, to
 // keep the per-mass mask that the region step reads small).

@@ -122,10 +122,11 @@ void stepFullModel(const PartModel& model, const SimulationSettings& settings,
                    StepCounters* counters = nullptr);
 
 // Advances only an active region (active_region.hpp): its moving masses and computed springs.
-// Masses outside the region are read (at their current, rest, positions) but never written.
+// Masses outside the region are read (at their current, rest, positions) but never changed (the
+// vector kernels store whole vectors, writing back the same bits where a mass does not move).
 // Two passes over the compact arrays: springs, then masses. O(|moving| + |computed|). On models
 // with spring blocks, the region's vector blocks (ActiveRegion::vectorBlocks) run by the full
-// step's vector kernel (AVX-512 where the CPU has it, else scalar; the same bits), then its
+// step's vector kernel (AVX-512 or AVX2 where the CPU has it, else scalar; the same bits), then its
 // other springs by the listed-spring kernel (AVX2 or AVX-512 CPUs, else scalar; the same bits);
 // forces are summed in that order. With Integrator::ImplicitEuler, one implicit step of the
 // moving masses with every other mass held (a zone's solve is small: O(computed springs) per

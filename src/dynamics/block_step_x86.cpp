@@ -161,8 +161,8 @@ constexpr std::array<std::uint32_t, 256> kSpread3 = [] {
     return table;
 }();
 
-// Bits of the masses cover[0..7] whose cover count is 0.
-FLEXFIT_AVX512 inline unsigned heldBits8(const std::uint16_t* cover) {
+// Bits of the masses cover[0..7] whose cover count is 0 (SSE2: every kernel may use it).
+inline unsigned heldBits8(const std::uint16_t* cover) {
     const __m128i zeroCount = _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(cover)), _mm_setzero_si128());
     return unsigned(_mm_movemask_epi8(_mm_packs_epi16(zeroCount, _mm_setzero_si128())));
 }
@@ -431,13 +431,6 @@ FLEXFIT_AVX2 void blockForces256(const SpringBlocks& blocks, const double* x, co
     }
 }
 
-// Bit i set for each of the masses cover[0..7] that moves (cover count non-zero).
-inline unsigned movingBits8(const std::uint16_t* cover) {
-    unsigned bits = 0;
-    for (unsigned i = 0; i < 8; ++i) bits |= unsigned(cover[i] != 0) << i;
-    return bits;
-}
-
 // All-ones 64-bit lanes for the bits of k (bit l: lane l), for the 16 values of k.
 alignas(32) constexpr std::array<std::array<std::int64_t, 4>, 16> kLaneMasks4 = [] {
     std::array<std::array<std::int64_t, 4>, 16> table{};
@@ -460,10 +453,10 @@ FLEXFIT_AVX2 void regionBlocks256(const SpringBlocks& blocks, std::span<const In
         __m256d g[6];
         blockSpringForces256(blocks, q, x, v, g);
         const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
-        const std::uint32_t movingA = kSpread3[movingBits8(cover + a0)];
+        const std::uint32_t movingA = kSpread3[~heldBits8(cover + a0) & 0xffu];
         double* fa = f + 3 * a0;
         if (blocks.offset[q] == 1) {
-            const unsigned secondEnds = movingBits8(cover + a0 + 1);  // mass a0 + 1 + i is lane i's second end
+            const unsigned secondEnds = ~heldBits8(cover + a0 + 1) & 0xffu;  // mass a0 + 1 + i is lane i's second end
             const std::uint32_t movingB = kSpread3[(secondEnds << 1) & 0xffu];
             __m256d previous = _mm256_setzero_pd();
             for (int j = 0; j < 6; ++j) {
@@ -480,7 +473,7 @@ FLEXFIT_AVX2 void regionBlocks256(const SpringBlocks& blocks, std::span<const In
             }
             continue;
         }
-        const std::uint32_t movingB = kSpread3[movingBits8(cover + b0)];
+        const std::uint32_t movingB = kSpread3[~heldBits8(cover + b0) & 0xffu];
         for (int j = 0; j < 6; ++j) {
             const __m256d old = _mm256_loadu_pd(fa + 4 * j);
             _mm256_storeu_pd(fa + 4 * j, _mm256_blendv_pd(old, _mm256_add_pd(old, g[j]), laneMask4(movingA, j)));

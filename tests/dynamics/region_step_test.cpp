@@ -160,7 +160,7 @@ TEST(RegionStep, ByTheFullModelHoldsInTheIntegrationPassBitForBit) {
 }
 
 // The rule on counts: by spring blocks the full step is chosen past about 35 % of the springs
-// when the region's springs are loose, past about 80 % when they fill whole blocks; with every
+// when the region's springs are loose, past about 80 % when they fill vector blocks; with every
 // spring listed (no blocks) past about 50 % (simulation.hpp).
 TEST(RegionStep, TheFullStepIsChosenWhenItCostsLess) {
     const auto blocks = buildPartModel(makeHeart());
@@ -214,7 +214,7 @@ TEST(RegionStep, GoldenHash) {
     anchors.integrator = Integrator::ExplicitEuler;
     anchors.restoration.method = RestorationMethod::AnchorSprings;
     anchors.restoration.anchorStiffness = 0.4;
-    // Every kernel the CPU has: the whole blocks and octets give the same bits in each.
+    // Every kernel the CPU has: the vector blocks and whole octets give the same bits in each.
     for (const detail::BlockKernel kernel : {detail::BlockKernel::Scalar, detail::BlockKernel::Avx2, detail::BlockKernel::Avx512}) {
         if (!detail::blockKernelAvailable(kernel)) continue;
         const detail::ScopedBlockKernel scope(kernel);
