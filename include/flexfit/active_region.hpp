@@ -18,8 +18,9 @@
 // blocks only), on torus1, torus2, the heart and the renumbered shuffled heart at levels 4-16:
 // with AVX-512, 3-5 made the region step as fast or faster at every partial coverage (5: by
 // 0-14 %), but with AVX2, whose loose springs are relatively cheaper, 2 / 3 / 4 made it up to
-// 1.34 / 1.19 / 1.16x slower at low coverage, and 5 was the smallest within noise of 8 or faster. The step runs the other ("loose") springs
-// and masses one at a time. O(8) more per joining or leaving spring or mass.
+// 1.34 / 1.19 / 1.16x slower at low coverage, and 5 was the smallest within noise of 8 or
+// faster. The step runs the other ("loose") springs and masses one at a time. O(8) more per
+// joining or leaving spring or mass.
 //
 // Known limit: a mass can be covered by at most 65,535 zones at once (the count is 16-bit, to
 // keep the per-mass mask that the region step reads small).

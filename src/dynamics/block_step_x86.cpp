@@ -113,6 +113,13 @@ FLEXFIT_AVX512 inline Flat24 shiftOneMass(const Flat24& g, __m512d previous) {
     return {{oneMassEarlier(previous, g.v[0]), oneMassEarlier(g.v[0], g.v[1]), oneMassEarlier(g.v[1], g.v[2])}};
 }
 
+// The mass after a row block's 8 (its last second end): f -= g_7, lanes 5-7 of `lastVector`.
+FLEXFIT_AVX512 inline void subtractLastSpring8(__m512d lastVector, double* f) {
+    alignas(64) double last[8];
+    _mm512_store_pd(last, lastVector);
+    for (int c = 0; c < 3; ++c) f[c] -= last[5 + c];
+}
+
 // Products d d and w d stay in the masses' layout; only their per-mass sums are transposed to
 // lanes, and the factor s is spread back: 15 permutes a block instead of 18.
 FLEXFIT_AVX512 inline Flat24 blockSpringForces(const SpringBlocks& blocks, std::size_t q, const double* x,
@@ -139,11 +146,7 @@ FLEXFIT_AVX512 void blockForces512(const SpringBlocks& blocks, const double* x, 
                 _mm512_storeu_pd(fa + 8 * j,
                                  _mm512_sub_pd(_mm512_add_pd(_mm512_loadu_pd(fa + 8 * j), g.v[j]), shifted.v[j]));
             carry = g.v[2];
-            if (q + 1 == blocks.blockCount() || !blocks.continuesRow(q + 1)) {
-                alignas(64) double last[8];
-                _mm512_store_pd(last, g.v[2]);
-                for (int c = 0; c < 3; ++c) fa[24 + c] -= last[5 + c];
-            }
+            if (q + 1 == blocks.blockCount() || !blocks.continuesRow(q + 1)) subtractLastSpring8(g.v[2], fa + 24);
             continue;
         }
         double* fb = fa + 3 * std::size_t(blocks.offset[q]);
@@ -166,6 +169,9 @@ inline unsigned heldBits8(const std::uint16_t* cover) {
     const __m128i zeroCount = _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(cover)), _mm_setzero_si128());
     return unsigned(_mm_movemask_epi8(_mm_packs_epi16(zeroCount, _mm_setzero_si128())));
 }
+
+// Bits of the masses cover[0..7] that move (cover count non-zero).
+inline unsigned movingBits8(const std::uint16_t* cover) { return ~heldBits8(cover) & 0xffu; }
 
 FLEXFIT_AVX512 std::size_t holdAtRest512(const PartModel& model, const std::uint16_t* cover, PartState& state) {
     const std::size_t n = model.massCount() / 8 * 8;
@@ -193,8 +199,8 @@ FLEXFIT_AVX512 std::size_t holdAtRest512(const PartModel& model, const std::uint
 // made in registers, in the same order per mass (+ g_i, then - g_(i-1), each where the mass
 // moves), so the bits are the same.
 FLEXFIT_AVX512 inline void regionRowBlock(const Flat24& g, std::size_t a0, const std::uint16_t* cover, double* f) {
-    const std::uint32_t movingA = kSpread3[~heldBits8(cover + a0) & 0xffu];
-    const unsigned secondEnds = ~heldBits8(cover + a0 + 1) & 0xffu;  // mass a0 + 1 + i is lane i's second end
+    const std::uint32_t movingA = kSpread3[movingBits8(cover + a0)];
+    const unsigned secondEnds = movingBits8(cover + a0 + 1);  // mass a0 + 1 + i is lane i's second end
     const std::uint32_t movingB = kSpread3[(secondEnds << 1) & 0xffu];  // as masses a0 + i, lanes 1..7
     const Flat24 shifted = shiftOneMass(g, _mm512_setzero_pd());
     double* fa = f + 3 * a0;
@@ -203,11 +209,7 @@ FLEXFIT_AVX512 inline void regionRowBlock(const Flat24& g, std::size_t a0, const
         const __m512d added = _mm512_mask_add_pd(old, __mmask8((movingA >> (8 * j)) & 0xffu), old, g.v[j]);
         _mm512_storeu_pd(fa + 8 * j, _mm512_mask_sub_pd(added, __mmask8((movingB >> (8 * j)) & 0xffu), added, shifted.v[j]));
     }
-    if ((secondEnds & 0x80u) != 0) {  // mass a0 + 8: - g_7 (lanes 5-7 of the last vector)
-        alignas(64) double last[8];
-        _mm512_store_pd(last, g.v[2]);
-        for (int c = 0; c < 3; ++c) fa[24 + c] -= last[5 + c];
-    }
+    if ((secondEnds & 0x80u) != 0) subtractLastSpring8(g.v[2], fa + 24);  // mass a0 + 8
 }
 
 FLEXFIT_AVX512 void regionBlocks512(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
@@ -219,8 +221,8 @@ FLEXFIT_AVX512 void regionBlocks512(const SpringBlocks& blocks, std::span<const 
             continue;
         }
         const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
-        const std::uint32_t movingA = kSpread3[~heldBits8(cover + a0) & 0xffu];
-        const std::uint32_t movingB = kSpread3[~heldBits8(cover + b0) & 0xffu];
+        const std::uint32_t movingA = kSpread3[movingBits8(cover + a0)];
+        const std::uint32_t movingB = kSpread3[movingBits8(cover + b0)];
         double* fa = f + 3 * a0;
         for (std::size_t j = 0; j < 3; ++j) {
             const __m512d old = _mm512_loadu_pd(fa + 8 * j);
@@ -389,6 +391,13 @@ FLEXFIT_AVX2 inline __m256d shiftOneMass4(__m256d a, __m256d b) {
     return _mm256_shuffle_pd(a, _mm256_permute2f128_pd(a, b, 0x21), 0b0101);
 }
 
+// The mass after a row block's 8 (its last second end): f -= g_7, lanes 1-3 of `lastVector`.
+FLEXFIT_AVX2 inline void subtractLastSpring4(__m256d lastVector, double* f) {
+    alignas(32) double last[4];
+    _mm256_store_pd(last, lastVector);
+    for (int c = 0; c < 3; ++c) f[c] -= last[1 + c];
+}
+
 // Block q's forces g_i on its first ends as the 24 doubles of 8 masses, in g[0..5].
 FLEXFIT_AVX2 inline void blockSpringForces256(const SpringBlocks& blocks, std::size_t q, const double* x, const double* v,
                                               __m256d g[6]) {
@@ -418,11 +427,7 @@ FLEXFIT_AVX2 void blockForces256(const SpringBlocks& blocks, const double* x, co
                 previous = g[j];
             }
             carry = g[5];
-            if (q + 1 == blocks.blockCount() || !blocks.continuesRow(q + 1)) {
-                alignas(32) double last[4];
-                _mm256_store_pd(last, g[5]);
-                for (int c = 0; c < 3; ++c) fa[24 + c] -= last[1 + c];
-            }
+            if (q + 1 == blocks.blockCount() || !blocks.continuesRow(q + 1)) subtractLastSpring4(g[5], fa + 24);
             continue;
         }
         double* fb = f + a + 3 * std::size_t(blocks.offset[q]);
@@ -444,6 +449,23 @@ FLEXFIT_AVX2 inline __m256d laneMask4(std::uint32_t lanes, int j) {
     return _mm256_load_pd(reinterpret_cast<const double*>(kLaneMasks4[(lanes >> (4 * j)) & 0xfu].data()));
 }
 
+// regionRowBlock (AVX-512) with 4-double vectors.
+FLEXFIT_AVX2 inline void regionRowBlock256(const __m256d g[6], std::size_t a0, const std::uint16_t* cover, double* f) {
+    const std::uint32_t movingA = kSpread3[movingBits8(cover + a0)];
+    const unsigned secondEnds = movingBits8(cover + a0 + 1);  // mass a0 + 1 + i is lane i's second end
+    const std::uint32_t movingB = kSpread3[(secondEnds << 1) & 0xffu];  // as masses a0 + i, lanes 1..7
+    double* fa = f + 3 * a0;
+    __m256d previous = _mm256_setzero_pd();
+    for (int j = 0; j < 6; ++j) {
+        const __m256d old = _mm256_loadu_pd(fa + 4 * j);
+        const __m256d added = _mm256_blendv_pd(old, _mm256_add_pd(old, g[j]), laneMask4(movingA, j));
+        const __m256d shifted = shiftOneMass4(previous, g[j]);
+        _mm256_storeu_pd(fa + 4 * j, _mm256_blendv_pd(added, _mm256_sub_pd(added, shifted), laneMask4(movingB, j)));
+        previous = g[j];
+    }
+    if ((secondEnds & 0x80u) != 0) subtractLastSpring4(g[5], fa + 24);  // mass a0 + 8
+}
+
 // The AVX-512 region kernel's method (regionBlocks512) with 4-double vectors: each sum is made
 // in every lane and kept only where the mass moves (a blend), so a lane equals the scalar
 // conditional sum; row blocks update their 9 masses in registers.
@@ -452,28 +474,14 @@ FLEXFIT_AVX2 void regionBlocks256(const SpringBlocks& blocks, std::span<const In
     for (const Index q : vectorBlocks) {
         __m256d g[6];
         blockSpringForces256(blocks, q, x, v, g);
-        const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
-        const std::uint32_t movingA = kSpread3[~heldBits8(cover + a0) & 0xffu];
-        double* fa = f + 3 * a0;
         if (blocks.offset[q] == 1) {
-            const unsigned secondEnds = ~heldBits8(cover + a0 + 1) & 0xffu;  // mass a0 + 1 + i is lane i's second end
-            const std::uint32_t movingB = kSpread3[(secondEnds << 1) & 0xffu];
-            __m256d previous = _mm256_setzero_pd();
-            for (int j = 0; j < 6; ++j) {
-                const __m256d old = _mm256_loadu_pd(fa + 4 * j);
-                const __m256d added = _mm256_blendv_pd(old, _mm256_add_pd(old, g[j]), laneMask4(movingA, j));
-                const __m256d shifted = shiftOneMass4(previous, g[j]);
-                _mm256_storeu_pd(fa + 4 * j, _mm256_blendv_pd(added, _mm256_sub_pd(added, shifted), laneMask4(movingB, j)));
-                previous = g[j];
-            }
-            if ((secondEnds & 0x80u) != 0) {  // mass a0 + 8: - g_7 (lanes 1-3 of the last vector)
-                alignas(32) double last[4];
-                _mm256_store_pd(last, g[5]);
-                for (int c = 0; c < 3; ++c) fa[24 + c] -= last[1 + c];
-            }
+            regionRowBlock256(g, blocks.first[q], cover, f);
             continue;
         }
-        const std::uint32_t movingB = kSpread3[~heldBits8(cover + b0) & 0xffu];
+        const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
+        const std::uint32_t movingA = kSpread3[movingBits8(cover + a0)];
+        double* fa = f + 3 * a0;
+        const std::uint32_t movingB = kSpread3[movingBits8(cover + b0)];
         for (int j = 0; j < 6; ++j) {
             const __m256d old = _mm256_loadu_pd(fa + 4 * j);
             _mm256_storeu_pd(fa + 4 * j, _mm256_blendv_pd(old, _mm256_add_pd(old, g[j]), laneMask4(movingA, j)));
