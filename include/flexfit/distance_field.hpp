@@ -111,7 +111,7 @@ private:
     void fill(Grid& grid, int i, int j, int k) const;
     void fillBand(Grid& grid, int cells) const;
     Interpolated sample(Grid& grid, const Vec3& p) const;
-    bool clearOf(Grid& grid, const Vec3& centre, double radius, double slack) const;
+    static double clearReach(const Grid& grid, double radius, double outside, double slack);
 
     std::vector<Vec3> vertices_;
     std::vector<Face> faces_;
