@@ -29,7 +29,9 @@
 // sqrt(3) (radius + distance to the grid). The point-shell query prunes subtrees with it.
 // Large balls are first tested on a coarse grid (8 fine cells a cell, filled when built):
 // the fine sample differs from the exact distance by at most sqrt(3) fine cells, and so does
-// the coarse one by sqrt(3) coarse cells, which the test adds to its reach.
+// the coarse one by sqrt(3) coarse cells, which the test adds to its reach. Where the coarse
+// sample shows the fine one cannot clear the ball either, no fine sample is read (the same
+// answer, without a cache miss in the fine grid).
 //
 // Not thread-safe: sample() may fill grid nodes. Memory: at most about 2^21 nodes (8 MB of
 // floats); the cell grows when the mesh's box needs more.
