@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <span>
 
 namespace flexfit::cli {
 namespace {
@@ -43,7 +44,7 @@ double deformation(const Part& part) {
 // coupling, per-stage microseconds; then per part, in scene order: its centre of mass
 // (<part>_x, _y, _z; moving parts), the force deformable parts pressed on it in the step
 // (<part>_contact_fx, _fy, _fz, world frame, RigidBody::deformableContactForce; dynamic parts)
-// and its largest deformation (<part>_deformation; parts that deform).
+// and its largest deformation (<part>_deformation; parts that deform; `deformations` by body).
 std::string csvHeader(const Scene& scene) {
     std::string h = "time,contacts,zones,moving_masses,computed_springs,coupling_fx,coupling_fy,coupling_fz,coupling_tx,coupling_ty,coupling_tz";
     for (std::size_t s = 0; s < kStageCount; ++s) h += std::string(",us_") + toString(Stage(s));
@@ -56,7 +57,7 @@ std::string csvHeader(const Scene& scene) {
     return h + "\n";
 }
 
-std::string csvRow(const Scene& scene, const World& w) {
+std::string csvRow(const Scene& scene, const World& w, std::span<const double> deformations) {
     const Coupling& c = w.coupling();
     std::string row = fmt::format("{:.6f},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}", w.time(), w.contacts().size(), zoneCount(w),
                                   movingMasses(w), computedSprings(w), c.force.x(), c.force.y(), c.force.z(), c.torque.x(),
@@ -72,7 +73,7 @@ std::string csvRow(const Scene& scene, const World& w) {
             const Vec3& f = w.body(id).deformableContactForce;
             row += fmt::format(",{:.9g},{:.9g},{:.9g}", f.x(), f.y(), f.z());
         }
-        if (scene.parts[id].part.mode != PartMode::Rigid) row += fmt::format(",{:.9g}", deformation(w.part(id)));
+        if (scene.parts[id].part.mode != PartMode::Rigid) row += fmt::format(",{:.9g}", deformations[id]);
     }
     return row + "\n";
 }
@@ -132,6 +133,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     std::vector<FramePart> frameParts;
     for (BodyId id = 0; id < w.bodyCount(); ++id) frameParts.push_back({scene.parts[id].name, &w.part(id)});
     std::vector<std::pair<double, std::string>> vtkFrames;
+    std::vector<double> deformations(w.bodyCount(), 0.0);  // by body, this step's
     ProgressBar bar("run " + std::filesystem::path(scene.source).filename().string(), options.progress);
     const auto start = Clock::now();
     for (std::uint64_t i = 0; i < steps; ++i) {
@@ -152,9 +154,12 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         s.maxMovingMasses = std::max(s.maxMovingMasses, moving);
         s.maxComputedSprings = std::max(s.maxComputedSprings, computedSprings(w));
         s.maxZones = std::max(s.maxZones, zoneCount(w));
-        for (BodyId id = 0; id < w.bodyCount(); ++id) s.maxDeformation = std::max(s.maxDeformation, deformation(w.part(id)));
+        for (BodyId id = 0; id < w.bodyCount(); ++id) {  // once a step: O(moving masses) each
+            deformations[id] = deformation(w.part(id));
+            s.maxDeformation = std::max(s.maxDeformation, deformations[id]);
+        }
         if (w.coupling().active) s.maxCouplingForce = std::max(s.maxCouplingForce, w.coupling().force.norm());
-        if (csv.is_open() && (i + 1) % std::uint64_t(std::max(1, options.csvEvery)) == 0) csv << csvRow(scene, w);
+        if (csv.is_open() && (i + 1) % std::uint64_t(std::max(1, options.csvEvery)) == 0) csv << csvRow(scene, w, deformations);
         if (objStride && !options.out.empty() && (i + 1) % objStride == 0)
             writeObjFrame(files.add(options.out / fmt::format("frame_{:06d}.obj", i + 1)), w, scene);
         if (vtkStride && !options.out.empty() && (i + 1) % vtkStride == 0) {
