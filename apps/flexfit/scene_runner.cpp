@@ -44,7 +44,8 @@ double deformation(const Part& part) {
 // coupling, per-stage microseconds; then per part, in scene order: its centre of mass
 // (<part>_x, _y, _z; moving parts), the force deformable parts pressed on it in the step
 // (<part>_contact_fx, _fy, _fz, world frame, RigidBody::deformableContactForce; dynamic parts)
-// and its largest deformation (<part>_deformation; parts that deform; `deformations` by body).
+// and its largest deformation (<part>_deformation; parts that deform), given in `deformations`
+// by body.
 std::string csvHeader(const Scene& scene) {
     std::string h = "time,contacts,zones,moving_masses,computed_springs,coupling_fx,coupling_fy,coupling_fz,coupling_tx,coupling_ty,coupling_tz";
     for (std::size_t s = 0; s < kStageCount; ++s) h += std::string(",us_") + toString(Stage(s));

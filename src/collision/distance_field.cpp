@@ -274,11 +274,12 @@ FLEXFIT_AVX2 std::size_t sampleFours(const Vec3& min, const std::array<int, 3>& 
 }  // namespace
 #endif
 
-// How far the sample at a ball's centre must exceed for no point of the ball to sample <= 0,
+// The value the sample at a ball's centre must exceed for no point of the ball to sample <= 0,
 // the centre `outside` the grid by that much (clamped into it). Two bounds on how far the
 // sample can fall over the ball: the interpolant's slope (sqrt(3) per unit), or the exact
 // distance's (1 per unit) plus the sample's error at both ends (sqrt(3) cells each). The float
-// node values' relative rounding (6e-8) is covered by the tiny extra margin.
+// node values' rounding (relative 6e-8) is covered by roundingReach, the double arithmetic's
+// by the factor 1 + 1e-9.
 double SignedDistanceField::clearReach(const Grid& grid, double radius, double outside, double slack) {
     const double fall = std::min(std::sqrt(3.0) * (radius + outside), radius + outside + 2.0 * std::sqrt(3.0) * grid.cell);
     return fall * (1.0 + 1e-9) + slack + grid.roundingReach;
@@ -297,9 +298,9 @@ bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
         if (coarse > clearReach(coarse_, radius, outside, gap)) return true;
         // The fine sample exceeds the coarse one by at most `gap` and both grids' rounding.
         // Where even that cannot clear the ball, the answer is no without the fine sample: at
-        // the top of a point-shell walk those samples fall far apart in the 8 MB fine grid, a
-        // cache miss each (about 0.3 us a node on the ball-torus haptic scene, half its worst
-        // narrow phase). The answer is the same either way.
+        // the top of a point-shell walk those samples fall far apart in the fine grid, a cache
+        // miss each. The answer is the same either way. (Inside the fine grid both grids
+        // sample the centre itself: the coarse box holds the fine one.)
         const double ceiling = coarse + gap * (1.0 + 1e-9) + coarse_.roundingReach + fine_.roundingReach;
         if (inGrid(centre) && ceiling <= clearReach(fine_, radius, 0.0, 0.0)) return false;
     }
