@@ -1,6 +1,8 @@
 // The point-shell queries (collision.hpp): a deformable part's masses against a rigid part's
 // signed distance field, in full or from what the pair's last query found.
 #include "collision/pair_query.hpp"
+#include "collision/sampling_kernel.hpp"
+#include "core/lanes256.hpp"
 #include "flexfit/distance_field.hpp"
 
 #include <limits>
@@ -51,7 +53,12 @@ public:
         const std::size_t n = batch_.masses.size();
         batch_.samples.resize(n);
         field_.sampleMany(batch_.points, batch_.samples);
-        for (std::size_t k = 0; k < n; ++k) {
+        std::size_t k = 0;
+#if defined(FLEXFIT_LANES256)
+        if (detail::vectorSamplingEnabled())
+            for (; k + 4 <= n; k += 4) addFourContacts(k, done);
+#endif
+        for (; k < n; ++k) {
             const SignedDistanceField::Interpolated& s = batch_.samples[k];
             if (s.distance <= 0.0) addContact(batch_.masses[k], batch_.points[k], s);
             done(k, s.distance);
@@ -75,13 +82,48 @@ private:
         return batch;
     }
 
+#if defined(FLEXFIT_LANES256)
+    // Queued samples k..k+3 as the scalar loop takes them (addContact, then done), the contacts'
+    // points and normals 4 at a time by the same operations in the same order (lanes256.hpp).
+    template <class Done>
+    FLEXFIT_AVX2_LANES void addFourContacts(std::size_t k, Done& done) {
+        using namespace detail::lanes;
+        const SignedDistanceField::Interpolated* s = &batch_.samples[k];
+        if (s[0].distance > 0.0 && s[1].distance > 0.0 && s[2].distance > 0.0 && s[3].distance > 0.0) {
+            for (int j = 0; j < 4; ++j) done(k + std::size_t(j), s[j].distance);
+            return;
+        }
+        const Lanes3 gradient = gather([&](int j) -> const Vec3& { return s[j].gradient; });
+        const __m256d g = _mm256_sqrt_pd(dot(gradient, gradient));
+        const Lanes3 point = add(rotate(broadcast(a_.pose().rotation), gather([&](int j) -> const Vec3& { return batch_.points[k + std::size_t(j)]; })),
+                                 broadcast(a_.pose().translation));
+        const Stored3 points = store(point), normals = store(negate(times(ra_, divide(gradient, g))));
+        alignas(32) double norms[4];
+        _mm256_store_pd(norms, g);
+        for (int j = 0; j < 4; ++j) {
+            const std::size_t q = k + std::size_t(j);
+            if (s[j].distance <= 0.0) {
+                if (norms[j] > 1e-9)
+                    pushContact(batch_.masses[q], points[j], normals[j], s[j].distance);
+                else
+                    addContact(batch_.masses[q], batch_.points[q], s[j]);
+            }
+            done(q, s[j].distance);
+        }
+    }
+#endif
+
+    void pushContact(Index m, const Vec3& point, const Vec3& normal, double distance) {
+        ++stats_.contacts;
+        contacts_.push_back({idA_, idB_, 0, b_.model().topology.facesOf(m)[0], point, normal, -distance, m});
+    }
+
     void addContact(Index m, const Vec3& p, const SignedDistanceField::Interpolated& s) {
         // The gradient is the outward normal (zero only on a symmetry plane of the field,
         // where the exact closest point decides).
         const double g = s.gradient.norm();
         const Vec3 outward = g > 1e-9 ? Vec3(s.gradient / g) : field_.query(p).normal;
-        ++stats_.contacts;
-        contacts_.push_back({idA_, idB_, 0, b_.model().topology.facesOf(m)[0], a_.pose().apply(p), -(ra_ * outward), -s.distance, m});
+        pushContact(m, a_.pose().apply(p), -(ra_ * outward), s.distance);
     }
 
     std::uint32_t idA_, idB_;

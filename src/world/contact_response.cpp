@@ -2,16 +2,13 @@
 #include "contact_response.hpp"
 
 #include "contact_solver.hpp"
+#include "core/lanes256.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <optional>
 #include <numeric>
-
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#endif
 
 namespace flexfit::detail {
 namespace {
@@ -103,10 +100,7 @@ void applyReaction(const PairTerms& terms, Part& p, Index mass, double h, RigidB
     b.deformableContactForce += force;
 }
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#define FLEXFIT_REACTIONS_AVX2 1
-#define FLEXFIT_AVX2 __attribute__((target("avx2")))
-
+#if defined(FLEXFIT_LANES256)
 std::atomic<int> scalarReactionScopes{0};
 
 bool vectorReactionsEnabled() {
@@ -114,76 +108,38 @@ bool vectorReactionsEnabled() {
     return avx2 && scalarReactionScopes.load(std::memory_order_relaxed) == 0;
 }
 
-// Three lanes of 4: one coordinate each.
-struct Lanes3 {
-    __m256d x, y, z;
-};
-
-FLEXFIT_AVX2 Lanes3 cross(const Lanes3& l, const Lanes3& r) {  // as Eigen's cross
-    return {_mm256_sub_pd(_mm256_mul_pd(l.y, r.z), _mm256_mul_pd(l.z, r.y)), _mm256_sub_pd(_mm256_mul_pd(l.z, r.x), _mm256_mul_pd(l.x, r.z)),
-            _mm256_sub_pd(_mm256_mul_pd(l.x, r.y), _mm256_mul_pd(l.y, r.x))};
-}
-FLEXFIT_AVX2 Lanes3 sub(const Lanes3& a, const Lanes3& b) { return {_mm256_sub_pd(a.x, b.x), _mm256_sub_pd(a.y, b.y), _mm256_sub_pd(a.z, b.z)}; }
-FLEXFIT_AVX2 Lanes3 broadcast(const Vec3& v) { return {_mm256_set1_pd(v.x()), _mm256_set1_pd(v.y()), _mm256_set1_pd(v.z())}; }
-// (a0 b0 + a1 b1) + a2 b2: Eigen's order for a 3-vector's dot and squared norm (SSE2 packets).
-FLEXFIT_AVX2 __m256d dot(const Lanes3& a, const Lanes3& b) {
-    return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(a.x, b.x), _mm256_mul_pd(a.y, b.y)), _mm256_mul_pd(a.z, b.z));
-}
-
-// q v as Eigen's Quaternion::_transformVector: uv = q.vec x v, doubled; v + w uv + q.vec x uv.
-FLEXFIT_AVX2 Lanes3 rotate(const Lanes3& qv, __m256d w, const Lanes3& v) {
-    Lanes3 uv = cross(qv, v);
-    uv = {_mm256_add_pd(uv.x, uv.x), _mm256_add_pd(uv.y, uv.y), _mm256_add_pd(uv.z, uv.z)};
-    const Lanes3 c = cross(qv, uv);
-    return {_mm256_add_pd(_mm256_add_pd(v.x, _mm256_mul_pd(w, uv.x)), c.x), _mm256_add_pd(_mm256_add_pd(v.y, _mm256_mul_pd(w, uv.y)), c.y),
-            _mm256_add_pd(_mm256_add_pd(v.z, _mm256_mul_pd(w, uv.z)), c.z)};
-}
-
-FLEXFIT_AVX2 Lanes3 gather(std::span<const Vec3> points, const ContactResponse::Reaction* four) {
-    alignas(32) double c[3][4];
-    for (int j = 0; j < 4; ++j)
-        for (int d = 0; d < 3; ++d) c[d][j] = points[four[j].mass][d];
-    return {_mm256_load_pd(c[0]), _mm256_load_pd(c[1]), _mm256_load_pd(c[2])};
-}
-
 // applyReaction for a frictionless pair's reactions, 4 a vector: each lane's force and torque
-// by the same operations in the same order (no fused multiply-add: the same bits), then added
-// to the body one reaction at a time, in order. Returns how many it did (a multiple of 4).
-FLEXFIT_AVX2 std::size_t applyFrictionlessReactions256(const PairTerms& terms, const Part& p, std::span<const ContactResponse::Reaction> reactions,
-                                                     RigidBody& b) {
-    const Eigen::Quaterniond& q = p.pose().rotation;
-    const Lanes3 qv = broadcast(q.vec()), translation = broadcast(p.pose().translation);
-    const __m256d w = _mm256_set1_pd(q.w()), zero = _mm256_setzero_pd(), signBit = _mm256_set1_pd(-0.0);
+// by the same operations in the same order (lanes256.hpp: the same bits), then added to the
+// body one reaction at a time, in order. Returns how many it did (a multiple of 4).
+FLEXFIT_AVX2_LANES std::size_t applyFrictionlessReactions256(const PairTerms& terms, const Part& p,
+                                                           std::span<const ContactResponse::Reaction> reactions, RigidBody& b) {
+    using namespace lanes;
+    const QuaternionLanes q = broadcast(p.pose().rotation);
+    const Lanes3 translation = broadcast(p.pose().translation);
     const Lanes3 bodyCentre = broadcast(terms.bodyCentre), bodyVelocity = broadcast(terms.bodyVelocity), bodySpin = broadcast(terms.bodySpin);
     const Lanes3 partCentre = broadcast(terms.partCentre), partVelocity = broadcast(terms.partVelocity), partSpin = broadcast(terms.partSpin);
-    const __m256d stiffness = _mm256_set1_pd(terms.stiffness), damping = _mm256_set1_pd(terms.damping);
+    const __m256d stiffness = _mm256_set1_pd(terms.stiffness), damping = _mm256_set1_pd(terms.damping), zero = _mm256_setzero_pd();
     const std::size_t n = reactions.size() / 4 * 4;
     for (std::size_t k = 0; k < n; k += 4) {
-        const Lanes3 local = gather(p.state().positions, &reactions[k]), rest = gather(p.model().restPositions, &reactions[k]);
-        const Lanes3 displacement = rotate(qv, w, sub(local, rest));
+        const ContactResponse::Reaction* four = &reactions[k];
+        const Lanes3 local = gather([&](int j) -> const Vec3& { return p.state().positions[four[j].mass]; });
+        const Lanes3 rest = gather([&](int j) -> const Vec3& { return p.model().restPositions[four[j].mass]; });
+        const Lanes3 displacement = rotate(q, sub(local, rest));
         const __m256d length = _mm256_sqrt_pd(dot(displacement, displacement));
-        const int acts = _mm256_movemask_pd(_mm256_cmp_pd(length, zero, _CMP_GT_OQ));
-        const Lanes3 normal = {_mm256_div_pd(_mm256_xor_pd(displacement.x, signBit), length), _mm256_div_pd(_mm256_xor_pd(displacement.y, signBit), length),
-                               _mm256_div_pd(_mm256_xor_pd(displacement.z, signBit), length)};
-        const Lanes3 turned = rotate(qv, w, local);
-        const Lanes3 x = {_mm256_add_pd(turned.x, translation.x), _mm256_add_pd(turned.y, translation.y), _mm256_add_pd(turned.z, translation.z)};
-        const Lanes3 arm = sub(x, bodyCentre), bodyTurn = cross(bodySpin, arm), partTurn = cross(partSpin, sub(x, partCentre));
-        const Lanes3 relative = {_mm256_sub_pd(_mm256_sub_pd(_mm256_add_pd(bodyVelocity.x, bodyTurn.x), partVelocity.x), partTurn.x),
-                                 _mm256_sub_pd(_mm256_sub_pd(_mm256_add_pd(bodyVelocity.y, bodyTurn.y), partVelocity.y), partTurn.y),
-                                 _mm256_sub_pd(_mm256_sub_pd(_mm256_add_pd(bodyVelocity.z, bodyTurn.z), partVelocity.z), partTurn.z)};
+        const int acts = _mm256_movemask_pd(_mm256_cmp_pd(length, zero, _CMP_GT_OQ));  // !(length > 0): no reaction
+        const Lanes3 normal = divide(negate(displacement), length);
+        const Lanes3 x = add(rotate(q, local), translation);
+        const Lanes3 arm = sub(x, bodyCentre);
+        const Lanes3 relative = sub(sub(add(bodyVelocity, cross(bodySpin, arm)), partVelocity), cross(partSpin, sub(x, partCentre)));
         __m256d pressing = _mm256_sub_pd(_mm256_mul_pd(stiffness, length), _mm256_mul_pd(damping, dot(relative, normal)));
         pressing = _mm256_blendv_pd(pressing, zero, _mm256_cmp_pd(pressing, zero, _CMP_LT_OQ));  // std::max(pressing, 0.0)
-        const Lanes3 force = {_mm256_mul_pd(pressing, normal.x), _mm256_mul_pd(pressing, normal.y), _mm256_mul_pd(pressing, normal.z)};
-        const Lanes3 torque = cross(arm, force);
-        alignas(32) double f[3][4], t[3][4];
-        _mm256_store_pd(f[0], force.x), _mm256_store_pd(f[1], force.y), _mm256_store_pd(f[2], force.z);
-        _mm256_store_pd(t[0], torque.x), _mm256_store_pd(t[1], torque.y), _mm256_store_pd(t[2], torque.z);
+        const Lanes3 forceLanes = scale(pressing, normal);
+        const Stored3 force = store(forceLanes), torque = store(cross(arm, forceLanes));
         for (int j = 0; j < 4; ++j) {
             if (!(acts & (1 << j))) continue;
-            const Vec3 fj(f[0][j], f[1][j], f[2][j]);
-            b.force += fj;
-            b.torque += Vec3(t[0][j], t[1][j], t[2][j]);
-            b.deformableContactForce += fj;
+            b.force += force[j];
+            b.torque += torque[j];
+            b.deformableContactForce += force[j];
         }
     }
     return n;
@@ -204,7 +160,7 @@ void applyReactionForces(const StepContext& step, double dampingRatio, Bodies& b
         Part& p = *bodies.parts[partId];
         RigidBody& b = bodies.rigid[body];
         std::size_t k = begin;
-#if defined(FLEXFIT_REACTIONS_AVX2)
+#if defined(FLEXFIT_LANES256)
         if (!(terms.staticFriction > 0.0) && vectorReactionsEnabled()) k += applyFrictionlessReactions256(terms, p, all.subspan(begin, end - begin), b);
 #endif
         for (; k < end; ++k) applyReaction(terms, p, all[k].mass, h, b);
@@ -272,12 +228,12 @@ double effectiveContactStiffness(const Part& part, double timeStep) {
 }
 
 ScopedScalarReactions::ScopedScalarReactions() {
-#if defined(FLEXFIT_REACTIONS_AVX2)
+#if defined(FLEXFIT_LANES256)
     scalarReactionScopes.fetch_add(1, std::memory_order_relaxed);
 #endif
 }
 ScopedScalarReactions::~ScopedScalarReactions() {
-#if defined(FLEXFIT_REACTIONS_AVX2)
+#if defined(FLEXFIT_LANES256)
     scalarReactionScopes.fetch_sub(1, std::memory_order_relaxed);
 #endif
 }

@@ -1,6 +1,7 @@
 // The coherent point-shell query (point_shell.cpp) against the full one, contact for contact, and
 // against brute force (every mass sampled), while a rigid ball wanders over a torus whose masses
 // a zone moves; then that a ball held still samples only the masses near it.
+#include "collision/sampling_kernel.hpp"
 #include "flexfit/flexfit.hpp"
 #include "same_contacts.hpp"
 #include "test_bodies.hpp"
@@ -122,4 +123,32 @@ TEST(PointShellCoherent, ABallHeldStillSamplesOnlyTheMassesNearIt) {
     }
     ASSERT_GT(last.contacts, 0u);
     EXPECT_LT(last.exactTests, first.exactTests / 2) << last.exactTests << " samples against " << first.exactTests;
+}
+
+TEST(PointShell, ContactsFourAtATimeEqualOneAtATime) {
+    // The AVX2 path (samples and contacts made 4 at a time) against one at a time
+    // (ScopedScalarSampling), bit for bit, as a turning ball wanders over a deforming torus.
+    if (!detail::vectorSamplingEnabled()) GTEST_SKIP() << "no AVX2 on this CPU: one path only";
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    BallOverTorus s;
+    s.ball.setPose(Pose{Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vec3(0.3, 1.0, -0.5).normalized())), Vec3(1.0, 1.05, 0.0)});
+    std::size_t contacts = 0;
+    for (int step = 0; step < 120; ++step) {
+        if (step % 60 < 40) s.torus.applyForce(12, Vec3(0.0, -2.0, 0.0));
+        s.torus.step();
+        Pose next = s.ball.pose();
+        next.translation += 0.004 * Vec3(u(rng), u(rng), u(rng)) + 0.02 * (Vec3(1.0, 1.05, 0.0) - next.translation);
+        next.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(0.05 * u(rng), Vec3(u(rng), u(rng), 1.0).normalized())) * next.rotation).normalized();
+        s.ball.setPose(next);
+        const std::vector<Contact> vector = s.full();
+        std::vector<Contact> scalar;
+        {
+            const detail::ScopedScalarSampling oneAtATime;
+            scalar = s.full();
+        }
+        expectSameContacts(vector, scalar, step);
+        contacts += vector.size();
+    }
+    EXPECT_GT(contacts, 400u);
 }
