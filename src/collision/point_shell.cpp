@@ -207,6 +207,35 @@ void takeWalk(PointShellCoherence& c) {
     ++c.traversals;
 }
 
+#if defined(FLEXFIT_LANES256)
+// The moving masses' skip test 4 at a time (each point turned into A's frame and its squared
+// distance to its last sample, by the same operations as the scalar loop: lanes256.hpp);
+// sampleMoved(m, p) for each mass not skipped, in order. Returns how many masses it took (a
+// multiple of 4).
+template <class SampleMoved>
+FLEXFIT_AVX2_LANES std::size_t sampleMovedFours(std::span<const Index> moving, const Part& b, const RelativePose& bInA,
+                                                const PointShellCoherence& c, SampleMoved& sampleMoved) {
+    using namespace detail::lanes;
+    const Lanes3 translation = broadcast(bInA.translation);
+    const std::vector<Vec3>& positions = b.state().positions;
+    const std::size_t n = moving.size() / 4 * 4;
+    for (std::size_t i = 0; i < n; i += 4) {
+        const Index* four = &moving[i];
+        const Lanes3 p = add(times(bInA.rotation, gather([&](int j) -> const Vec3& { return positions[four[j]]; })), translation);
+        const Lanes3 last = gather([&](int j) -> const Vec3& { return c.lastSamples[four[j]].point; });
+        const Lanes3 moved = sub(p, last);
+        const __m256d reach = _mm256_set_pd(c.lastSamples[four[3]].squaredReach, c.lastSamples[four[2]].squaredReach,
+                                            c.lastSamples[four[1]].squaredReach, c.lastSamples[four[0]].squaredReach);
+        const int skipped = _mm256_movemask_pd(_mm256_cmp_pd(dot(moved, moved), reach, _CMP_LT_OQ));
+        if (skipped == 0xf) continue;
+        const Stored3 points = store(p);
+        for (int j = 0; j < 4; ++j)
+            if (!(skipped & (1 << j))) sampleMoved(four[j], points[j]);
+    }
+    return n;
+}
+#endif
+
 }  // namespace
 
 void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField& fieldA, std::uint32_t idB, const Part& b,
@@ -233,17 +262,26 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
     if (c.lastSamples.size() != massCount) c.lastSamples.assign(massCount, {});  // none yet
     // Moving masses: skipped while they stay closer to their last sample than it was far from
     // the surface (slope sqrt(3)); any other is sampled, and that sample kept.
-    for (Index m : b.movingMasses()) {
-        const Vec3 p = sampler.pointOf(m);
-        PointShellCoherence::LastSample& last = c.lastSamples[m];
-        if ((p - last.point).squaredNorm() < last.squaredReach) continue;
+    const auto sampleMoved = [&](Index m, const Vec3& p) {
         // Not sampled: a free vertex never touches; one outside the grid is not sampled again
         // until it can have entered it (the margin covers rounding in the two squares).
+        PointShellCoherence::LastSample& last = c.lastSamples[m];
         switch (sampler.queue(m, p)) {
             case MassSampler::Queued::Yes: break;
             case MassSampler::Queued::FreeVertex: last = {p, std::numeric_limits<double>::infinity()}; break;
             case MassSampler::Queued::OutsideGrid: last = {p, fieldA.squaredDistanceToGrid(p) * (1.0 - 1e-9)}; break;
         }
+    };
+    const std::span<const Index> moving = b.movingMasses();
+    std::size_t i = 0;
+#if defined(FLEXFIT_LANES256)
+    if (detail::vectorSamplingEnabled()) i = sampleMovedFours(moving, b, bInA, c, sampleMoved);
+#endif
+    for (; i < moving.size(); ++i) {
+        const Index m = moving[i];
+        const Vec3 p = sampler.pointOf(m);
+        const PointShellCoherence::LastSample& last = c.lastSamples[m];
+        if (!((p - last.point).squaredNorm() < last.squaredReach)) sampleMoved(m, p);
     }
     const std::size_t movingQueued = sampler.queuedCount();
     // Masses at rest: those the list's walk reached with the margin, while B's rest sphere has

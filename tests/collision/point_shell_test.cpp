@@ -126,14 +126,16 @@ TEST(PointShellCoherent, ABallHeldStillSamplesOnlyTheMassesNearIt) {
 }
 
 TEST(PointShell, ContactsFourAtATimeEqualOneAtATime) {
-    // The AVX2 path (samples and contacts made 4 at a time) against one at a time
-    // (ScopedScalarSampling), bit for bit, as a turning ball wanders over a deforming torus.
+    // The AVX2 paths (samples, contacts and the coherent query's skip test 4 at a time)
+    // against one at a time (ScopedScalarSampling), bit for bit, by the full and the coherent
+    // query, as a turning ball wanders over a deforming torus.
     if (!detail::vectorSamplingEnabled()) GTEST_SKIP() << "no AVX2 on this CPU: one path only";
     std::mt19937 rng(9);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     BallOverTorus s;
     s.ball.setPose(Pose{Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vec3(0.3, 1.0, -0.5).normalized())), Vec3(1.0, 1.05, 0.0)});
     std::size_t contacts = 0;
+    PointShellCoherence vectorCoherence, scalarCoherence;
     for (int step = 0; step < 120; ++step) {
         if (step % 60 < 40) s.torus.applyForce(12, Vec3(0.0, -2.0, 0.0));
         s.torus.step();
@@ -141,13 +143,17 @@ TEST(PointShell, ContactsFourAtATimeEqualOneAtATime) {
         next.translation += 0.004 * Vec3(u(rng), u(rng), u(rng)) + 0.02 * (Vec3(1.0, 1.05, 0.0) - next.translation);
         next.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(0.05 * u(rng), Vec3(u(rng), u(rng), 1.0).normalized())) * next.rotation).normalized();
         s.ball.setPose(next);
-        const std::vector<Contact> vector = s.full();
-        std::vector<Contact> scalar;
+        QueryStats stats;
+        const std::vector<Contact> vector = s.full(), vectorCoherent = s.coherent(vectorCoherence, stats);
+        std::vector<Contact> scalar, scalarCoherent;
         {
             const detail::ScopedScalarSampling oneAtATime;
             scalar = s.full();
+            scalarCoherent = s.coherent(scalarCoherence, stats);
         }
         expectSameContacts(vector, scalar, step);
+        expectSameContacts(vectorCoherent, scalarCoherent, step);
+        expectSameContacts(vectorCoherent, vector, step);
         contacts += vector.size();
     }
     EXPECT_GT(contacts, 400u);
