@@ -1,7 +1,6 @@
 // The point-shell queries (collision.hpp): a deformable part's masses against a rigid part's
 // signed distance field, in full or from what the pair's last query found.
 #include "collision/pair_query.hpp"
-#include "collision/sampling_kernel.hpp"
 #include "core/lanes256.hpp"
 #include "flexfit/distance_field.hpp"
 
@@ -55,7 +54,7 @@ public:
         field_.sampleMany(batch_.points, batch_.samples);
         std::size_t k = 0;
 #if defined(FLEXFIT_LANES256)
-        if (detail::vectorSamplingEnabled())
+        if (detail::lanesEnabled())
             for (; k + 4 <= n; k += 4) addFourContacts(k, done);
 #endif
         for (; k < n; ++k) {
@@ -275,7 +274,7 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
     const std::span<const Index> moving = b.movingMasses();
     std::size_t i = 0;
 #if defined(FLEXFIT_LANES256)
-    if (detail::vectorSamplingEnabled()) i = sampleMovedFours(moving, b, bInA, c, sampleMoved);
+    if (detail::lanesEnabled()) i = sampleMovedFours(moving, b, bInA, c, sampleMoved);
 #endif
     for (; i < moving.size(); ++i) {
         const Index m = moving[i];

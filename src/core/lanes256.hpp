@@ -5,8 +5,26 @@
 // squared norm (a0 b0 + a1 b1) + a2 b2; a 3x3 matrix times a vector, rows 0 and 1
 // (m0 v0 + m1 v1) + m2 v2 but row 2 m0 v0 + (m1 v1 + m2 v2) (rows 0-1 form one SSE2 packet);
 // cross products and Quaternion::_transformVector as written in Eigen's source. Callers check
-// __builtin_cpu_supports("avx2") and keep a test that compares with the scalar code bitwise.
+// lanesEnabled() and keep a test that compares with the scalar code bitwise.
 #pragma once
+
+namespace flexfit::detail {
+
+// True when the paths built on these lanes run: compiled in, the CPU has AVX2, and no
+// ScopedScalarLanes is alive (lanes256.cpp). The paths: the contact response's frictionless
+// reactions, Part::displaceMasses, the point shell's contacts and its moving masses' skip test.
+bool lanesEnabled();
+
+// While at least one scope is alive (on any thread), those paths run one at a time: for tests.
+class ScopedScalarLanes {
+public:
+    ScopedScalarLanes();
+    ~ScopedScalarLanes();
+    ScopedScalarLanes(const ScopedScalarLanes&) = delete;
+    ScopedScalarLanes& operator=(const ScopedScalarLanes&) = delete;
+};
+
+}  // namespace flexfit::detail
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #define FLEXFIT_LANES256 1

@@ -4,11 +4,13 @@
 #include "divergence.hpp"
 #include "model/kring.hpp"
 #include "model/spring_blocks.hpp"
+#include "core/lanes256.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
 
 namespace flexfit {
 namespace {
@@ -302,6 +304,57 @@ void Part::displaceMass(Index mass, const Vec3& worldDisplacement) {
         if (against < 0.0) state_.velocities[mass] -= against * direction;
     }
     markChanged(mass);
+}
+
+#if defined(FLEXFIT_LANES256)
+namespace {
+
+// displaceMass's arithmetic for 4 moving masses (lanes256.hpp's orders, the same bits): the
+// displacement turned into the part's frame, the positions moved, the velocities' components
+// against it removed.
+FLEXFIT_AVX2_LANES void displaceFour(const Eigen::Quaterniond& rotation, const Index* masses, const Vec3* worldDisplacements, PartState& state) {
+    using namespace detail::lanes;
+    const Lanes3 d = rotate(broadcast(rotation.conjugate()), gather([&](int j) -> const Vec3& { return worldDisplacements[j]; }));
+    const Lanes3 moved = add(gather([&](int j) -> const Vec3& { return state.positions[masses[j]]; }), d);
+    const __m256d zero = _mm256_setzero_pd(), length = _mm256_sqrt_pd(dot(d, d));
+    const Lanes3 direction = divide(d, length);
+    const Lanes3 v = gather([&](int j) -> const Vec3& { return state.velocities[masses[j]]; });
+    const __m256d against = dot(v, direction);
+    // Only where length > 0 and against < 0 (NaN: neither, as the scalar tests).
+    const __m256d removes = _mm256_and_pd(_mm256_cmp_pd(length, zero, _CMP_GT_OQ), _mm256_cmp_pd(against, zero, _CMP_LT_OQ));
+    const Lanes3 slowed = sub(v, scale(against, direction));
+    const Stored3 positions = store(moved), velocities = store({_mm256_blendv_pd(v.x, slowed.x, removes), _mm256_blendv_pd(v.y, slowed.y, removes),
+                                                                 _mm256_blendv_pd(v.z, slowed.z, removes)});
+    for (int j = 0; j < 4; ++j) {
+        state.positions[masses[j]] = positions[j];
+        state.velocities[masses[j]] = velocities[j];
+    }
+}
+
+}  // namespace
+#endif
+
+void Part::displaceMasses(std::span<const Index> masses, std::span<const Vec3> worldDisplacements) {
+    if (masses.size() != worldDisplacements.size())
+        throw std::invalid_argument("Part::displaceMasses: " + std::to_string(masses.size()) + " masses, " +
+                                    std::to_string(worldDisplacements.size()) + " displacements");
+    std::size_t i = 0;
+#if defined(FLEXFIT_LANES256)
+    if (detail::lanesEnabled() && settings_.mode != PartMode::Rigid)
+        for (; i + 4 <= masses.size(); i += 4) {
+            const Index* four = &masses[i];
+            const auto movingMass = [&](Index m) { return m < model_->massCount() && region_.moves(m); };
+            const bool distinct = four[0] != four[1] && four[0] != four[2] && four[0] != four[3] && four[1] != four[2] &&
+                                  four[1] != four[3] && four[2] != four[3];
+            if (!(distinct && movingMass(four[0]) && movingMass(four[1]) && movingMass(four[2]) && movingMass(four[3]))) {
+                for (int j = 0; j < 4; ++j) displaceMass(four[j], worldDisplacements[i + std::size_t(j)]);
+                continue;
+            }
+            displaceFour(pose_.rotation, four, &worldDisplacements[i], state_);
+            for (int j = 0; j < 4; ++j) markChanged(four[j]);
+        }
+#endif
+    for (; i < masses.size(); ++i) displaceMass(masses[i], worldDisplacements[i]);
 }
 
 bool Part::zoneAtRest(const Zone& zone) const {

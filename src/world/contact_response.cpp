@@ -5,7 +5,6 @@
 #include "core/lanes256.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <optional>
 #include <numeric>
@@ -41,8 +40,18 @@ void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactRes
     }
 }
 
-void displacePushedMasses(Bodies& bodies, const ContactResponse& r) {
-    for (const ContactResponse::Push& p : r.pushes) bodies.parts[p.body]->displaceMass(p.mass, p.displacement);
+// Each body's run of pushes at once (Part::displaceMasses), in order.
+void displacePushedMasses(Bodies& bodies, ContactResponse& r) {
+    for (std::size_t begin = 0, end = 0; begin < r.pushes.size(); begin = end) {
+        const BodyId body = r.pushes[begin].body;
+        r.runMasses.clear();
+        r.runDisplacements.clear();
+        for (end = begin; end < r.pushes.size() && r.pushes[end].body == body; ++end) {
+            r.runMasses.push_back(r.pushes[end].mass);
+            r.runDisplacements.push_back(r.pushes[end].displacement);
+        }
+        bodies.parts[body]->displaceMasses(r.runMasses, r.runDisplacements);
+    }
 }
 
 // What every reaction between one pressing body and one deformable part shares.
@@ -101,13 +110,6 @@ void applyReaction(const PairTerms& terms, Part& p, Index mass, double h, RigidB
 }
 
 #if defined(FLEXFIT_LANES256)
-std::atomic<int> scalarReactionScopes{0};
-
-bool vectorReactionsEnabled() {
-    static const bool avx2 = __builtin_cpu_supports("avx2");
-    return avx2 && scalarReactionScopes.load(std::memory_order_relaxed) == 0;
-}
-
 // applyReaction for a frictionless pair's reactions, 4 a vector: each lane's force and torque
 // by the same operations in the same order (lanes256.hpp: the same bits), then added to the
 // body one reaction at a time, in order. Returns how many it did (a multiple of 4).
@@ -161,7 +163,7 @@ void applyReactionForces(const StepContext& step, double dampingRatio, Bodies& b
         RigidBody& b = bodies.rigid[body];
         std::size_t k = begin;
 #if defined(FLEXFIT_LANES256)
-        if (!(terms.staticFriction > 0.0) && vectorReactionsEnabled()) k += applyFrictionlessReactions256(terms, p, all.subspan(begin, end - begin), b);
+        if (!(terms.staticFriction > 0.0) && lanesEnabled()) k += applyFrictionlessReactions256(terms, p, all.subspan(begin, end - begin), b);
 #endif
         for (; k < end; ++k) applyReaction(terms, p, all[k].mass, h, b);
     }
@@ -225,17 +227,6 @@ double effectiveContactStiffness(const Part& part, double timeStep) {
         case RestorationMethod::None: break;
     }
     return springs;
-}
-
-ScopedScalarReactions::ScopedScalarReactions() {
-#if defined(FLEXFIT_LANES256)
-    scalarReactionScopes.fetch_add(1, std::memory_order_relaxed);
-#endif
-}
-ScopedScalarReactions::~ScopedScalarReactions() {
-#if defined(FLEXFIT_LANES256)
-    scalarReactionScopes.fetch_sub(1, std::memory_order_relaxed);
-#endif
 }
 
 void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response) {

@@ -50,6 +50,8 @@ struct ContactResponse {
     };
     IndexSet pushed;
     std::vector<Push> pushes;  // parallel to pushed's members
+    std::vector<Index> runMasses;         // one body's run of pushes, for Part::displaceMasses
+    std::vector<Vec3> runDisplacements;
     IndexSet reacting;
     std::vector<BodyId> reactionOwner;  // (world masses) the body that last counted each
     struct Reaction {
@@ -63,17 +65,6 @@ struct ContactResponse {
 // Deformable pushes, then the reactions dynamic bodies feel, for the contacts of this step.
 void respondToContacts(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
                        ContactResponse& response);
-
-// Frictionless pairs' reactions run 4 at a time on CPUs with AVX2, by the same operations in the
-// same order as one at a time (no fused multiply-add), added to the body in order: the same bits.
-// While a scope is alive (on any thread), every reaction runs one at a time: for tests.
-class ScopedScalarReactions {
-public:
-    ScopedScalarReactions();
-    ~ScopedScalarReactions();
-    ScopedScalarReactions(const ScopedScalarReactions&) = delete;
-    ScopedScalarReactions& operator=(const ScopedScalarReactions&) = delete;
-};
 
 // The deformable pushes alone (zones at the contacted faces, masses moved out): for a body
 // pressing parts in the middle of its sub-steps.

@@ -2,6 +2,7 @@
 // against brute force (every mass sampled), while a rigid ball wanders over a torus whose masses
 // a zone moves; then that a ball held still samples only the masses near it.
 #include "collision/sampling_kernel.hpp"
+#include "core/lanes256.hpp"
 #include "flexfit/flexfit.hpp"
 #include "same_contacts.hpp"
 #include "test_bodies.hpp"
@@ -127,9 +128,9 @@ TEST(PointShellCoherent, ABallHeldStillSamplesOnlyTheMassesNearIt) {
 
 TEST(PointShell, ContactsFourAtATimeEqualOneAtATime) {
     // The AVX2 paths (samples, contacts and the coherent query's skip test 4 at a time)
-    // against one at a time (ScopedScalarSampling), bit for bit, by the full and the coherent
+    // against one at a time (ScopedScalarSampling, ScopedScalarLanes), bit for bit, by the full and the coherent
     // query, as a turning ball wanders over a deforming torus.
-    if (!detail::vectorSamplingEnabled()) GTEST_SKIP() << "no AVX2 on this CPU: one path only";
+    if (!detail::vectorSamplingEnabled() || !detail::lanesEnabled()) GTEST_SKIP() << "no AVX2 on this CPU: one path only";
     std::mt19937 rng(9);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     BallOverTorus s;
@@ -148,6 +149,7 @@ TEST(PointShell, ContactsFourAtATimeEqualOneAtATime) {
         std::vector<Contact> scalar, scalarCoherent;
         {
             const detail::ScopedScalarSampling oneAtATime;
+            const detail::ScopedScalarLanes lanesOneAtATime;
             scalar = s.full();
             scalarCoherent = s.coherent(scalarCoherence, stats);
         }

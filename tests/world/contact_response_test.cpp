@@ -5,6 +5,7 @@
 #include "flexfit/flexfit.hpp"
 #include "test_bodies.hpp"
 #include "world/contact_response.hpp"
+#include "core/lanes256.hpp"
 
 #include <gtest/gtest.h>
 
@@ -291,17 +292,17 @@ TEST(ContactResponse, TheReactionIsDampedAndReported) {
 }
 
 TEST(ContactResponse, FrictionlessReactionsFourAtATimeGiveTheSameBits) {
-    // The AVX2 path for frictionless reactions against one at a time (ScopedScalarReactions): a
+    // The AVX2 path for frictionless reactions against one at a time (ScopedScalarLanes): a
     // turned rim, a ball thrown at it spinning, no gravity. Every step's reported force and the
     // ball's velocities, and the final state hash, bit for bit.
-    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2: one path only";
+    if (!detail::lanesEnabled()) GTEST_SKIP() << "no AVX2 on this CPU: one path only";
     struct Run {
         std::vector<Vec3> reported, linear, angular;
         std::size_t mostContacts = 0;
         std::uint64_t hash = 0;
     };
     auto run = [](bool scalar) {
-        std::optional<detail::ScopedScalarReactions> oneAtATime;
+        std::optional<detail::ScopedScalarLanes> oneAtATime;
         if (scalar) oneAtATime.emplace();
         WorldSettings settings;
         settings.gravity = Vec3::Zero();

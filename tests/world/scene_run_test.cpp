@@ -3,7 +3,7 @@
 // solver's example scenes (incline, peg in hole, stack, ball-torus with friction) against
 // Coulomb's law, and determinism of a whole scene run.
 #include "collision/sampling_kernel.hpp"
-#include "world/contact_response.hpp"
+#include "core/lanes256.hpp"
 #include "flexfit/scene_file.hpp"
 #include "flexfit/scene_run.hpp"
 #include "flexfit/frame_export.hpp"
@@ -423,14 +423,14 @@ TEST_P(GoldenSceneRun, GoldenHashWithEveryKernel) {
     for (const auto kernel : kSceneKernels) {
         const detail::ScopedBlockKernel chosen(kernel);
         // The scalar kernel runs as on a CPU without vector units: the point shell's masses are
-        // sampled one by one too, and the reactions computed one by one (under the sanitizers,
+        // sampled one by one too, and the lane paths run one at a time (lanes256.hpp) (under the sanitizers,
         // the vector paths the CPU has).
         std::optional<detail::ScopedScalarSampling> scalarSampling;
-        std::optional<detail::ScopedScalarReactions> scalarReactions;
+        std::optional<detail::ScopedScalarLanes> scalarLanes;
 #if !defined(__SANITIZE_ADDRESS__)
         if (kernel == detail::BlockKernel::Scalar) {
             scalarSampling.emplace();
-            scalarReactions.emplace();
+            scalarLanes.emplace();
         }
 #endif
         SceneRun run(scene);
