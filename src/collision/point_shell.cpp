@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <stdexcept>
+#include <vector>
 
 namespace flexfit {
 using namespace detail;
@@ -184,13 +185,27 @@ void startWalk(PointShellCoherence::Walk& w, const RelativePose& pose, double ma
 
 // Advances the walk by up to `budget` nodes; true when it is complete. Each listed mass keeps
 // the distance its rest position samples at the walk's pose (infinity outside the grid).
+// The leaves in the grid are sampled together after the slice (sampleMany: 4 a vector, the
+// same values as one at a time).
 bool advanceWalk(PointShellCoherence::Walk& w, const SignedDistanceField& field, const Bvh<Aabb>& restPoints, std::size_t budget,
                  QueryStats& stats) {
+    thread_local std::vector<std::size_t> slots;  // into w.masses
+    thread_local std::vector<Vec3> points;
+    thread_local std::vector<SignedDistanceField::Interpolated> samples;
+    slots.clear();
+    points.clear();
     const std::size_t visited = walkRestPoints(field, restPoints, w.pose, w.margin, w.stack, budget, [&](Index m) {
         const Vec3 p = w.pose.apply(restPoints.leafVolume(m).centre());
         ++stats.exactTests;
-        w.masses.push_back({m, field.inGrid(p) ? field.sample(p).distance : std::numeric_limits<double>::infinity()});
+        if (field.inGrid(p)) {
+            slots.push_back(w.masses.size());
+            points.push_back(p);
+        }
+        w.masses.push_back({m, std::numeric_limits<double>::infinity()});
     });
+    samples.resize(points.size());
+    field.sampleMany(points, samples);
+    for (std::size_t k = 0; k < slots.size(); ++k) w.masses[slots[k]].second = samples[k].distance;
     w.nodes += visited;
     stats.volumeTests += visited;
     return w.stack.empty();
