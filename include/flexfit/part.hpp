@@ -148,7 +148,8 @@ public:
     void displaceMass(Index mass, const Vec3& worldDisplacement);
     // displaceMass for each (masses[i], worldDisplacements[i]), in order: the same bits, 4 distinct
     // moving masses at a time on CPUs with AVX2 (internal lanes256.hpp). The spans must have the
-    // same size (std::invalid_argument otherwise).
+    // same size (InputError otherwise), and the displacements must not be this part's own state
+    // (a group of 4 reads its inputs before it writes).
     void displaceMasses(std::span<const Index> masses, std::span<const Vec3> worldDisplacements);
     // Masses whose position may have changed since clearChangedMasses(): every mass stepped or
     // displaced, and every mass that returned to rest. Collision hierarchies refit from it.

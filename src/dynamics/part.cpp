@@ -10,7 +10,6 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <stdexcept>
 
 namespace flexfit {
 namespace {
@@ -336,8 +335,8 @@ FLEXFIT_AVX2_LANES void displaceFour(const Eigen::Quaterniond& rotation, const I
 
 void Part::displaceMasses(std::span<const Index> masses, std::span<const Vec3> worldDisplacements) {
     if (masses.size() != worldDisplacements.size())
-        throw std::invalid_argument("Part::displaceMasses: " + std::to_string(masses.size()) + " masses, " +
-                                    std::to_string(worldDisplacements.size()) + " displacements");
+        throw InputError(kPartSource, 0, "displaceMasses: " + std::to_string(masses.size()) + " masses but " +
+                                             std::to_string(worldDisplacements.size()) + " displacements");
     std::size_t i = 0;
 #if defined(FLEXFIT_LANES256)
     if (detail::lanesEnabled() && settings_.mode != PartMode::Rigid)

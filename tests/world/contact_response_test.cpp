@@ -293,13 +293,15 @@ TEST(ContactResponse, TheReactionIsDampedAndReported) {
 
 TEST(ContactResponse, FrictionlessReactionsFourAtATimeGiveTheSameBits) {
     // The AVX2 path for frictionless reactions against one at a time (ScopedScalarLanes): a
-    // turned rim, a ball thrown at it spinning, no gravity. Every step's reported force and the
+    // turned rim that moves and turns on (kinematic: the part's own velocity and spin enter the
+    // reaction), a ball thrown at it spinning, no gravity. Every step's reported force and the
     // ball's velocities, and the final state hash, bit for bit.
     if (!detail::lanesEnabled()) GTEST_SKIP() << "no AVX2 on this CPU: one path only";
     struct Run {
         std::vector<Vec3> reported, linear, angular;
         std::size_t mostContacts = 0;
         std::uint64_t hash = 0;
+        bool partMoves = false;
     };
     auto run = [](bool scalar) {
         std::optional<detail::ScopedScalarLanes> oneAtATime;
@@ -311,25 +313,31 @@ TEST(ContactResponse, FrictionlessReactionsFourAtATimeGiveTheSameBits) {
         rim.simulation.restoration = {RestorationMethod::AnchorSprings, 4.0, 0.5, 0.0};
         rim.zones.contactLevel = 3;
         const Pose turned{Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vec3(1.0, 0.5, -0.2).normalized())), Vec3(0.7, -0.4, 1.1)};
-        const BodyId mouth = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}, {}}), rim, BodySettings{}, turned);
+        BodySettings moved;
+        moved.motion = MotionType::Kinematic;
+        const BodyId mouth = world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}, {}}), rim, moved, turned);
         BodySettings ballBody = flexfit::testing::dynamicBody(turned.rotate(Vec3(0.3, -40.0, 0.1)));
         ballBody.angularVelocity = Vec3(2.0, -1.0, 3.0);
         ballBody.density = 0.01;
         const BodyId ball = world.add(buildPartModel(makeIcoSphere(8.0, 2)), rigidPart(), ballBody, Pose{Eigen::Quaterniond::Identity(), turned.apply(Vec3(0.5, 10.8, 0.0))});
         Run r;
         for (int i = 0; i < 300; ++i) {
+            const double t = 1e-3 * (i + 1);
+            world.setKinematicTarget(mouth, Pose{Eigen::Quaterniond(Eigen::AngleAxisd(0.4 * t, Vec3(0.1, 1.0, 0.3).normalized())) * turned.rotation,
+                                                 turned.translation + t * Vec3(0.5, 1.5, -0.3)});
             world.step();
             r.mostContacts = std::max(r.mostContacts, world.contacts().size());
             r.reported.push_back(world.body(ball).deformableContactForce);
             r.linear.push_back(world.body(ball).linearVelocity);
             r.angular.push_back(world.body(ball).angularVelocity);
         }
-        (void)mouth;
         r.hash = world.stateHash();
+        r.partMoves = world.body(mouth).linearVelocity.norm() > 0.0 && world.body(mouth).angularVelocity.norm() > 0.0;
         return r;
     };
     const Run vector = run(false), scalar = run(true);
-    ASSERT_GT(scalar.mostContacts, 16u);  // several groups of 4, and a remainder
+    ASSERT_GT(scalar.mostContacts, 16u);  // several groups of 4
+    ASSERT_TRUE(scalar.partMoves);
     ASSERT_GT(std::count_if(scalar.reported.begin(), scalar.reported.end(), [](const Vec3& f) { return f != Vec3::Zero(); }), 20);
     EXPECT_EQ(vector.reported, scalar.reported);
     EXPECT_EQ(vector.linear, scalar.linear);
