@@ -45,6 +45,7 @@
 
 #include <array>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace flexfit {
@@ -114,6 +115,8 @@ private:
     void fill(Grid& grid, int i, int j, int k) const;
     void fillBand(Grid& grid, int cells) const;
     Interpolated sample(Grid& grid, const Vec3& p) const;
+    // p clamped into the grid's box, and how far p is from it.
+    static std::pair<Vec3, double> clampedInto(const Grid& grid, const Vec3& p);
     static double clearReach(const Grid& grid, double radius, double outside, double slack);
 
     std::vector<Vec3> vertices_;

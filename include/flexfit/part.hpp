@@ -206,6 +206,10 @@ private:
     void collectMembers(Zone& zone);
     bool zoneAtRest(const Zone& zone) const;
     void markChanged(Index mass);
+    // Whether displaceMass moves this mass: in range, moving, and the part not Rigid.
+    bool displaces(Index mass) const {
+        return mass < model_->massCount() && region_.moves(mass) && settings_.mode != PartMode::Rigid;
+    }
     // Checks a load on one mass (range, finite) and opens or keeps its zone; false in Rigid mode.
     bool loadMass(Index mass, const Vec3& worldLoad, const char* what);
     void markAllChanged();

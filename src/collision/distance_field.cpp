@@ -280,6 +280,11 @@ FLEXFIT_AVX2 std::size_t sampleFours(const Vec3& min, const std::array<int, 3>& 
 // distance's (1 per unit) plus the sample's error at both ends (sqrt(3) cells each). The float
 // node values' rounding (relative 6e-8) is covered by roundingReach, the double arithmetic's
 // by the factor 1 + 1e-9.
+std::pair<Vec3, double> SignedDistanceField::clampedInto(const Grid& grid, const Vec3& p) {
+    const Vec3 clamped = p.cwiseMax(grid.box.min).cwiseMin(grid.box.max);
+    return {clamped, (p - clamped).norm()};
+}
+
 double SignedDistanceField::clearReach(const Grid& grid, double radius, double outside, double slack) {
     const double fall = std::min(std::sqrt(3.0) * (radius + outside), radius + outside + 2.0 * std::sqrt(3.0) * grid.cell);
     return fall * (1.0 + 1e-9) + slack + grid.roundingReach;
@@ -290,8 +295,7 @@ bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
         // Large balls first on the coarse grid, with both grids' sample errors as slack.
         // The fine grid's box lies inside the coarse one's, so "outside the coarse grid" also
         // means "outside the fine one".
-        const Vec3 clamped = centre.cwiseMax(coarse_.box.min).cwiseMin(coarse_.box.max);
-        const double outside = (centre - clamped).norm();
+        const auto [clamped, outside] = clampedInto(coarse_, centre);
         if (outside > radius) return true;  // wholly outside the grid, where nothing is sampled
         const double gap = std::sqrt(3.0) * (coarse_.cell + fine_.cell);
         const double coarse = sample(coarse_, clamped).distance;
@@ -304,8 +308,7 @@ bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
         const double ceiling = coarse + gap * (1.0 + 1e-9) + coarse_.roundingReach + fine_.roundingReach;
         if (inGrid(centre) && ceiling <= clearReach(fine_, radius, 0.0, 0.0)) return false;
     }
-    const Vec3 clamped = centre.cwiseMax(fine_.box.min).cwiseMin(fine_.box.max);
-    const double outside = (centre - clamped).norm();
+    const auto [clamped, outside] = clampedInto(fine_, centre);
     if (outside > radius) return true;
     return sample(fine_, clamped).distance > clearReach(fine_, radius, outside, 0.0);
 }

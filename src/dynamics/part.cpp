@@ -293,7 +293,7 @@ void Part::touchFace(Index face) {
 }
 
 void Part::displaceMass(Index mass, const Vec3& worldDisplacement) {
-    if (mass >= model_->massCount() || !region_.moves(mass) || settings_.mode == PartMode::Rigid) return;
+    if (!displaces(mass)) return;
     const Vec3 d = pose_.rotateInverse(worldDisplacement);
     state_.positions[mass] += d;
     const double length = d.norm();
@@ -339,13 +339,12 @@ void Part::displaceMasses(std::span<const Index> masses, std::span<const Vec3> w
                                              std::to_string(worldDisplacements.size()) + " displacements");
     std::size_t i = 0;
 #if defined(FLEXFIT_LANES256)
-    if (detail::lanesEnabled() && settings_.mode != PartMode::Rigid)
+    if (detail::lanesEnabled())
         for (; i + 4 <= masses.size(); i += 4) {
             const Index* four = &masses[i];
-            const auto movingMass = [&](Index m) { return m < model_->massCount() && region_.moves(m); };
             const bool distinct = four[0] != four[1] && four[0] != four[2] && four[0] != four[3] && four[1] != four[2] &&
                                   four[1] != four[3] && four[2] != four[3];
-            if (!(distinct && movingMass(four[0]) && movingMass(four[1]) && movingMass(four[2]) && movingMass(four[3]))) {
+            if (!(distinct && displaces(four[0]) && displaces(four[1]) && displaces(four[2]) && displaces(four[3]))) {
                 for (int j = 0; j < 4; ++j) displaceMass(four[j], worldDisplacements[i + std::size_t(j)]);
                 continue;
             }
