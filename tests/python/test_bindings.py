@@ -155,7 +155,7 @@ def test_step_releases_the_gil(examples):
     runs = [flexfit.SceneRun(flexfit.load_scene(str(examples / "ball_torus.toml"))) for _ in range(2)]
     # While one thread is inside step(), this thread keeps running Python: with the GIL held it
     # would be blocked for the whole call and count next to nothing.
-    worker = threading.Thread(target=runs[0].step, args=(600,))
+    worker = threading.Thread(target=runs[0].step, args=(300,))
     worker.start()
     count = 0
     while worker.is_alive():
@@ -163,15 +163,15 @@ def test_step_releases_the_gil(examples):
     worker.join()
     assert count > 200, count
     # Two threads stepping two worlds at once give the same run as one alone.
-    threads = [threading.Thread(target=r.step, args=(300,)) for r in runs]
+    threads = [threading.Thread(target=r.step, args=(150,)) for r in runs]
     for t in threads:
         t.start()
     for t in threads:
         t.join()
     alone = flexfit.SceneRun(flexfit.load_scene(str(examples / "ball_torus.toml")))
-    alone.step(900)
+    alone.step(450)
     assert runs[0].world.state_hash() == alone.world.state_hash()
-    assert runs[1].world.step_count == 300
+    assert runs[1].world.step_count == 150
 
 
 def described(obj):
@@ -203,13 +203,13 @@ def test_every_binding_has_a_docstring():
 def test_sweep_bindings(tmp_path, examples):
     path = tmp_path / "sweep.toml"
     path.write_text((examples / "sweeps" / "ball_torus_friction.toml").read_text().replace('"../ball_torus.toml"', f'"{examples / "ball_torus.toml"}"')
-                    .replace("duration = 2.0", "duration = 0.2"))
+                    .replace("duration = 2.0", "duration = 0.05"))
     sweep = flexfit.load_sweep(str(path))
     assert len(sweep) == 12 and sweep.parameter_names == ["diameter", "rim", "friction"]
     assert sweep.labels(0) == ["14", "rigid", "0"] and len(set(sweep.run_ids)) == 12
     assert sweep.file.name == "sweep.toml" and sweep.scene.name == "ball_torus.toml"
     scene = sweep.scene_of(11)
-    assert scene.part_names == ["mouth", "ball"] and scene.duration == 0.2 and scene.time_step == 0.001 and scene.warnings == []
+    assert scene.part_names == ["mouth", "ball"] and scene.duration == 0.05 and scene.time_step == 0.001 and scene.warnings == []
     assert "run " + sweep.run_ids[11] in scene.source
     out = tmp_path / "out"
     assert flexfit.missing_sweep_runs(sweep, str(out)) == list(range(12))

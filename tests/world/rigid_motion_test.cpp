@@ -54,14 +54,18 @@ TEST(RigidMotion, BallWiderThanTheOpeningRestsOnTheRim) {
 }
 
 // Sanitizer builds run ~30x slower: they check the largest time step and the tightest ball
-// only (the Release run checks the whole sweep; the sanitizers look for memory errors, which
-// the same code paths would show with either ball).
+// only, and not the ball both pushed and thrown (the Release run checks the whole sweep; the
+// sanitizers look for memory errors, which the same code paths would show with either ball, and
+// the pushed ball and the thrown one run the contact and the sub-step paths apart; the thrown
+// ball's crossing step alone took 35-45 s there).
 #if defined(__SANITIZE_ADDRESS__)
 constexpr double kTimeSteps[] = {1.0 / 30};
 constexpr double kBallWidths[] = {1.005};
+constexpr bool kPushedAndThrown = false;
 #else
 constexpr double kTimeSteps[] = {1.0 / 120, 1.0 / 30};
 constexpr double kBallWidths[] = {1.005, 2.0};
+constexpr bool kPushedAndThrown = true;
 #endif
 
 namespace {
@@ -119,10 +123,12 @@ void expectNoTunnelling(const ThinPart& part) {
     for (double width : kBallWidths) {
         const TriMesh ball = ballAtLeast(width * part.opening);
         for (double force : {0.0, 1e6})
-            for (double speed : {0.0, 1e4})
+            for (double speed : {0.0, 1e4}) {
+                if (force > 0.0 && speed > 0.0 && !kPushedAndThrown) continue;
                 for (double dt : kTimeSteps)
                     EXPECT_GT(lowestThrough(part, ball, force, speed, dt, 0.5), 0.0)
                         << part.name << ": ball " << width << " x the opening, force " << force << ", speed " << speed << ", dt " << dt;
+            }
     }
     const TriMesh narrower = makeIcoSphere(0.9 * part.opening, 3);  // its vertices are on the sphere
     EXPECT_LT(lowestThrough(part, narrower, 0.0, 0.0, 1.0 / 120, 2.5), -5.0) << part.name;
