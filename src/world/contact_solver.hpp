@@ -54,6 +54,10 @@ struct ContactSolver {
 };
 
 // Combining rules (body.hpp): geometric mean of the frictions, larger restitution.
+// Whether the tangent impulse (x, y) is inside the static cone of radius `cone` by far more
+// than rounding, so that std::hypot(x, y) > cone is false: the friction step skips hypot then.
+bool wellInsideCone(double x, double y, double cone);
+
 double combinedFriction(double a, double b);
 double combinedRestitution(double a, double b);
 

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 using namespace flexfit;
 using namespace flexfit::testing;
@@ -80,6 +81,31 @@ TEST(ContactSolver, CombiningRules) {
     EXPECT_DOUBLE_EQ(detail::combinedFriction(0.4, 0.9), 0.6);
     EXPECT_EQ(detail::combinedFriction(0.0, 0.9), 0.0);
     EXPECT_EQ(detail::combinedRestitution(0.2, 0.7), 0.7);
+}
+
+TEST(ContactSolver, WellInsideTheConeOnlyWhereHypotSaysInside) {
+    // Cones a few ulps either side of hypot(x, y), at scales from 1e-160 to 1e150: wherever
+    // the shortcut answers "well inside", hypot must not exceed the cone (else the friction
+    // step would skip a clamp it makes without the shortcut).
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), exponent(-160.0, 150.0);
+    int inside = 0;
+    for (int i = 0; i < 400000; ++i) {
+        const double scale = std::pow(10.0, exponent(rng));
+        const double x = unit(rng) * scale, y = (i % 7 == 0 ? 0.0 : unit(rng)) * scale;
+        const double edge = std::hypot(x, y);
+        double cone = edge;
+        const int ulps = int(i % 13) - 6;  // -6..6 ulps from the edge
+        for (int k = 0; k < std::abs(ulps); ++k) cone = std::nextafter(cone, ulps < 0 ? 0.0 : HUGE_VAL);
+        if (i % 5 == 0) cone *= 1.0 + 1e-9 * (i % 3);  // and a little further in
+        if (!detail::wellInsideCone(x, y, cone)) continue;
+        ++inside;
+        ASSERT_FALSE(std::hypot(x, y) > cone) << x << " " << y << " " << cone;
+    }
+    EXPECT_GT(inside, 1000);  // the shortcut is taken
+    EXPECT_TRUE(detail::wellInsideCone(0.3, 0.4, 0.6));
+    EXPECT_FALSE(detail::wellInsideCone(0.3, 0.4, 0.5));
+    EXPECT_FALSE(detail::wellInsideCone(0.0, 0.0, 0.0));  // no cone: hypot decides
 }
 
 TEST(ContactSolver, BoxOnAnInclineSticksBelowTheFrictionAngle) {
