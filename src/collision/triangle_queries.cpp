@@ -1,6 +1,9 @@
 #include "collision/triangle_queries.hpp"
+#include "core/lanes256.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -79,6 +82,73 @@ bool clearlyApartOnAnEdgeAxis(const Triangle& first, const Triangle& second, std
     }
     return false;
 }
+
+// The separating-axis loop of intersectTriangles: over `axes` in order, skipping those shorter
+// than `minLength2`, the smallest overlap and its axis (pointing the way `first` must move);
+// false when an axis separates the triangles.
+bool smallestOverlap(const Triangle& first, const Triangle& second, std::span<const Vec3> axes, double minLength2,
+                     double& bestOverlap, Vec3& bestAxis) {
+    for (Vec3 axis : axes) {
+        const double length2 = axis.squaredNorm();
+        if (!(length2 > minLength2)) continue;  // parallel edges: no axis
+        axis /= std::sqrt(length2);
+        const Interval i1 = project(first, axis), i2 = project(second, axis);
+        const double pushUp = i2.max - i1.min;    // move first along +axis by this to separate
+        const double pushDown = i1.max - i2.min;  // or along -axis by this
+        if (pushUp < 0 || pushDown < 0) return false;  // separating axis
+        const double overlap = std::min(pushUp, pushDown);
+        if (overlap < bestOverlap) {
+            bestOverlap = overlap;
+            bestAxis = pushUp <= pushDown ? axis : Vec3(-axis);
+        }
+    }
+    return true;
+}
+
+#if defined(FLEXFIT_LANES256)
+using namespace detail::lanes;
+
+// std::min({a, b, c}) and std::max({a, b, c}) lane by lane, NaNs included (min_pd(x, y) is
+// x < y ? x : y, as std::min's "b < smallest ? b : smallest").
+FLEXFIT_AVX2_LANES inline __m256d min3(__m256d a, __m256d b, __m256d c) { return _mm256_min_pd(c, _mm256_min_pd(b, a)); }
+FLEXFIT_AVX2_LANES inline __m256d max3(__m256d a, __m256d b, __m256d c) { return _mm256_max_pd(c, _mm256_max_pd(b, a)); }
+
+// smallestOverlap four axes a vector: the square roots and the divisions that normalise the
+// axes (the loop's costliest instructions in perf, on the stack scene's resting boxes) run in
+// lanes, by the same operations in the same order, so each lane gives the scalar loop's bits;
+// the smallest overlap is then taken lane by lane in the axes' order, as the loop takes it.
+FLEXFIT_AVX2_LANES bool smallestOverlapFours(const Triangle& first, const Triangle& second, std::span<const Vec3> axes,
+                                             double minLength2, double& bestOverlap, Vec3& bestAxis) {
+    const Lanes3 a1 = broadcast(first.a), b1 = broadcast(first.b), c1 = broadcast(first.c);
+    const Lanes3 a2 = broadcast(second.a), b2 = broadcast(second.b), c2 = broadcast(second.c);
+    const __m256d threshold = _mm256_set1_pd(minLength2), zero = _mm256_setzero_pd();
+    const Vec3 none = Vec3::Zero();  // pads the last four: length 0, never an axis
+    for (std::size_t k = 0; k < axes.size(); k += 4) {
+        const Lanes3 axis = gather([&](int l) -> const Vec3& { return k + std::size_t(l) < axes.size() ? axes[k + std::size_t(l)] : none; });
+        const __m256d length2 = dot(axis, axis);
+        const __m256d valid = _mm256_cmp_pd(length2, threshold, _CMP_GT_OQ);
+        // Lanes that are no axis divide by 1 (no 0 / 0: it would raise FE_INVALID).
+        const Lanes3 unit = divide(axis, _mm256_blendv_pd(_mm256_set1_pd(1.0), _mm256_sqrt_pd(length2), valid));
+        const __m256d pa1 = dot(a1, unit), pb1 = dot(b1, unit), pc1 = dot(c1, unit);
+        const __m256d pa2 = dot(a2, unit), pb2 = dot(b2, unit), pc2 = dot(c2, unit);
+        const __m256d pushUp = _mm256_sub_pd(max3(pa2, pb2, pc2), min3(pa1, pb1, pc1));
+        const __m256d pushDown = _mm256_sub_pd(max3(pa1, pb1, pc1), min3(pa2, pb2, pc2));
+        const __m256d separates = _mm256_and_pd(valid, _mm256_or_pd(_mm256_cmp_pd(pushUp, zero, _CMP_LT_OQ), _mm256_cmp_pd(pushDown, zero, _CMP_LT_OQ)));
+        if (_mm256_movemask_pd(separates) != 0) return false;
+        alignas(32) double overlap[4], up[4];
+        _mm256_store_pd(overlap, _mm256_min_pd(pushDown, pushUp));  // std::min(pushUp, pushDown)
+        _mm256_store_pd(up, _mm256_cmp_pd(pushUp, pushDown, _CMP_LE_OQ));
+        const int validLanes = _mm256_movemask_pd(valid);
+        const Stored3 units = store(unit);
+        for (int l = 0; l < 4; ++l) {
+            if ((validLanes >> l & 1) == 0 || !(overlap[l] < bestOverlap)) continue;
+            bestOverlap = overlap[l];
+            bestAxis = std::bit_cast<std::uint64_t>(up[l]) != 0 ? units[l] : Vec3(-units[l]);
+        }
+    }
+    return true;
+}
+#endif
 
 }  // namespace
 
@@ -182,21 +252,15 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
 
     double bestOverlap = std::numeric_limits<double>::infinity();
     Vec3 bestAxis = Vec3::UnitY();
-    for (std::size_t k = 0; k < axisCount; ++k) {
-        Vec3 axis = axes[k];
-        const double length2 = axis.squaredNorm();
-        if (!(length2 > 1e-24 * scale * scale)) continue;  // parallel edges: no axis
-        axis /= std::sqrt(length2);
-        const Interval i1 = project(first, axis), i2 = project(second, axis);
-        const double pushUp = i2.max - i1.min;    // move first along +axis by this to separate
-        const double pushDown = i1.max - i2.min;  // or along -axis by this
-        if (pushUp < 0 || pushDown < 0) return std::nullopt;  // separating axis
-        const double overlap = std::min(pushUp, pushDown);
-        if (overlap < bestOverlap) {
-            bestOverlap = overlap;
-            bestAxis = pushUp <= pushDown ? axis : Vec3(-axis);
-        }
-    }
+    const std::span<const Vec3> used(axes.data(), axisCount);
+    const double minLength2 = 1e-24 * scale * scale;
+#if defined(FLEXFIT_LANES256)
+    if (detail::lanesEnabled() ? !smallestOverlapFours(first, second, used, minLength2, bestOverlap, bestAxis)
+                               : !smallestOverlap(first, second, used, minLength2, bestOverlap, bestAxis))
+        return std::nullopt;
+#else
+    if (!smallestOverlap(first, second, used, minLength2, bestOverlap, bestAxis)) return std::nullopt;
+#endif
     // Contact point: centroid of the edge-through-triangle intersection points.
     PointSet points;
     if (!coplanar) {

@@ -14,7 +14,8 @@ namespace flexfit::detail {
 
 // True when the paths built on these lanes run: compiled in, the CPU has AVX2, and no
 // ScopedScalarLanes is alive (lanes256.cpp). The paths: the contact response's frictionless
-// reactions, Part::displaceMasses, the point shell's contacts and its moving masses' skip test.
+// reactions, Part::displaceMasses, the point shell's contacts and its moving masses' skip test,
+// intersectTriangles' separating-axis loop.
 bool lanesEnabled();
 
 // While at least one scope is alive (on any thread), those paths run one at a time: for tests.

@@ -1,10 +1,14 @@
 // Triangle queries against independent references: dense sampling of the triangle for the
 // closest point, and edge-through-triangle (Moller-Trumbore) tests for intersection.
 #include "collision/triangle_queries.hpp"
+#include "core/lanes256.hpp"
 #include "flexfit/flexfit.hpp"
 
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cstdint>
+#include <optional>
 #include <random>
 
 using namespace flexfit;
@@ -126,6 +130,54 @@ TEST(TriangleTriangle, AgreesWithEdgeTestsOnRandomPairs) {
         EXPECT_NEAR(contact->normal.norm(), 1.0, 1e-12);
     }
     EXPECT_GT(hits, 1000);
+}
+
+namespace {
+
+std::uint64_t bitsOf(double x) { return std::bit_cast<std::uint64_t>(x); }
+
+// The same contact bit for bit (or none on both sides).
+void expectSameBits(const std::optional<TriangleContact>& x, const std::optional<TriangleContact>& y, int pair) {
+    ASSERT_EQ(x.has_value(), y.has_value()) << "pair " << pair;
+    if (!x) return;
+    EXPECT_EQ(bitsOf(x->depth), bitsOf(y->depth)) << "pair " << pair;
+    for (int d = 0; d < 3; ++d) {
+        EXPECT_EQ(bitsOf(x->normal[d]), bitsOf(y->normal[d])) << "pair " << pair;
+        EXPECT_EQ(bitsOf(x->point[d]), bitsOf(y->point[d])) << "pair " << pair;
+    }
+}
+
+}  // namespace
+
+TEST(TriangleTriangle, AxesFourAVectorGiveTheScalarLoopsBits) {
+    // intersectTriangles' separating-axis loop runs four axes a vector where lanes run
+    // (lanes256.hpp); one at a time under ScopedScalarLanes. Random pairs (most intersect:
+    // the second is the first moved a little, or shares a corner with it), coplanar ones (17 axes), pairs with
+    // parallel edges (axes skipped), needles, and pairs an axis separates.
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> small(-0.3, 0.3);
+    int contacts = 0;
+    for (int k = 0; k < 20000; ++k) {
+        Triangle x = randomTriangle(rng), y = randomTriangle(rng);
+        switch (k % 5) {
+        case 0: y = shifted(x, {small(rng), small(rng), small(rng)}); break;  // parallel edges
+        case 1: y = {x.a + Vec3(small(rng), small(rng), 0.0), x.c, x.b + Vec3(0.0, small(rng), 0.0)}; break;
+        case 2:  // coplanar: both in z = 0.25
+            for (Triangle* t : {&x, &y}) t->a.z() = t->b.z() = t->c.z() = 0.25;
+            break;
+        case 3: y.c = y.a + 1e-7 * (y.b - y.a); break;  // a needle
+        default: break;
+        }
+        const auto lanes = intersectTriangles(x, y);
+        std::optional<TriangleContact> scalar;
+        {
+            const detail::ScopedScalarLanes oneAtATime;
+            scalar = intersectTriangles(x, y);
+        }
+        expectSameBits(lanes, scalar, k);
+        contacts += lanes.has_value();
+    }
+    EXPECT_GT(contacts, 4000);
 }
 
 TEST(TriangleTriangle, CoplanarAndTouching) {
