@@ -43,6 +43,7 @@ BENCH_FLAGS := --benchmark_repetitions=12 --benchmark_enable_random_interleaving
 	--benchmark_out_format=csv
 bench: release
 	@scripts/install-deps.sh --bench
+	@cmake --build --preset release --target benchmarks -j $(JOBS)
 	build/release/bench/bench_msd_step $(BENCH_FLAGS) --benchmark_out=bench/results/msd_step.csv
 	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitFullStep BM_NaiveFullStep
 	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitAvx2 BM_NaiveFullStep
