@@ -19,7 +19,9 @@ inline Triangle triangleOf(std::span<const Vec3> positions, const Face& f) { ret
 inline double volumeSize(const Sphere& s) { return 2.0 * s.radius; }
 inline double volumeSize(const Aabb& b) { return b.size(); }
 // Which side of a node pair descends: the larger volume, compared by squared size (the box's
-// diagonal without its square root, which was the traversal's costliest instruction).
+// diagonal without its square root, which was the traversal's costliest instruction). Sizes
+// within rounding of each other may now descend the other side: that changes the order of
+// the traversal and its counts, never the contacts (sorted) or the candidates (a set).
 inline double squaredVolumeSize(const Sphere& s) { return 4.0 * s.radius * s.radius; }
 inline double squaredVolumeSize(const Aabb& b) { return (b.max - b.min).squaredNorm(); }
 

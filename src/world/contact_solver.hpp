@@ -53,11 +53,11 @@ struct ContactSolver {
     std::vector<Eigen::Matrix3d> inverseInertia;  // (nbody) world frame, at the sub-step's start
 };
 
-// Combining rules (body.hpp): geometric mean of the frictions, larger restitution.
 // Whether the tangent impulse (x, y) is inside the static cone of radius `cone` by far more
 // than rounding, so that std::hypot(x, y) > cone is false: the friction step skips hypot then.
 bool wellInsideCone(double x, double y, double cone);
 
+// Combining rules (body.hpp): geometric mean of the frictions, larger restitution.
 double combinedFriction(double a, double b);
 double combinedRestitution(double a, double b);
 

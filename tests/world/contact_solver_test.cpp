@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 using namespace flexfit;
@@ -84,11 +85,11 @@ TEST(ContactSolver, CombiningRules) {
 }
 
 TEST(ContactSolver, WellInsideTheConeOnlyWhereHypotSaysInside) {
-    // Cones a few ulps either side of hypot(x, y), at scales from 1e-160 to 1e150: wherever
+    // Cones a few ulps either side of hypot(x, y), at scales from 1e-160 to 1e300: wherever
     // the shortcut answers "well inside", hypot must not exceed the cone (else the friction
     // step would skip a clamp it makes without the shortcut).
     std::mt19937 rng(3);
-    std::uniform_real_distribution<double> unit(-1.0, 1.0), exponent(-160.0, 150.0);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), exponent(-160.0, 300.0);  // squares overflow above ~1e154
     int inside = 0;
     for (int i = 0; i < 400000; ++i) {
         const double scale = std::pow(10.0, exponent(rng));
@@ -106,6 +107,14 @@ TEST(ContactSolver, WellInsideTheConeOnlyWhereHypotSaysInside) {
     EXPECT_TRUE(detail::wellInsideCone(0.3, 0.4, 0.6));
     EXPECT_FALSE(detail::wellInsideCone(0.3, 0.4, 0.5));
     EXPECT_FALSE(detail::wellInsideCone(0.0, 0.0, 0.0));  // no cone: hypot decides
+    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+    for (const double cone : {nan, -1.0, -inf})
+        EXPECT_FALSE(detail::wellInsideCone(0.3, 0.4, cone)) << cone;  // hypot decides (and clamps as before)
+    EXPECT_FALSE(detail::wellInsideCone(nan, 0.4, 1.0));
+    EXPECT_FALSE(detail::wellInsideCone(inf, 0.4, 1.0));
+    EXPECT_TRUE(detail::wellInsideCone(0.3, 0.4, inf));  // hypot 0.5 > inf is false too
+    EXPECT_FALSE(detail::wellInsideCone(1e200, 1e200, 1e201));  // the squares overflow: hypot decides
+    EXPECT_TRUE(detail::wellInsideCone(1e153, 1e153, 1e160));   // cone^2 overflows, the squares do not: hypot is finite
 }
 
 TEST(ContactSolver, BoxOnAnInclineSticksBelowTheFrictionAngle) {

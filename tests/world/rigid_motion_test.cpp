@@ -56,8 +56,8 @@ TEST(RigidMotion, BallWiderThanTheOpeningRestsOnTheRim) {
 // Sanitizer builds run ~30x slower: they check the largest time step and the tightest ball
 // only, and not the ball both pushed and thrown (the Release run checks the whole sweep; the
 // sanitizers look for memory errors, which the same code paths would show with either ball, and
-// the pushed ball and the thrown one run the contact and the sub-step paths apart; the thrown
-// ball's crossing step alone took 35-45 s there).
+// the pushed ball and the thrown one run the contact and the sub-step paths apart; the pushed
+// and thrown ball took 45 s there, most of it in its crossing step).
 #if defined(__SANITIZE_ADDRESS__)
 constexpr double kTimeSteps[] = {1.0 / 30};
 constexpr double kBallWidths[] = {1.005};
