@@ -150,6 +150,15 @@ FLEXFIT_AVX2_LANES bool smallestOverlapFours(const Triangle& first, const Triang
 }
 #endif
 
+// smallestOverlap, four axes a vector where lanes run.
+bool smallestOverlapByLanes(const Triangle& first, const Triangle& second, std::span<const Vec3> axes, double minLength2,
+                            double& bestOverlap, Vec3& bestAxis) {
+#if defined(FLEXFIT_LANES256)
+    if (detail::lanesEnabled()) return smallestOverlapFours(first, second, axes, minLength2, bestOverlap, bestAxis);
+#endif
+    return smallestOverlap(first, second, axes, minLength2, bestOverlap, bestAxis);
+}
+
 }  // namespace
 
 Vec3 closestPointOnTriangle(const Vec3& p, const Triangle& t, TriangleFeature* feature) {
@@ -252,15 +261,8 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
 
     double bestOverlap = std::numeric_limits<double>::infinity();
     Vec3 bestAxis = Vec3::UnitY();
-    const std::span<const Vec3> used(axes.data(), axisCount);
-    const double minLength2 = 1e-24 * scale * scale;
-#if defined(FLEXFIT_LANES256)
-    if (detail::lanesEnabled() ? !smallestOverlapFours(first, second, used, minLength2, bestOverlap, bestAxis)
-                               : !smallestOverlap(first, second, used, minLength2, bestOverlap, bestAxis))
+    if (!smallestOverlapByLanes(first, second, std::span<const Vec3>(axes.data(), axisCount), 1e-24 * scale * scale, bestOverlap, bestAxis))
         return std::nullopt;
-#else
-    if (!smallestOverlap(first, second, used, minLength2, bestOverlap, bestAxis)) return std::nullopt;
-#endif
     // Contact point: centroid of the edge-through-triangle intersection points.
     PointSet points;
     if (!coplanar) {

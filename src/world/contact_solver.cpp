@@ -53,9 +53,10 @@ void solveFriction(SolverContact& c, const ContactSolver& s, Bodies& bodies) {
     const double old1 = c.tangentImpulse1, old2 = c.tangentImpulse2;
     double new1 = old1 - c.tangentMass1 * v.dot(c.tangent1);
     double new2 = old2 - c.tangentMass2 * v.dot(c.tangent2);
-    if (!wellInsideCone(new1, new2, c.staticFriction * c.normalImpulse)) {
+    const double cone = c.staticFriction * c.normalImpulse;
+    if (!wellInsideCone(new1, new2, cone)) {
         const double magnitude = std::hypot(new1, new2);
-        if (magnitude > c.staticFriction * c.normalImpulse) {
+        if (magnitude > cone) {
             const double scale = magnitude > 0.0 ? c.kineticFriction * c.normalImpulse / magnitude : 0.0;
             new1 *= scale;
             new2 *= scale;

@@ -149,6 +149,18 @@ void expectSameBits(const std::optional<TriangleContact>& x, const std::optional
     }
 }
 
+// intersectTriangles with lanes and one at a time give the same contact; whether there is one.
+bool expectLanesMatchScalar(const Triangle& x, const Triangle& y, int pair) {
+    const auto lanes = intersectTriangles(x, y);
+    std::optional<TriangleContact> scalar;
+    {
+        const detail::ScopedScalarLanes oneAtATime;
+        scalar = intersectTriangles(x, y);
+    }
+    expectSameBits(lanes, scalar, pair);
+    return lanes.has_value();
+}
+
 }  // namespace
 
 TEST(TriangleTriangle, AxesFourAVectorGiveTheScalarLoopsBits) {
@@ -171,14 +183,7 @@ TEST(TriangleTriangle, AxesFourAVectorGiveTheScalarLoopsBits) {
         case 3: y.c = y.a + 1e-7 * (y.b - y.a); break;  // a needle
         default: break;
         }
-        const auto lanes = intersectTriangles(x, y);
-        std::optional<TriangleContact> scalar;
-        {
-            const detail::ScopedScalarLanes oneAtATime;
-            scalar = intersectTriangles(x, y);
-        }
-        expectSameBits(lanes, scalar, k);
-        contacts += lanes.has_value();
+        contacts += expectLanesMatchScalar(x, y, k);
     }
     EXPECT_GT(contacts, 4000);
     // Ties and special values random pairs do not reach: a triangle against itself (pushUp
@@ -189,15 +194,7 @@ TEST(TriangleTriangle, AxesFourAVectorGiveTheScalarLoopsBits) {
     Triangle withNaN = t;
     withNaN.c.x() = std::numeric_limits<double>::quiet_NaN();
     const std::pair<Triangle, Triangle> special[] = {{t, t}, {u, u}, {t, u}, {u, t}, {withNaN, u}, {u, withNaN}, {withNaN, withNaN}};
-    for (std::size_t i = 0; i < std::size(special); ++i) {
-        const auto lanes = intersectTriangles(special[i].first, special[i].second);
-        std::optional<TriangleContact> scalar;
-        {
-            const detail::ScopedScalarLanes oneAtATime;
-            scalar = intersectTriangles(special[i].first, special[i].second);
-        }
-        expectSameBits(lanes, scalar, int(100000 + i));
-    }
+    for (std::size_t i = 0; i < std::size(special); ++i) expectLanesMatchScalar(special[i].first, special[i].second, int(100000 + i));
 }
 
 TEST(TriangleTriangle, CoplanarAndTouching) {
