@@ -164,15 +164,15 @@ std::size_t walkRestPoints(const SignedDistanceField& field, const Bvh<Aabb>& re
 }
 
 // The coherent query's rest-mass list: a margin of kMarginCells cells of the field; a new
-// list's walk starts once B's rest sphere has moved kWalkStart of the margin, and goes on
-// 1 / kWalkShare of the last walk's nodes (at least kMinWalkNodes) per query, so it is done
+// list's walk starts once B's rest sphere has moved kShellWalkStart of the margin, and goes on
+// 1 / kShellWalkShare of the last walk's nodes (at least kShellMinWalkNodes) per query, so it is done
 // before the old list runs out unless the motion outruns it (then the query finishes it).
 // Measured on the ball-torus haptic scene: a walk of ~8,000 nodes costs ~750 us; the ball
 // leaves a margin in ~35 steps.
 constexpr double kMarginCells = 2.0;
-constexpr double kWalkStart = 0.4;
-constexpr std::size_t kWalkShare = 16;
-constexpr std::size_t kMinWalkNodes = 128;
+constexpr double kShellWalkStart = 0.4;
+constexpr std::size_t kShellWalkShare = 16;
+constexpr std::size_t kShellMinWalkNodes = 128;
 
 void startWalk(PointShellCoherence::Walk& w, const RelativePose& pose, double margin) {
     w.stack.assign(1, 0);
@@ -316,8 +316,8 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
         takeWalk(c);
         motion = motionSince(c.pose);
     } else {
-        if (!c.walk.active && motion > kWalkStart * c.margin) startWalk(c.walk, bInA, margin);
-        if (c.walk.active && advanceWalk(c.walk, fieldA, restPointsB, std::max(kMinWalkNodes, c.traversalCost / kWalkShare), stats)) {
+        if (!c.walk.active && motion > kShellWalkStart * c.margin) startWalk(c.walk, bInA, margin);
+        if (c.walk.active && advanceWalk(c.walk, fieldA, restPointsB, std::max(kShellMinWalkNodes, c.traversalCost / kShellWalkShare), stats)) {
             if (motionSince(c.walk.pose) <= c.walk.margin) {
                 takeWalk(c);
                 motion = motionSince(c.pose);

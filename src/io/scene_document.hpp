@@ -10,6 +10,9 @@
 
 namespace flexfit::detail {
 
+// The line a TOML node starts on, for messages (0 when it has no source region).
+inline std::size_t lineOf(const toml::node& node) { return node.source().begin.line; }
+
 Scene readSceneDocument(const toml::table& document, const std::string& source, const std::filesystem::path& baseDirectory,
                         const SceneReadOptions& options);
 

@@ -19,7 +19,7 @@
 namespace flexfit {
 namespace {
 
-std::size_t lineOf(const toml::node& node) { return node.source().begin.line; }
+using detail::lineOf;
 
 // One TOML table with its name for messages ("part 'ball'") and the keys read from it.
 class Table {

@@ -44,7 +44,7 @@ toml::table parseText(const std::string& text, const std::filesystem::path& file
     }
 }
 
-std::size_t lineOf(const toml::node& node) { return node.source().begin.line; }
+using detail::lineOf;
 
 NodePtr clone(const toml::node& node) {
     return node.visit([](const auto& x) { return NodePtr(new std::decay_t<decltype(x)>(x)); });
