@@ -41,11 +41,7 @@ std::set<std::pair<Index, Index>> bruteForceContacts(const Part& a, const Part& 
     return out;
 }
 
-std::set<std::pair<Index, Index>> pairsOf(const std::vector<Contact>& contacts) {
-    std::set<std::pair<Index, Index>> out;
-    for (const Contact& c : contacts) out.insert({c.faceA, c.faceB});
-    return out;
-}
+using flexfit::testing::pairsOf;
 
 // A small random rigid motion: a turn of up to `turn` radians about a random axis (about the
 // part's origin) and a shift of up to `shift`; now and then (1 in 25) a jump ten times as large.

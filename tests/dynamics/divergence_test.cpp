@@ -2,6 +2,7 @@
 // vectorised test against every position of a bad value, the first bad mass and what of it,
 // and the cause from the stability bounds.
 #include "dynamics/divergence.hpp"
+#include "strings.hpp"
 #include "flexfit/flexfit.hpp"
 
 #include <gtest/gtest.h>
@@ -14,7 +15,7 @@ using namespace flexfit;
 
 namespace {
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using flexfit::testing::contains;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

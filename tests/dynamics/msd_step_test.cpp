@@ -1,6 +1,7 @@
 // stepFullModel against independent references: the analytic damped oscillator, conservation
 // laws, and the thesis-style naive implementation (tests/support/naive_msd.hpp).
 #include "flexfit/flexfit.hpp"
+#include "strings.hpp"
 #include "golden.hpp"
 #include "naive_from_mesh.hpp"
 #include "shuffled_mesh.hpp"
@@ -251,7 +252,7 @@ TEST(MsdStep, SettingsValidation) {
 
 namespace {
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using flexfit::testing::contains;
 
 // Steps under `load` until the step throws (at most `steps`); returns the error and the time
 // at the start of the step that threw.

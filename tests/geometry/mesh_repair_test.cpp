@@ -3,6 +3,7 @@
 // and a brute-force winding check over every pair of faces; the strict reading's first defect
 // and its line.
 #include "flexfit/generators.hpp"
+#include "strings.hpp"
 #include "flexfit/mesh_repair.hpp"
 
 #include <gtest/gtest.h>
@@ -17,7 +18,7 @@
 namespace flexfit {
 namespace {
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using flexfit::testing::contains;
 
 // Brute force: every pair of faces sharing two vertices runs that edge in opposite directions.
 bool consistentlyWound(const TriMesh& mesh) {

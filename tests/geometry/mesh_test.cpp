@@ -1,5 +1,6 @@
 // Tests validateMesh (each error class, each warning count) and weldVertices, against hand-built meshes and a brute-force O(n^2) welding reference.
 #include "flexfit/mesh.hpp"
+#include "strings.hpp"
 
 #include <gtest/gtest.h>
 
@@ -35,7 +36,7 @@ InputError expectInvalid(const TriMesh& mesh, const MeshSourceLines& lines = {})
     return InputError("none", 0, "no error");
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using flexfit::testing::contains;
 
 // ---------------------------------------------------------------------------------------------
 // validateMesh: valid input

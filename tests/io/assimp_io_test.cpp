@@ -1,5 +1,7 @@
 // Tests readMesh on small hand-written files: through assimp (STL, glTF 2.0) and, for OBJ, OFF and PLY, through their own readers (obj_io_test.cpp, off_io_test.cpp and ply_io_test.cpp test them further), against hand-counted vertices/faces/edges after welding, the OBJ writer's round trip and the error contract.
 #include "flexfit/generators.hpp"
+#include "float_precision.hpp"
+#include "strings.hpp"
 #include "flexfit/mesh_io.hpp"
 
 #include <gtest/gtest.h>
@@ -24,14 +26,9 @@ namespace fs = std::filesystem;
 
 using flexfit::testing::TempDir;
 
-// Rounds each coordinate to the nearest float. Written per scalar: GCC 12 at -O2 was seen to drop
-// the rounding in `v.cast<float>().cast<double>()` inside a loop over Eigen vectors.
-Vec3 toFloatPrecision(const Vec3& v) {
-    volatile float x = float(v.x()), y = float(v.y()), z = float(v.z());
-    return Vec3(double(x), double(y), double(z));
-}
+using flexfit::testing::toFloatPrecision;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using flexfit::testing::contains;
 
 double signedVolume(const TriMesh& mesh) {
     double sum = 0.0;
@@ -55,11 +52,11 @@ InputError expectReadError(const fs::path& file, const MeshReadOptions& options 
 }
 
 // Unit cube, outward counter-clockwise quads (1-based OBJ indices).
-const std::string kCubeVertices =
+const std::string kObjCubeVertices =
     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
-const std::string kObjCubeQuads = "# cube\no cube\n" + kCubeVertices +
+const std::string kObjCubeQuads = "# cube\no cube\n" + kObjCubeVertices +
                                   "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
-const std::string kObjCubeTriangles = "o cube\n" + kCubeVertices +
+const std::string kObjCubeTriangles = "o cube\n" + kObjCubeVertices +
                                       "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n"
                                       "f 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n";
 

@@ -1,5 +1,7 @@
 // Tests the format dispatch of writeMesh/readMesh and readMesh's weld tolerance on .tri files, against meshes written and counted by hand.
 #include "flexfit/generators.hpp"
+#include "float_precision.hpp"
+#include "strings.hpp"
 #include "flexfit/mesh_io.hpp"
 
 #include <gtest/gtest.h>
@@ -30,14 +32,9 @@ std::string slurp(const fs::path& file) {
     return buffer.str();
 }
 
-// Rounds each coordinate to the nearest float. Written per scalar: GCC 12 at -O2 was seen to drop
-// the rounding in `v.cast<float>().cast<double>()` inside a loop over Eigen vectors.
-Vec3 toFloatPrecision(const Vec3& v) {
-    volatile float x = float(v.x()), y = float(v.y()), z = float(v.z());
-    return Vec3(double(x), double(y), double(z));
-}
+using flexfit::testing::toFloatPrecision;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using flexfit::testing::contains;
 
 bool bitIdentical(const TriMesh& a, const TriMesh& b) {
     return a.vertices.size() == b.vertices.size() && a.faces == b.faces &&

@@ -20,7 +20,7 @@ using testing::TempDir;
 
 using testing::contains;
 
-InputError readError(const std::string& text, const MeshReadOptions& options = {}) { return testing::meshReadError("m.obj", text, options); }
+InputError readObjError(const std::string& text, const MeshReadOptions& options = {}) { return testing::meshReadError("m.obj", text, options); }
 
 TEST(ObjIo, KeepsTheFilesVertexOrderAndEveryBit) {
     // A double mesh in no useful order, written with 17 digits: it reads back as it was.
@@ -48,7 +48,7 @@ TEST(ObjIo, CornerFormsNegativeAndForwardIndices) {
     EXPECT_EQ(r.mesh.faces, (std::vector<Face>{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}));
     EXPECT_TRUE(r.diagnostics.closed());
     EXPECT_TRUE(r.diagnostics.warnings.empty());
-    const InputError before = readError("v 0 0 0\nv 1 0 0\nf -3 -2 -1\nv 0 1 0\n");
+    const InputError before = readObjError("v 0 0 0\nv 1 0 0\nf -3 -2 -1\nv 0 1 0\n");
     EXPECT_EQ(before.line(), 3u) << before.what();
     EXPECT_TRUE(contains(before.problem(), "refers before the first vertex (2 vertices read so far)")) << before.problem();
 }
@@ -147,7 +147,7 @@ TEST(ObjIo, ABackslashEndingALineContinuesItsStatement) {
     EXPECT_EQ(split.mesh.faces, whole.mesh.faces);
     EXPECT_EQ(split.mesh.faces, (std::vector<Face>{{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}));
     // A problem in a continued statement is named at its first line.
-    const InputError e = readError("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 \\\n 2 \\\n 9\n");
+    const InputError e = readObjError("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 \\\n 2 \\\n 9\n");
     EXPECT_EQ(e.line(), 4u) << e.what();
     EXPECT_TRUE(contains(e.problem(), "face corner 9 out of range")) << e.what();
 }
@@ -173,13 +173,13 @@ TEST(ObjIo, ProblemsNameTheirLine) {
         {"\n  \n", 0, "empty file"},
     };
     for (const Case& c : cases) {
-        const InputError e = readError(c.text);
+        const InputError e = readObjError(c.text);
         EXPECT_EQ(e.line(), c.line) << c.text << e.what();
         EXPECT_TRUE(contains(e.problem(), c.problem)) << c.text << e.what();
     }
     // Strict: a degenerate face is refused at its line (repaired by default), after a quad split
     // in two triangles (each keeps the quad's line).
-    const InputError strict = readError("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 5 4\n# flat\nf 1 2 3\n",
+    const InputError strict = readObjError("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 5 4\n# flat\nf 1 2 3\n",
                                         {.weldTolerance = std::nullopt, .repair = false});
     EXPECT_EQ(strict.line(), 8u) << strict.what();
 }

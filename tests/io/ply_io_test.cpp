@@ -30,7 +30,7 @@ using testing::TempDir;
 
 using testing::contains;
 
-InputError readError(const std::string& text) { return testing::meshReadError("m.ply", text); }
+InputError readPlyError(const std::string& text) { return testing::meshReadError("m.ply", text); }
 
 std::string asciiPly(const TriMesh& mesh) {
     std::string text = "ply\nformat ascii 1.0\ncomment by hand\nelement vertex " + std::to_string(mesh.vertices.size()) +
@@ -274,17 +274,17 @@ TEST(PlyIo, BinaryProblemsNameTheirElementAndByte) {
     const TriMesh mesh = makeIcoSphere(1.0, 0);
     const std::string whole = binaryPly(mesh, false);
     const std::size_t body = whole.find("end_header\n") + 11;
-    const InputError cut = readError(whole.substr(0, body + 29 * 3 + 10));  // inside vertex 3 (29 bytes each)
+    const InputError cut = readPlyError(whole.substr(0, body + 29 * 3 + 10));  // inside vertex 3 (29 bytes each)
     EXPECT_TRUE(contains(cut.problem(), "vertex 3 (byte")) << cut.what();
     EXPECT_TRUE(contains(cut.problem(), "ends inside it")) << cut.what();
-    const InputError extra = readError(whole + "xy");
+    const InputError extra = readPlyError(whole + "xy");
     EXPECT_TRUE(contains(extra.problem(), "2 bytes after the last element")) << extra.what();
     std::string outOfRange = whole;
     const std::size_t lastIndex = outOfRange.size() - 4;
     std::string index;
     put(index, std::uint32_t(12), false);  // 12 vertices: numbered 0..11
     outOfRange.replace(lastIndex, 4, index);
-    const InputError range = readError(outOfRange);
+    const InputError range = readPlyError(outOfRange);
     EXPECT_TRUE(contains(range.problem(), "face 19")) << range.what();
     EXPECT_TRUE(contains(range.problem(), "face corner 12 out of range")) << range.what();
 }

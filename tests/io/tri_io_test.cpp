@@ -1,5 +1,6 @@
 // Tests the .tri reader and writer (parseTri, formatTri, readTri, writeTri) against the SPEC.md format: exact round trips of generated meshes, one test per malformed class (line and phrase), and a fixed-seed fuzz.
 #include "flexfit/generators.hpp"
+#include "strings.hpp"
 #include "flexfit/mesh_io.hpp"
 
 #include <gtest/gtest.h>
@@ -41,7 +42,7 @@ private:
     fs::path path_;
 };
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using flexfit::testing::contains;
 
 bool bitIdentical(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;

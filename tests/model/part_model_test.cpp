@@ -1,5 +1,6 @@
 // Tests buildPartModel and materialPreset against Euclidean rest lengths computed here, the thesis's Table 4.1 presets and the settings-validation contract; the shell material against hand-computed masses and constants, a membrane's Young's modulus and a cantilever's beam formula (static solves done here with Eigen); and PartState::atRest sharing one model.
 #include "flexfit/generators.hpp"
+#include "strings.hpp"
 #include "flexfit/part_model.hpp"
 #include "flexfit/part_state.hpp"
 #include "model/spring_blocks.hpp"
@@ -29,7 +30,7 @@ namespace {
 static_assert(std::is_same_v<decltype(buildPartModel(std::declval<TriMesh>())), std::shared_ptr<const PartModel>>,
               "models are shared read-only");
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using flexfit::testing::contains;
 
 TriMesh tetrahedron() {
     TriMesh mesh;

@@ -203,13 +203,13 @@ def test_every_binding_has_a_docstring():
 def test_sweep_bindings(tmp_path, examples):
     path = tmp_path / "sweep.toml"
     path.write_text((examples / "sweeps" / "ball_torus_friction.toml").read_text().replace('"../ball_torus.toml"', f'"{examples / "ball_torus.toml"}"')
-                    .replace("duration = 2.0", "duration = 0.05"))
+                    .replace("duration = 2.0", "duration = 0.02"))
     sweep = flexfit.load_sweep(str(path))
     assert len(sweep) == 12 and sweep.parameter_names == ["diameter", "rim", "friction"]
     assert sweep.labels(0) == ["14", "rigid", "0"] and len(set(sweep.run_ids)) == 12
     assert sweep.file.name == "sweep.toml" and sweep.scene.name == "ball_torus.toml"
     scene = sweep.scene_of(11)
-    assert scene.part_names == ["mouth", "ball"] and scene.duration == 0.05 and scene.time_step == 0.001 and scene.warnings == []
+    assert scene.part_names == ["mouth", "ball"] and scene.duration == 0.02 and scene.time_step == 0.001 and scene.warnings == []
     assert "run " + sweep.run_ids[11] in scene.source
     out = tmp_path / "out"
     assert flexfit.missing_sweep_runs(sweep, str(out)) == list(range(12))

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "flexfit/mesh_io.hpp"
+#include "strings.hpp"
 #include "temp_dir.hpp"
 
 #include <gtest/gtest.h>
@@ -14,8 +15,6 @@
 #include <vector>
 
 namespace flexfit::testing {
-
-inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 inline InputError meshReadError(const std::string& fileName, const std::string& text, const MeshReadOptions& options = {}) {
     TempDir dir;

@@ -24,6 +24,10 @@ inline BodySettings dynamicBody(Vec3 velocity = Vec3::Zero()) {
 }
 
 inline Pose at(const Vec3& p) { return Pose{Eigen::Quaterniond::Identity(), p}; }
+// Turned by `angle` radians about `axis`.
+inline Pose at(const Vec3& p, double angle, const Vec3& axis = Vec3::UnitY()) {
+    return Pose{Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis)), p};
+}
 
 struct BallTorus {
     World world;

@@ -2,6 +2,7 @@
 // interpolated snap, and a ball falling through the container mouth assembled by zone
 // snap-fitting in the world.
 #include "flexfit/flexfit.hpp"
+#include "test_bodies.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,9 +10,7 @@ using namespace flexfit;
 
 namespace {
 
-Pose at(const Vec3& p, double angle = 0.0, const Vec3& axis = Vec3::UnitY()) {
-    return Pose{Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis)), p};
-}
+using flexfit::testing::at;
 
 AssemblyRule rule(SnapTechnique technique) {
     AssemblyRule r;

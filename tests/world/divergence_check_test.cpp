@@ -3,6 +3,7 @@
 // with a DivergenceError naming the body, the time at the start of the step and the likely
 // cause; a normal run never throws.
 #include "flexfit/flexfit.hpp"
+#include "strings.hpp"
 #include "test_bodies.hpp"
 #include "world/divergence_check.hpp"
 
@@ -22,7 +23,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using flexfit::testing::contains;
 
 // Steps the world, calling `load` before each step, until a step throws (at most `steps`).
 // Returns the error and the world's time before the step that threw.

@@ -1,6 +1,7 @@
 // The operator's grab against the analytic critically damped oscillator and statics (the
 // coupling holds a body's weight), and forces on selected masses and faces.
 #include "flexfit/flexfit.hpp"
+#include "test_bodies.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +11,7 @@ using namespace flexfit;
 
 namespace {
 
-Pose at(const Vec3& p) { return Pose{Eigen::Quaterniond::Identity(), p}; }
+using flexfit::testing::at;
 
 struct GrabbedBall {
     World world;

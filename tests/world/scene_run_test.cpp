@@ -311,6 +311,9 @@ TEST(SceneRun, PegSticksInItsHoleWhenPushedTooWeaklyAndPassesWhenPushedHarder) {
 }
 
 TEST(SceneRun, StackStaysInItsSettledPose) {
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "Release only: the same scene runs whole under the sanitizers in GoldenHashWithEveryKernel";
+#endif
     const Scene scene = exampleScene("stack.toml");
     std::vector<BodyId> boxes;
     for (const char* name : {"bottom", "middle", "top"}) boxes.push_back(partNamed(scene, name));
@@ -328,6 +331,9 @@ TEST(SceneRun, StackStaysInItsSettledPose) {
 }
 
 TEST(SceneRun, FrictionSlowsTheBallThroughTheMouthButItStillPasses) {
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "Release only: both scenes run whole under the sanitizers in GoldenHashWithEveryKernel";
+#endif
     auto assembled = [](const char* file) {
         const Scene scene = exampleScene(file);
         SceneRun run(scene);
