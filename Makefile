@@ -3,7 +3,7 @@ JOBS ?= $(shell nproc)
 FLEXFIT := build/release/apps/flexfit/flexfit
 DEMO_OUT ?= out/demo
 
-.PHONY: demo test deps release asan bench clean
+.PHONY: demo test test-sanitizer-long deps release asan bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -33,10 +33,15 @@ demo: release
 	  || echo "demo: no EGL rendering here, skipped $(DEMO_OUT)/viewer.png"; \
 	echo "demo: results in $(DEMO_OUT)/ (ball_torus/: metrics.csv, summary.json; ball-torus/: summary.md, *.png; viewer.png)"
 
-# The whole suite, in Release and again under AddressSanitizer + UBSan.
+# The whole suite in Release, and again under AddressSanitizer + UBSan but for the sanitizer
+# run's longest tests (tests/sanitizer_long.txt), which test-sanitizer-long runs (CI runs both).
+SANITIZER_LONG := ^($(shell grep -v '^\#' tests/sanitizer_long.txt | paste -sd'|'))( |$$)
 test: release asan
 	ctest --preset release -j $(JOBS)
-	ctest --preset asan -j $(JOBS)
+	ctest --preset asan -j $(JOBS) -E '$(SANITIZER_LONG)'
+
+test-sanitizer-long: asan
+	ctest --preset asan -j $(JOBS) -R '$(SANITIZER_LONG)'
 
 BENCH_FLAGS := --benchmark_repetitions=12 --benchmark_enable_random_interleaving=true \
 	--benchmark_report_aggregates_only=true --benchmark_min_time=0.2 \
