@@ -312,7 +312,8 @@ TEST(SceneRun, PegSticksInItsHoleWhenPushedTooWeaklyAndPassesWhenPushedHarder) {
 
 TEST(SceneRun, StackStaysInItsSettledPose) {
 #if defined(__SANITIZE_ADDRESS__)
-    GTEST_SKIP() << "Release only: the same scene runs whole under the sanitizers in GoldenHashWithEveryKernel";
+    GTEST_SKIP() << "Release only: the same scene runs whole under the sanitizers in GoldenHashWithEveryKernel/stack"
+                    " (make test-sanitizer-long)";
 #endif
     const Scene scene = exampleScene("stack.toml");
     std::vector<BodyId> boxes;
