@@ -36,10 +36,7 @@ using flexfit::testing::toFloatPrecision;
 
 using flexfit::testing::contains;
 
-bool bitIdentical(const TriMesh& a, const TriMesh& b) {
-    return a.vertices.size() == b.vertices.size() && a.faces == b.faces &&
-           std::memcmp(a.vertices.data(), b.vertices.data(), a.vertices.size() * sizeof(Vec3)) == 0;
-}
+bool bitIdentical(const TriMesh& a, const TriMesh& b) { return a.faces == b.faces && testing::bitIdentical(a.vertices, b.vertices); }
 
 // ---------------------------------------------------------------------------------------------
 // writeMesh dispatch

@@ -1,5 +1,6 @@
 // Tests the .tri reader and writer (parseTri, formatTri, readTri, writeTri) against the SPEC.md format: exact round trips of generated meshes, one test per malformed class (line and phrase), and a fixed-seed fuzz.
 #include "flexfit/generators.hpp"
+#include "float_precision.hpp"
 #include "strings.hpp"
 #include "flexfit/mesh_io.hpp"
 
@@ -44,9 +45,7 @@ private:
 
 using flexfit::testing::contains;
 
-bool bitIdentical(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;
-}
+using flexfit::testing::bitIdentical;
 
 // A valid tetrahedron; line numbers: name 1, counts 2, vertices 3-6, faces 7-10.
 const std::string kTet =

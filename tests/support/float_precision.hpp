@@ -1,7 +1,10 @@
-// A point as a file of 32-bit floats stores it.
+// Points as mesh files store them: rounded to 32-bit floats, compared bit for bit.
 #pragma once
 
 #include "flexfit/core.hpp"
+
+#include <cstring>
+#include <vector>
 
 namespace flexfit::testing {
 
@@ -10,6 +13,10 @@ namespace flexfit::testing {
 inline Vec3 toFloatPrecision(const Vec3& v) {
     volatile float x = float(v.x()), y = float(v.y()), z = float(v.z());
     return Vec3(double(x), double(y), double(z));
+}
+
+inline bool bitIdentical(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;
 }
 
 }  // namespace flexfit::testing
