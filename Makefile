@@ -80,6 +80,7 @@ bench: release
 	  --pair BM_ToolIntoPart/2/0/1/iterations:3/manual_time BM_ToolIntoPart/2/0/4/iterations:3/manual_time \
 	  --pair BM_ToolIntoPart/2/1/1/iterations:3/manual_time BM_ToolIntoPart/2/1/4/iterations:3/manual_time
 	build/release/bench/bench_zone_coverage $(BENCH_FLAGS) --benchmark_out=bench/results/zone_coverage.csv
+	/usr/bin/python3 tools/bench_ratios.py bench/results/zone_coverage.csv --counter chosen_over_whole
 	build/release/bench/bench_implicit_step --benchmark_repetitions=3 --benchmark_report_aggregates_only=true --benchmark_min_time=0.2 --benchmark_out_format=csv --benchmark_out=bench/results/implicit_step.csv
 	build/release/bench/bench_stiffness_limit --benchmark_out_format=csv --benchmark_out=bench/results/stiffness_limit.csv
 	build/release/bench/bench_world --benchmark_repetitions=3 --benchmark_out_format=csv --benchmark_out=bench/results/world.csv

@@ -8,11 +8,6 @@
 
 #include <benchmark/benchmark.h>
 
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <vector>
-
 namespace {
 
 using namespace flexfit;
@@ -20,39 +15,16 @@ using namespace flexfit;
 using flexfit::bench::modelByIndex;
 using flexfit::bench::settings;
 
-double median(std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-    return v[v.size() / 2];
-}
-
-// Parts A and B are built twice, once in each order: where the allocator puts a part's state
-// moves the vector full step's time by up to ~7% (heart, the same code in both parts: 1.063
-// with A built first, 0.996 with B first), so a_over_b is the geometric mean of both orders.
+// Parts A and B, in alternating chunks and built in both orders (pairedChunkTimes): a_over_b
+// is the geometric mean of the two orders' ratios, each also reported.
 template <class MakeA, class MakeB>
 void paired(benchmark::State& state, MakeA makeA, MakeB makeB, int chunk, bool loadA, bool loadB) {
-    Part a1 = makeA(), b1 = makeB();
-    Part b2 = makeB(), a2 = makeA();
-    std::vector<double> ta1, tb1, ta2, tb2;
-    auto timeChunk = [chunk](Part& part, bool load) {
-        const auto start = std::chrono::steady_clock::now();
-        for (int i = 0; i < chunk; ++i) {
-            if (load) part.applyForce(0, Vec3(0, 0.05, 0));
-            part.step();
-        }
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    };
-    for (auto _ : state) {
-        ta1.push_back(timeChunk(a1, loadA));
-        tb1.push_back(timeChunk(b1, loadB));
-        ta2.push_back(timeChunk(a2, loadA));
-        tb2.push_back(timeChunk(b2, loadB));
-    }
-    const double first = median(ta1) / median(tb1), second = median(ta2) / median(tb2);
-    state.counters["a_over_b"] = std::sqrt(first * second);
-    state.counters["a_over_b_a_built_first"] = first;
-    state.counters["a_over_b_b_built_first"] = second;
-    state.counters["a_ns_per_step"] = 1e9 * std::sqrt(median(ta1) * median(ta2)) / chunk;
-    state.counters["b_ns_per_step"] = 1e9 * std::sqrt(median(tb1) * median(tb2)) / chunk;
+    const flexfit::bench::PairedTimes t = flexfit::bench::pairedChunkTimes(state, {makeA, makeB}, {loadA, loadB}, chunk);
+    state.counters["a_over_b"] = t.ratio(0, 1);
+    state.counters["a_over_b_a_built_first"] = t.medians[0][0] / t.medians[0][1];
+    state.counters["a_over_b_b_built_first"] = t.medians[1][0] / t.medians[1][1];
+    state.counters["a_ns_per_step"] = t.nsPerStep(0, chunk);
+    state.counters["b_ns_per_step"] = t.nsPerStep(1, chunk);
 }
 
 void BM_PairedFullOverOneZone(benchmark::State& state) {

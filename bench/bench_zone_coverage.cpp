@@ -4,9 +4,11 @@
 // for locality (blocks again). Six zones at mass
 // seeds spread over the mesh, at levels from 2 to 24; each step loads one mass. With the
 // cheaper path (the default) a large region is stepped by the full step with the other masses
-// held; without it, always by the region step. The counter `coverage` is the share of the
-// model's springs the region computes.
+// held; without it, always by the region step. Both beside the whole model in one benchmark
+// (chosen_over_whole, region_over_whole). The counter `coverage` is the share of the model's
+// springs the region computes.
 #include "flexfit/flexfit.hpp"
+#include "part_bench_support.hpp"
 #include "shuffled_mesh.hpp"
 
 #include <benchmark/benchmark.h>
@@ -41,41 +43,46 @@ PartSettings settings(PartMode mode, bool cheaper) {
     return s;
 }
 
-void step(benchmark::State& state, Part& part) {
-    for (auto _ : state) {
-        part.applyForce(0, Vec3(0, 0.05, 0));
-        part.step();
-    }
-    state.SetLabel(kNames[state.range(0)]);
-    state.counters["coverage"] = double(part.computedSprings().size()) / double(part.model().springCount());
+// Six zones at mass seeds spread over the mesh, each grown to `level`.
+Part zonesPart(int mesh, int level, bool cheaper) {
+    const auto& m = model(mesh);
+    Part part(m, settings(PartMode::RigidDeformable, cheaper));
+    for (Index seed = 0; seed < m->massCount(); seed += Index(m->massCount() / 6)) part.openZone(ZoneSeed::mass(seed), level);
+    return part;
+}
+
+// Three parts stepped in alternating chunks (pairedChunkTimes: four copies built in different
+// orders, so where the allocator puts each state weighs on all alike): the zones with the cheaper path (the
+// default), the same zones by the region step only, and the whole model.
+void BM_Zones(benchmark::State& state) {
+    const int mesh = int(state.range(0)), level = int(state.range(1));
+    constexpr int kChunk = 8;
+    constexpr std::size_t kCopies = 4;  // each order and its reverse, twice rotated
+    const flexfit::bench::PairedTimes t = flexfit::bench::pairedChunkTimes(
+        state,
+        {[&] { return zonesPart(mesh, level, true); }, [&] { return zonesPart(mesh, level, false); },
+         [&] { return Part(model(mesh), settings(PartMode::FullDeformable, true)); }},
+        {true, true, true}, kChunk, kCopies);
+    state.SetLabel(kNames[mesh]);
+    state.counters["chosen_over_whole"] = t.ratio(0, 2);
+    state.counters["region_over_whole"] = t.ratio(1, 2);
+    state.counters["whole_ns_per_step"] = t.nsPerStep(2, kChunk);
     // The region's size, and the counts fullStepCostsLess weighs (RegionWork), to fit its costs to these timings.
-    const ActiveRegion& region = part.region();
+    const Part part = zonesPart(mesh, level, true);
+    const RegionWork work = RegionWork::of(part.region());
+    state.counters["coverage"] = double(part.computedSprings().size()) / double(part.model().springCount());
     state.counters["computed_springs"] = double(part.computedSprings().size());
-    const RegionWork work = RegionWork::of(region);
     state.counters["loose_springs"] = double(work.looseSprings);
     state.counters["block_lanes"] = double(work.blockLanes);  // 8 a vector block
     state.counters["moving_masses"] = double(part.movingMasses().size());
-}
-
-void BM_Whole(benchmark::State& state) {
-    Part part(model(int(state.range(0))), settings(PartMode::FullDeformable, true));
-    step(state, part);
-}
-
-void BM_Zones(benchmark::State& state) {
-    const auto& m = model(int(state.range(0)));
-    Part part(m, settings(PartMode::RigidDeformable, state.range(2) != 0));
-    for (Index seed = 0; seed < m->massCount(); seed += Index(m->massCount() / 6)) part.openZone(ZoneSeed::mass(seed), int(state.range(1)));
-    step(state, part);
+    state.counters["full_step_chosen"] = part.region().coversEveryMass() || fullStepCostsLess(part.model(), work) ? 1.0 : 0.0;
 }
 
 void Coverages(benchmark::internal::Benchmark* b) {
     for (int mesh : {0, 1, 2, 3, 4})
-        for (int level : {2, 4, 8, 12, 16, 24})
-            for (int cheaper : {1, 0}) b->Args({mesh, level, cheaper});
+        for (int level : {2, 4, 8, 12, 16, 24}) b->Args({mesh, level});
 }
 
-BENCHMARK(BM_Whole)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4);
 BENCHMARK(BM_Zones)->Apply(Coverages);
 
 }  // namespace

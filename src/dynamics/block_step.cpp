@@ -178,7 +178,7 @@ void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartStat
     std::size_t integrated = 0, heldDone = 0;  // what the vector kernels did; the scalar passes finish
 #if defined(FLEXFIT_X86_KERNELS)
     if (kernel == BlockKernel::Avx512) heldDone = integrated = integrateAvx512(model, update, state, held);
-    if (kernel == BlockKernel::Avx2) integrated = integrateAvx2(model, update, state);
+    if (kernel == BlockKernel::Avx2) heldDone = integrated = integrateAvx2(model, update, state, held);
 #endif
     integrateScalar(model, update, state, integrated);
     if (held != nullptr) holdAtRestFrom(model, held, state, heldDone);

@@ -603,9 +603,16 @@ FLEXFIT_AVX2 inline __m256d spread4(__m256d values, int j) {
     }
 }
 
+// Bits of the masses cover[0..3] whose cover count is 0.
+inline unsigned heldBits4(const std::uint16_t* cover) {
+    const __m128i zeroCount = _mm_cmpeq_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(cover)), _mm_setzero_si128());
+    return unsigned(_mm_movemask_epi8(_mm_packs_epi16(zeroCount, _mm_setzero_si128()))) & 0xfu;
+}
+
 // Groups of 4 masses: group g starts at 4 g, or with an octet list at 8 octets[g / 2] + 4 (g % 2).
+// With `held`, the masses whose count is 0 end at rest (as holdAtRest puts them: a selection).
 FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& p, PartState& state, const Index* octets,
-                                      std::size_t groups) {
+                                      std::size_t groups, const std::uint16_t* held = nullptr) {
     double* x = state.positions.data()->data();
     double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
@@ -619,6 +626,7 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
         const std::size_t i = octets != nullptr ? 8 * std::size_t(octets[g / 2]) + 4 * (g % 2) : 4 * g;
         const __m256d mass = _mm256_loadu_pd(model.mass.data() + i);
         const __m256d hOverMass = _mm256_mul_pd(h, _mm256_loadu_pd(model.inverseMass.data() + i));
+        const std::uint32_t heldLanes = held != nullptr ? kSpread3[heldBits4(held + i)] : 0u;
         for (int j = 0; j < 3; ++j) {
             const std::size_t o = 3 * i + 4 * std::size_t(j);
             const __m256d m = spread4(mass, j), hm = spread4(hOverMass, j);
@@ -639,6 +647,11 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
                 const __m256d correction = _mm256_mul_pd(constraint, _mm256_sub_pd(r, xn));
                 xn = _mm256_add_pd(xn, correction);
                 vn = _mm256_add_pd(vn, _mm256_mul_pd(invH, correction));
+            }
+            if (heldLanes != 0) {  // masses no zone covers: back to rest
+                const __m256d atRest = laneMask4(heldLanes, j);
+                xn = _mm256_blendv_pd(xn, _mm256_loadu_pd(rest + o), atRest);
+                vn = _mm256_andnot_pd(atRest, vn);
             }
             _mm256_storeu_pd(x + o, xn);
             _mm256_storeu_pd(v + o, vn);
@@ -664,8 +677,8 @@ std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Ind
                                      const double* x, const double* v, double* f) {
     return listedSpringForcesBy(listedForces512, 8, model, springs, cover, x, v, f);
 }
-std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state) {
-    return integrate256(model, update, state, nullptr, model.massCount() / 4);
+std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held) {
+    return integrate256(model, update, state, nullptr, model.massCount() / 4, held);
 }
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held) {
     return integrate512(model, update, state, nullptr, model.massCount() / 8, held);

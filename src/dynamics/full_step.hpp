@@ -82,9 +82,9 @@ std::size_t listedSpringForcesAvx2(const PartModel& model, std::span<const Index
 // The same with n a multiple of 8.
 std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
                                      const double* x, const double* v, double* f);
-// Integrates masses [0, n) for the largest n that is a multiple of the width; returns n.
-std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state);
-// The same, 8 at a time; the masses whose `held` count is 0 (when given) left at rest.
+// Integrates masses [0, n) for the largest n that is a multiple of the width (4, 8); returns n.
+// The masses whose `held` count is 0 (when given) end at rest, as holdAtRest leaves them.
+std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held);
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held);
 void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                            const double* x, const double* v, double* f);

@@ -112,14 +112,14 @@ TEST(RegionStep, ByTheFullModelMatchesTheNaiveReferenceToo) {
 }
 
 // The full step standing for a region holds the other masses at rest in its integration pass
-// (AVX-512: masked in the same vectors; other kernels: a pass after it): the same bits as the
+// (AVX-512 and AVX2: masked in the same vectors; scalar: a pass after it): the same bits as the
 // full step followed by holdAtRest (the second implementation), in every kernel, with and
 // without spring blocks, on a mesh whose mass count is no multiple of 8 (the vector kernels'
 // tail), with each restoration and each integrator.
 TEST(RegionStep, ByTheFullModelHoldsInTheIntegrationPassBitForBit) {
     const TriMesh sphere = makeIcoSphere(1.0, 3);  // 642 masses
     if (!detail::blockKernelAvailable(detail::BlockKernel::Avx512))
-        std::cout << "[ note ] no AVX-512 on this CPU: the masked hold inside the integration is not exercised\n";
+        std::cout << "[ note ] no AVX-512 on this CPU: its masked hold inside the integration is not exercised\n";
     struct Variant {
         RestorationMethod restoration;
         Integrator integrator;
