@@ -451,11 +451,21 @@ FLEXFIT_AVX2 inline __m256d laneMask4(std::uint32_t lanes, int j) {
 
 // regionRowBlock (AVX-512) with 4-double vectors.
 FLEXFIT_AVX2 inline void regionRowBlock256(const __m256d g[6], std::size_t a0, const std::uint16_t* cover, double* f) {
-    const std::uint32_t movingA = kSpread3[movingBits8(cover + a0)];
+    const unsigned firstEnds = movingBits8(cover + a0);
     const unsigned secondEnds = movingBits8(cover + a0 + 1);  // mass a0 + 1 + i is lane i's second end
-    const std::uint32_t movingB = kSpread3[(secondEnds << 1) & 0xffu];  // as masses a0 + i, lanes 1..7
     double* fa = f + 3 * a0;
     __m256d previous = _mm256_setzero_pd();
+    if ((firstEnds & secondEnds) == 0xffu) {  // all 9 masses move: the full kernel's sums, unmasked
+        for (int j = 0; j < 6; ++j) {
+            const __m256d shifted = shiftOneMass4(previous, g[j]);
+            _mm256_storeu_pd(fa + 4 * j, _mm256_sub_pd(_mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]), shifted));
+            previous = g[j];
+        }
+        subtractLastSpring4(g[5], fa + 24);
+        return;
+    }
+    const std::uint32_t movingA = kSpread3[firstEnds];
+    const std::uint32_t movingB = kSpread3[(secondEnds << 1) & 0xffu];  // as masses a0 + i, lanes 1..7
     for (int j = 0; j < 6; ++j) {
         const __m256d old = _mm256_loadu_pd(fa + 4 * j);
         const __m256d added = _mm256_blendv_pd(old, _mm256_add_pd(old, g[j]), laneMask4(movingA, j));
@@ -479,14 +489,19 @@ FLEXFIT_AVX2 void regionBlocks256(const SpringBlocks& blocks, std::span<const In
             continue;
         }
         const std::size_t a0 = blocks.first[q], b0 = a0 + blocks.offset[q];
-        const std::uint32_t movingA = kSpread3[movingBits8(cover + a0)];
+        const unsigned firstEnds = movingBits8(cover + a0), secondEnds = movingBits8(cover + b0);
         double* fa = f + 3 * a0;
-        const std::uint32_t movingB = kSpread3[movingBits8(cover + b0)];
+        double* fb = f + 3 * b0;  // after the first ends' stores: the ranges overlap when offset < 8
+        if ((firstEnds & secondEnds) == 0xffu) {  // all 16 ends move: the full kernel's sums, unmasked
+            for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fa + 4 * j, _mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]));
+            for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fb + 4 * j, _mm256_sub_pd(_mm256_loadu_pd(fb + 4 * j), g[j]));
+            continue;
+        }
+        const std::uint32_t movingA = kSpread3[firstEnds], movingB = kSpread3[secondEnds];
         for (int j = 0; j < 6; ++j) {
             const __m256d old = _mm256_loadu_pd(fa + 4 * j);
             _mm256_storeu_pd(fa + 4 * j, _mm256_blendv_pd(old, _mm256_add_pd(old, g[j]), laneMask4(movingA, j)));
         }
-        double* fb = f + 3 * b0;  // after the first ends' stores: the ranges overlap when offset < 8
         for (int j = 0; j < 6; ++j) {
             const __m256d old = _mm256_loadu_pd(fb + 4 * j);
             _mm256_storeu_pd(fb + 4 * j, _mm256_blendv_pd(old, _mm256_sub_pd(old, g[j]), laneMask4(movingB, j)));
