@@ -52,8 +52,8 @@ Part zonesPart(int mesh, int level, bool cheaper) {
 }
 
 // Three parts stepped in alternating chunks (pairedChunkTimes: four copies built in different
-// orders, so where the allocator puts each state weighs on all alike): the zones with the cheaper path (the
-// default), the same zones by the region step only, and the whole model.
+// orders, so where the allocator puts each state weighs on all alike): the zones with the
+// cheaper path (the default), the same zones by the region step only, and the whole model.
 void BM_Zones(benchmark::State& state) {
     const int mesh = int(state.range(0)), level = int(state.range(1));
     constexpr int kChunk = 8;
