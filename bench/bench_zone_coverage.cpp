@@ -51,9 +51,9 @@ Part zonesPart(int mesh, int level, bool cheaper) {
     return part;
 }
 
-// Three parts stepped in alternating chunks (pairedChunkTimes: four copies built in different
-// orders, so where the allocator puts each state weighs on all alike): the zones with the
-// cheaper path (the default), the same zones by the region step only, and the whole model.
+// Three parts stepped in alternating chunks (pairedChunkTimes: four copies, each pair of parts
+// built in either order twice, as where the allocator puts a state moves its time): the zones
+// with the cheaper path (the default), the same zones by the region step only, and the whole model.
 void BM_Zones(benchmark::State& state) {
     const int mesh = int(state.range(0)), level = int(state.range(1));
     constexpr int kChunk = 8;

@@ -55,9 +55,10 @@ struct PairedTimes {
 // Chunks of `chunk` steps of every part alternate, each timed apart, so the slow drifts of a
 // shared VM fall on all of them alike (separate benchmarks of identical code differed by up to
 // 6 % here). Where the allocator puts a part's state moves the vector step's time by up to
-// ~10 % (the heart, the same code in two parts: 1.063 with one built first, 0.996 with the
+// ~7 % (the heart, the same code in two parts: 1.063 with one built first, 0.996 with the
 // other), so the set is built `copies` times, copy c in the given order for even c and in the
-// reverse one for odd c, rotated by c / 2, and ratios are geometric means over the copies.
+// reverse one for odd c, rotated by c / 2 (with 4 copies each pair of parts is built in either
+// order twice), and ratios are geometric means over the copies.
 // load[i]: part i gets a force on mass 0 before each step.
 inline PairedTimes pairedChunkTimes(benchmark::State& state, const std::vector<std::function<Part()>>& make,
                                     const std::vector<bool>& load, int chunk, std::size_t copies = 2) {
@@ -81,9 +82,9 @@ inline PairedTimes pairedChunkTimes(benchmark::State& state, const std::vector<s
         }
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
-    for (auto _ : state)
-        for (std::size_t i = 0; i < n; ++i)
-            for (std::size_t c = 0; c < copies; ++c) times[c][i].push_back(timeChunk(sets[c][i], load[i]));
+    for (auto _ : state)  // A B C A B C ...: each chunk follows another part's
+        for (std::size_t c = 0; c < copies; ++c)
+            for (std::size_t i = 0; i < n; ++i) times[c][i].push_back(timeChunk(sets[c][i], load[i]));
     PairedTimes t;
     for (const auto& copy : times) {
         t.medians.emplace_back();

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <iostream>
 #include <random>
+#include <utility>
 
 using namespace flexfit;
 using detail::BlockKernel;
@@ -281,6 +282,9 @@ TEST(BlockStep, HoldAtRestPutsBackExactlyTheUncoveredMassesInEveryKernel) {
 // that applies each force to the moving ends only, blocks in the listed order (first ends, then
 // second ends), rows (offset 1) among them. The forces start non-zero, so a kernel that summed
 // a mass's two terms in another order would show; compared bit for bit (+0 against -0 too).
+// Two covers: a third of the masses held at random (most blocks partly moving), and long runs of
+// moving masses between held stripes, so blocks whose ends all move (which the vector kernels sum
+// without masks) and partly moving ones both come, rows and other offsets alike.
 TEST(BlockStep, RegionBlocksReachOnlyMovingEndsInEveryKernel) {
     const auto model = buildPartModel(makeTorus2());
     const SpringBlocks& blocks = *model->springBlocks;
@@ -289,38 +293,58 @@ TEST(BlockStep, RegionBlocksReachOnlyMovingEndsInEveryKernel) {
     std::mt19937 rng(4);
     std::uniform_real_distribution<double> pending(-1e-3, 1e-3);
     for (Vec3& f : moved.forces) f = Vec3(pending(rng), pending(rng), pending(rng));
-    std::vector<std::uint16_t> cover(model->massCount());
-    for (auto& c : cover) c = rng() % 3 == 0 ? 0 : 1;
     std::vector<Index> listed;
     for (Index q = 0; q < blocks.blockCount(); q += 1 + rng() % 3) listed.push_back(q);
     std::shuffle(listed.begin(), listed.end(), rng);
     ASSERT_TRUE(std::any_of(listed.begin(), listed.end(), [&](Index q) { return blocks.offset[q] == 1; }));
     ASSERT_TRUE(std::any_of(listed.begin(), listed.end(), [&](Index q) { return blocks.offset[q] > 1; }));
-    PartState expected = moved;
-    for (Index q : listed) {
-        Vec3 g[SpringBlocks::kWidth];
-        for (Index i = 0; i < SpringBlocks::kWidth; ++i) {
-            const Index e = blocks.laneSpring[SpringBlocks::kWidth * q + i];
-            g[i] = detail::springForceOnFirst(model->stiffness[e], model->damping[e], model->restLength[e], moved.positions[model->springA[e]],
-                                              moved.positions[model->springB[e]], moved.velocities[model->springA[e]],
-                                              moved.velocities[model->springB[e]]);
+    std::vector<std::uint16_t> randomCover(model->massCount()), stripedCover(model->massCount());
+    for (auto& c : randomCover) c = rng() % 3 == 0 ? 0 : 1;
+    for (std::size_t m = 0; m < stripedCover.size(); ++m) stripedCover[m] = (m / 40) % 4 == 0 ? 0 : 1;
+    // Whether every end of block q moves: masses a0 .. a0 + 7 and a0 + offset .. a0 + offset + 7.
+    auto allEndsMove = [&](const std::vector<std::uint16_t>& cover, Index q) {
+        for (Index i = 0; i < SpringBlocks::kWidth; ++i)
+            if (cover[blocks.first[q] + i] == 0 || cover[blocks.first[q] + blocks.offset[q] + i] == 0) return false;
+        return true;
+    };
+    for (const auto& [name, cover] : {std::pair{"random", &randomCover}, std::pair{"striped", &stripedCover}}) {
+        SCOPED_TRACE(name);
+        const bool striped = cover == &stripedCover;
+        for (const bool row : {true, false})
+            for (const bool all : {true, false}) {
+                const bool present = std::any_of(listed.begin(), listed.end(), [&](Index q) {
+                    return (blocks.offset[q] == 1) == row && allEndsMove(*cover, q) == all;
+                });
+                if (striped) {
+                    EXPECT_TRUE(present) << (row ? "row" : "other") << " blocks with " << (all ? "all" : "not all") << " ends moving";
+                }
+            }
+        PartState expected = moved;
+        for (Index q : listed) {
+            Vec3 g[SpringBlocks::kWidth];
+            for (Index i = 0; i < SpringBlocks::kWidth; ++i) {
+                const Index e = blocks.laneSpring[SpringBlocks::kWidth * q + i];
+                g[i] = detail::springForceOnFirst(model->stiffness[e], model->damping[e], model->restLength[e], moved.positions[model->springA[e]],
+                                                  moved.positions[model->springB[e]], moved.velocities[model->springA[e]],
+                                                  moved.velocities[model->springB[e]]);
+            }
+            for (Index i = 0; i < SpringBlocks::kWidth; ++i) {
+                const Index a = model->springA[blocks.laneSpring[SpringBlocks::kWidth * q + i]];
+                if ((*cover)[a] != 0) expected.forces[a] += g[i];
+            }
+            for (Index i = 0; i < SpringBlocks::kWidth; ++i) {
+                const Index b = model->springB[blocks.laneSpring[SpringBlocks::kWidth * q + i]];
+                if ((*cover)[b] != 0) expected.forces[b] -= g[i];
+            }
         }
-        for (Index i = 0; i < SpringBlocks::kWidth; ++i) {
-            const Index a = model->springA[blocks.laneSpring[SpringBlocks::kWidth * q + i]];
-            if (cover[a] != 0) expected.forces[a] += g[i];
+        for (BlockKernel kernel : kAllKernels) {
+            if (!detail::blockKernelAvailable(kernel)) continue;
+            PartState state = moved;
+            detail::regionBlockForces(blocks, listed, cover->data(), state.positions.data()->data(), state.velocities.data()->data(),
+                                      state.forces.data()->data(), kernel);
+            EXPECT_EQ(std::memcmp(state.forces.data(), expected.forces.data(), state.forces.size() * sizeof(Vec3)), 0)
+                << detail::toString(kernel);
         }
-        for (Index i = 0; i < SpringBlocks::kWidth; ++i) {
-            const Index b = model->springB[blocks.laneSpring[SpringBlocks::kWidth * q + i]];
-            if (cover[b] != 0) expected.forces[b] -= g[i];
-        }
-    }
-    for (BlockKernel kernel : kAllKernels) {
-        if (!detail::blockKernelAvailable(kernel)) continue;
-        PartState state = moved;
-        detail::regionBlockForces(blocks, listed, cover.data(), state.positions.data()->data(), state.velocities.data()->data(),
-                                  state.forces.data()->data(), kernel);
-        EXPECT_EQ(std::memcmp(state.forces.data(), expected.forces.data(), state.forces.size() * sizeof(Vec3)), 0)
-            << detail::toString(kernel);
     }
 }
 
