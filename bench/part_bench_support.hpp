@@ -40,15 +40,16 @@ inline double median(std::vector<double> v) {
 struct PairedTimes {
     std::vector<std::vector<double>> medians;  // [copy][part]
     // The time ratio of parts a and b: the geometric mean over the copies.
-    double ratio(std::size_t a, std::size_t b) const {
+    double ratio(std::size_t a, std::size_t b) const { return overCopies([&](const auto& m) { return m[a] / m[b]; }); }
+    double nsPerStep(std::size_t part, int chunk) const { return 1e9 * overCopies([&](const auto& m) { return m[part]; }) / chunk; }
+
+private:
+    // The geometric mean of value(copy's medians) over the copies.
+    template <class Value>
+    double overCopies(Value value) const {
         double logSum = 0.0;
-        for (const auto& m : medians) logSum += std::log(m[a] / m[b]);
+        for (const auto& m : medians) logSum += std::log(value(m));
         return std::exp(logSum / double(medians.size()));
-    }
-    double nsPerStep(std::size_t part, int chunk) const {
-        double logSum = 0.0;
-        for (const auto& m : medians) logSum += std::log(m[part]);
-        return 1e9 * std::exp(logSum / double(medians.size())) / chunk;
     }
 };
 

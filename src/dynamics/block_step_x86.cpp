@@ -164,10 +164,20 @@ constexpr std::array<std::uint32_t, 256> kSpread3 = [] {
     return table;
 }();
 
-// Bits of the masses cover[0..7] whose cover count is 0 (SSE2: every kernel may use it).
-inline unsigned heldBits8(const std::uint16_t* cover) {
-    const __m128i zeroCount = _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(cover)), _mm_setzero_si128());
+// Bit i set where the 16-bit count i of `counts` is 0 (SSE2: every kernel may use it).
+inline unsigned zeroCountBits(__m128i counts) {
+    const __m128i zeroCount = _mm_cmpeq_epi16(counts, _mm_setzero_si128());
     return unsigned(_mm_movemask_epi8(_mm_packs_epi16(zeroCount, _mm_setzero_si128())));
+}
+
+// Bits of the masses cover[0..7] whose cover count is 0.
+inline unsigned heldBits8(const std::uint16_t* cover) {
+    return zeroCountBits(_mm_loadu_si128(reinterpret_cast<const __m128i*>(cover)));
+}
+
+// Bits of the masses cover[0..3] whose cover count is 0 (reads those 4 counts only).
+inline unsigned heldBits4(const std::uint16_t* cover) {
+    return zeroCountBits(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(cover))) & 0xfu;
 }
 
 // Bits of the masses cover[0..7] that move (cover count non-zero).
@@ -412,6 +422,24 @@ FLEXFIT_AVX2 inline void blockSpringForces256(const SpringBlocks& blocks, std::s
     }
 }
 
+// A row block's forces on its first 8 masses, unmasked: f[a0 + i] += g_i - g_(i-1), where
+// `previous` holds g_(-1) in lanes 1-3 (the previous row block's g_7, or zero). The mass after
+// the 8 (g_7's second end) is left to the caller.
+FLEXFIT_AVX2 inline void addRowForces256(const __m256d g[6], __m256d previous, double* fa) {
+    for (int j = 0; j < 6; ++j) {
+        const __m256d shifted = shiftOneMass4(previous, g[j]);
+        _mm256_storeu_pd(fa + 4 * j, _mm256_sub_pd(_mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]), shifted));
+        previous = g[j];
+    }
+}
+
+// Another block's forces, unmasked: its 8 first ends += g, then its 8 second ends -= g (after the
+// first ends' stores: the ranges overlap when the offset is below 8).
+FLEXFIT_AVX2 inline void addBlockForces256(const __m256d g[6], double* fa, double* fb) {
+    for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fa + 4 * j, _mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]));
+    for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fb + 4 * j, _mm256_sub_pd(_mm256_loadu_pd(fb + 4 * j), g[j]));
+}
+
 FLEXFIT_AVX2 void blockForces256(const SpringBlocks& blocks, const double* x, const double* v, double* f) {
     __m256d carry = _mm256_setzero_pd();  // previous row block's last vector (g_7 in lanes 1-3)
     for (std::size_t q = 0; q < blocks.blockCount(); ++q) {
@@ -420,19 +448,12 @@ FLEXFIT_AVX2 void blockForces256(const SpringBlocks& blocks, const double* x, co
         blockSpringForces256(blocks, q, x, v, g);
         double* fa = f + a;
         if (blocks.offset[q] == 1) {
-            __m256d previous = blocks.continuesRow(q) ? carry : _mm256_setzero_pd();
-            for (int j = 0; j < 6; ++j) {
-                const __m256d shifted = shiftOneMass4(previous, g[j]);
-                _mm256_storeu_pd(fa + 4 * j, _mm256_sub_pd(_mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]), shifted));
-                previous = g[j];
-            }
+            addRowForces256(g, blocks.continuesRow(q) ? carry : _mm256_setzero_pd(), fa);
             carry = g[5];
             if (q + 1 == blocks.blockCount() || !blocks.continuesRow(q + 1)) subtractLastSpring4(g[5], fa + 24);
             continue;
         }
-        double* fb = f + a + 3 * std::size_t(blocks.offset[q]);
-        for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fa + 4 * j, _mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]));
-        for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fb + 4 * j, _mm256_sub_pd(_mm256_loadu_pd(fb + 4 * j), g[j]));
+        addBlockForces256(g, fa, f + a + 3 * std::size_t(blocks.offset[q]));
     }
 }
 
@@ -456,16 +477,12 @@ FLEXFIT_AVX2 inline void regionRowBlock256(const __m256d g[6], std::size_t a0, c
     const unsigned firstEnds = movingBits8(cover + a0);
     const unsigned secondEnds = movingBits8(cover + a0 + 1);  // mass a0 + 1 + i is lane i's second end
     double* fa = f + 3 * a0;
-    __m256d previous = _mm256_setzero_pd();
     if ((firstEnds & secondEnds) == 0xffu) {  // all 9 masses move: the full kernel's sums, unmasked
-        for (int j = 0; j < 6; ++j) {
-            const __m256d shifted = shiftOneMass4(previous, g[j]);
-            _mm256_storeu_pd(fa + 4 * j, _mm256_sub_pd(_mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]), shifted));
-            previous = g[j];
-        }
+        addRowForces256(g, _mm256_setzero_pd(), fa);
         subtractLastSpring4(g[5], fa + 24);
         return;
     }
+    __m256d previous = _mm256_setzero_pd();
     const std::uint32_t movingA = kSpread3[firstEnds];
     const std::uint32_t movingB = kSpread3[(secondEnds << 1) & 0xffu];  // as masses a0 + i, lanes 1..7
     for (int j = 0; j < 6; ++j) {
@@ -497,8 +514,7 @@ FLEXFIT_AVX2 void regionBlocks256(const SpringBlocks& blocks, std::span<const In
         double* fa = f + 3 * a0;
         double* fb = f + 3 * b0;  // after the first ends' stores: the ranges overlap when offset < 8
         if ((firstEnds & secondEnds) == 0xffu) {  // all 16 ends move: the full kernel's sums, unmasked
-            for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fa + 4 * j, _mm256_add_pd(_mm256_loadu_pd(fa + 4 * j), g[j]));
-            for (int j = 0; j < 6; ++j) _mm256_storeu_pd(fb + 4 * j, _mm256_sub_pd(_mm256_loadu_pd(fb + 4 * j), g[j]));
+            addBlockForces256(g, fa, fb);
             continue;
         }
         const std::uint32_t movingA = kSpread3[firstEnds], movingB = kSpread3[secondEnds];
@@ -620,12 +636,6 @@ FLEXFIT_AVX2 inline __m256d spread4(__m256d values, int j) {
         case 1: return _mm256_permute4x64_pd(values, 0xA5);  // 1 1 2 2
         default: return _mm256_permute4x64_pd(values, 0xFE);  // 2 3 3 3
     }
-}
-
-// Bits of the masses cover[0..3] whose cover count is 0.
-inline unsigned heldBits4(const std::uint16_t* cover) {
-    const __m128i zeroCount = _mm_cmpeq_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(cover)), _mm_setzero_si128());
-    return unsigned(_mm_movemask_epi8(_mm_packs_epi16(zeroCount, _mm_setzero_si128()))) & 0xfu;
 }
 
 // Groups of 4 masses: group g starts at 4 g, or with an octet list at 8 octets[g / 2] + 4 (g % 2).
