@@ -68,6 +68,46 @@ def subdivide(vertices, faces):
     return vertices, out
 
 
+def refine_away(vertices, faces, near):
+    """One level of conforming red-green refinement of the faces whose centroid is not `near`:
+    those split into 4 at their edges' midpoints; a near face with split edges (the seam) into
+    2 or 3, so the mesh stays conforming. Faces with no split edge stay as they are."""
+    vertices = list(vertices)
+    split = set()
+    for f in faces:
+        if not near(tuple(sum(vertices[v][d] for v in f) / 3 for d in range(3))):
+            split.update((min(f[i], f[(i + 1) % 3]), max(f[i], f[(i + 1) % 3])) for i in range(3))
+    mids = {}
+
+    def mid(a, b):
+        key = (min(a, b), max(a, b))
+        if key not in mids:
+            mids[key] = len(vertices)
+            vertices.append(tuple(0.5 * (x + y) for x, y in zip(vertices[a], vertices[b])))
+        return mids[key]
+
+    out = []
+    for f in faces:
+        cut = [(min(f[i], f[(i + 1) % 3]), max(f[i], f[(i + 1) % 3])) in split for i in range(3)]
+        if all(cut):
+            a, b, c = f
+            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+            out += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca)]
+        elif any(cut):
+            # Rotate so that edge (a, b) is cut and, with two cuts, (b, c) is the other.
+            k = next(i for i in range(3) if cut[i] and (sum(cut) == 1 or cut[(i + 1) % 3]))
+            a, b, c = f[k], f[(k + 1) % 3], f[(k + 2) % 3]
+            ab = mid(a, b)
+            if sum(cut) == 1:
+                out += [(a, ab, c), (ab, b, c)]
+            else:
+                bc = mid(b, c)
+                out += [(ab, b, bc), (a, ab, bc), (a, bc, c)]
+        else:
+            out.append(f)
+    return vertices, out
+
+
 def shuffled(vertices, faces, seed):
     order = list(range(len(vertices)))
     random.Random(seed).shuffle(order)  # vertex v becomes order[v]
@@ -129,23 +169,39 @@ duration = 1.5
 """
 
 
-def scenes(directory):
+def distance_to_segment(p, a, b):
+    ab = [y - x for x, y in zip(a, b)]
+    t = sum((q - x) * d for q, x, d in zip(p, a, ab)) / sum(d * d for d in ab)
+    t = min(1.0, max(0.0, t))
+    return math.dist(p, [x + t * d for x, d in zip(a, ab)])
+
+
+# Faces within this many tool radii of the tool's path stay as the file has them with --refine
+# away: the contacts and the zones under the tool (within about 1.6 radii) meet the same faces.
+NEAR_RADII = 2.5
+
+
+def scenes(directory, refine="uniform"):
     vertices, faces = read_off(WUSON)
     lo = [min(p[d] for p in vertices) for d in range(3)]
     hi = [max(p[d] for p in vertices) for d in range(3)]
     radius = 0.1 * math.dist(lo, hi)
     top = max(vertices, key=lambda p: p[1])
+    y_press, z_end = top[1] + 0.8 * radius, top[2] + 2.0 * radius
+    path = ((top[0], y_press, top[2]), (top[0], y_press, z_end))
+    near = lambda p: distance_to_segment(p, *path) < NEAR_RADII * radius  # noqa: E731
     out = []
     for level in range(3):
         v, f = shuffled(vertices, faces, 7)
-        path = os.path.join(directory, f"wuson_x{4 ** level}.obj")
-        write_obj(path, v, f)
-        scene = os.path.join(directory, f"tool_press_x{4 ** level}.toml")
+        name = f"wuson_{'away_' if refine == 'away' else ''}x{4 ** level}"
+        mesh = os.path.join(directory, name + ".obj")
+        write_obj(mesh, v, f)
+        scene = os.path.join(directory, f"tool_press_{name}.toml")
         with open(scene, "w") as s:
-            s.write(SCENE.format(query="faces", mesh=path, radius=radius, x=top[0], z=top[2], y_start=top[1] + 1.3 * radius,
-                                 y_press=top[1] + 0.8 * radius, z_end=top[2] + 2.0 * radius))
-        out.append((4 ** level, len(f), scene))
-        vertices, faces = subdivide(vertices, faces)
+            s.write(SCENE.format(query="faces", mesh=mesh, radius=radius, x=top[0], z=top[2], y_start=top[1] + 1.3 * radius,
+                                 y_press=y_press, z_end=z_end))
+        out.append((f"wuson {'refined away ' + str(level) if refine == 'away' else 'x' + str(4 ** level)}", len(f), scene))
+        vertices, faces = refine_away(vertices, faces, near) if refine == "away" else subdivide(vertices, faces)
     return out
 
 
@@ -179,6 +235,7 @@ def measure(flexfit, scene, directory):
     steps = [float(r["us_world_step"]) if "us_world_step" in r else sum(float(r[k]) for k in stages) for r in rows]
     narrow = [float(r["us_narrow_phase"]) for r in rows]
     return {"contact_steps": len(rows), "contacts": statistics.mean(float(r["contacts"]) for r in rows),
+            "moving_masses": statistics.mean(float(r["moving_masses"]) for r in rows),
             "us_narrow_phase": statistics.mean(narrow), "us_world_step": statistics.mean(steps),
             "us_step_p50": percentile(steps, 50), "us_step_p99": percentile(steps, 99)}
 
@@ -188,19 +245,21 @@ def main():
     parser.add_argument("--flexfit", action="append", required=True, help="NAME=PATH of a flexfit binary")
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--csv")
+    parser.add_argument("--refine", choices=("uniform", "away"), default="uniform",
+                        help="x4 and x16: every face split in 4 (uniform), or only the faces away from the tool's path (away)")
     args = parser.parse_args()
     binaries = [b.split("=", 1) for b in args.flexfit]
     if not os.path.exists(WUSON):
         raise SystemExit(f"{WUSON} is missing: install Debian's assimp-testmodels")
     with tempfile.TemporaryDirectory() as directory:
         runs = {}
-        for scale, faces, scene in scenes(directory):
+        for label, faces, scene in scenes(directory, args.refine):
             for _ in range(args.rounds):
                 for name, path in binaries:
-                    runs.setdefault((scale, faces, name), []).append(measure(path, scene, directory))
+                    runs.setdefault((label, faces, name), []).append(measure(path, scene, directory))
     table = []
-    for (scale, faces, name), results in runs.items():
-        row = {"part": f"wuson x{scale}", "faces": faces, "binary": name}
+    for (label, faces, name), results in runs.items():
+        row = {"part": label, "faces": faces, "binary": name}
         for key in results[0]:
             row[key] = statistics.median(r[key] for r in results)
         table.append(row)

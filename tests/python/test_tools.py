@@ -1,0 +1,56 @@
+"""The measuring scripts' own geometry (tools/): checked against what the mesh must keep."""
+
+import math
+import sys
+
+import pytest
+from conftest import ROOT
+
+sys.path.insert(0, str(ROOT / "tools"))
+import tool_press  # noqa: E402
+
+
+def subdivided_octahedron(levels):
+    """A closed surface: the octahedron, midpoint-subdivided `levels` times (tool_press.subdivide)."""
+    vertices = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
+    faces = [(0, 2, 4), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)]
+    for _ in range(levels):
+        vertices, faces = tool_press.subdivide(vertices, faces)
+    return vertices, faces
+
+
+def area(vertices, faces):
+    total = 0.0
+    for a, b, c in faces:
+        u = [q - p for p, q in zip(vertices[a], vertices[b])]
+        w = [q - p for p, q in zip(vertices[a], vertices[c])]
+        total += 0.5 * math.dist((0, 0, 0), (u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]))
+    return total
+
+
+def directed_edges(faces):
+    return [(f[i], f[(i + 1) % 3]) for f in faces for i in range(3)]
+
+
+# Kept as they are: a half (its seam's faces split in 2) and a wedge (at its corners, in 3).
+@pytest.mark.parametrize("near,inner", [(lambda p: p[0] > 0.3, lambda p: p[0] > 0.6),
+                                        (lambda p: p[0] > 0.2 and p[1] > 0.2, lambda p: p[0] > 0.3 and p[1] > 0.3)])
+def test_refine_away_stays_closed_and_oriented_and_keeps_the_near_faces(near, inner):
+    vertices, faces = subdivided_octahedron(3)
+    refined_vertices, refined = vertices, faces
+    for _ in range(2):
+        refined_vertices, refined = tool_press.refine_away(refined_vertices, refined, near)
+    # Closed and consistently wound: each directed edge once, its reverse once (no crack at the seam).
+    edges = directed_edges(refined)
+    unique = set(edges)
+    assert len(edges) == len(unique)
+    assert all((b, a) in unique for a, b in unique)
+    # The same surface: splitting at midpoints of flat triangles keeps the area.
+    assert math.isclose(area(refined_vertices, refined), area(vertices, faces), rel_tol=1e-12)
+    # Faces with every vertex well inside the near side are the input's, untouched.
+    inside = [f for f in faces if all(inner(vertices[v]) for v in f)]
+    assert inside and all(f in refined for f in inside)
+    # The far side was refined: each of its faces into 16 by two levels.
+    far_before = sum(1 for f in faces if all(vertices[v][0] < 0.0 for v in f))
+    far_after = sum(1 for f in refined if all(refined_vertices[v][0] < 0.0 for v in f))
+    assert far_before and far_after >= 16 * far_before
