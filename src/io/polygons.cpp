@@ -29,31 +29,77 @@ bool inTriangle(const Eigen::Vector2d& x, const Eigen::Vector2d& p, const Eigen:
     return turn(p, q, x) >= 0.0 && turn(q, r, x) >= 0.0 && turn(r, p, x) >= 0.0;
 }
 
-// Ear clipping; false when no ear is left (a self-intersecting or degenerate polygon).
-bool clipEars(std::span<const Index> corners, const std::vector<Eigen::Vector2d>& p, std::vector<Face>& out) {
-    std::vector<std::size_t> left(corners.size());
-    for (std::size_t i = 0; i < left.size(); ++i) left[i] = i;
-    while (left.size() > 3) {
-        const std::size_t m = left.size();
-        bool clipped = false;
-        for (std::size_t i = 0; i < m && !clipped; ++i) {
-            const std::size_t a = left[(i + m - 1) % m], b = left[i], c = left[(i + 1) % m];
-            if (turn(p[a], p[b], p[c]) <= 0.0) continue;  // reflex or flat: not an ear
-            bool blocked = false;
-            for (std::size_t j : left) {  // a corner met twice (a bridged hole) does not block its own ear
-                const Index v = corners[j];
-                if (v != corners[a] && v != corners[b] && v != corners[c] && inTriangle(p[j], p[a], p[b], p[c])) blocked = true;
-            }
-            if (blocked) continue;
-            out.push_back({corners[a], corners[b], corners[c]});
-            left.erase(left.begin() + std::ptrdiff_t(i));
-            clipped = true;
+// The corners left, as a ring of positions into the polygon, each with whether it was an ear
+// when last checked. Clipping an ear only removes a corner, so an ear elsewhere stays one
+// (its triangle is the same and nothing can newly block it); only the two neighbours of a clipped
+// corner are checked again. A corner can become an ear unnoticed (its blocker clipped), so a lap
+// without an ear checks every corner again before giving up. Linear in the corners per check:
+// O(n^2) on polygons whose ears are few (a zigzag band: its two ends), where restarting the scan
+// at the first corner after each clip was O(n^3) (10,000 corners: a minute).
+class EarRing {
+public:
+    EarRing(std::span<const Index> corners, const std::vector<Eigen::Vector2d>& p)
+        : corners_(corners), p_(p), prev_(corners.size()), next_(corners.size()), ear_(corners.size()), left_(corners.size()) {
+        for (std::size_t i = 0; i < left_; ++i) {
+            prev_[i] = (i + left_ - 1) % left_;
+            next_[i] = (i + 1) % left_;
         }
-        if (!clipped) return false;
+        checkAll(0);
     }
-    out.push_back({corners[left[0]], corners[left[1]], corners[left[2]]});
-    return true;
-}
+
+    // Clips ears until a triangle is left; false when none is left to clip.
+    bool clip(std::vector<Face>& out) {
+        std::size_t i = 0, sinceClip = 0;
+        bool fresh = true;  // every corner checked since the last clip
+        while (left_ > 3) {
+            if (ear_[i]) {
+                const std::size_t a = prev_[i], c = next_[i];
+                out.push_back({corners_[a], corners_[i], corners_[c]});
+                next_[a] = c;
+                prev_[c] = a;
+                --left_;
+                ear_[a] = isEar(a);
+                ear_[c] = isEar(c);
+                i = c;
+                sinceClip = 0;
+                fresh = false;
+                continue;
+            }
+            i = next_[i];
+            if (++sinceClip < left_) continue;
+            if (fresh) return false;
+            checkAll(i);
+            sinceClip = 0;
+            fresh = true;
+        }
+        out.push_back({corners_[prev_[i]], corners_[i], corners_[next_[i]]});
+        return true;
+    }
+
+private:
+    // Every corner left, around the ring from `start` (one of them).
+    void checkAll(std::size_t start) {
+        for (std::size_t i = start, k = 0; k < left_; i = next_[i], ++k) ear_[i] = isEar(i);
+    }
+
+    // Convex, and no other corner in or on its triangle (a corner met twice, a bridged hole,
+    // does not block its own ear).
+    bool isEar(std::size_t b) const {
+        const std::size_t a = prev_[b], c = next_[b];
+        if (turn(p_[a], p_[b], p_[c]) <= 0.0) return false;  // reflex or flat
+        for (std::size_t j = next_[c]; j != a; j = next_[j]) {
+            const Index v = corners_[j];
+            if (v != corners_[a] && v != corners_[b] && v != corners_[c] && inTriangle(p_[j], p_[a], p_[b], p_[c])) return false;
+        }
+        return true;
+    }
+
+    std::span<const Index> corners_;
+    const std::vector<Eigen::Vector2d>& p_;
+    std::vector<std::size_t> prev_, next_;
+    std::vector<char> ear_;
+    std::size_t left_;
+};
 
 }  // namespace
 
@@ -69,7 +115,7 @@ bool triangulatePolygon(const std::vector<Vec3>& vertices, std::span<const Index
     for (std::size_t i = 0; i < p.size() && convex; ++i) convex = turn(p[i], p[(i + 1) % p.size()], p[(i + 2) % p.size()]) > 0.0;
     if (convex) return fan();
     const std::size_t before = out.size();
-    if (clipEars(corners, p, out)) return true;
+    if (EarRing(corners, p).clip(out)) return true;
     out.resize(before);
     fan();
     return false;

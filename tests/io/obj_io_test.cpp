@@ -10,7 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 namespace flexfit {
@@ -105,12 +107,60 @@ TEST(ObjIo, ConcavePolygonsAreClippedByEars) {
     EXPECT_EQ(k.diagnostics.nonManifoldEdges, 0u);
 }
 
+// A zigzag band of n corners, as one OBJ polygon: only the band's two ends are ears at first,
+// and the corners are rotated so those ends lie inside the list. Its area by the shoelace formula.
+std::pair<std::string, double> zigzagBand(std::size_t n) {
+    std::vector<Eigen::Vector2d> bottom, top;
+    for (std::size_t k = 0; k < n / 2; ++k) {
+        const double x = double(k), y = k % 2 == 0 ? 0.0 : 1.0;
+        bottom.emplace_back(x, y - 0.1);
+        top.emplace_back(x, y + 0.1);
+    }
+    std::vector<Eigen::Vector2d> ring = bottom;  // counter-clockwise: along the bottom, back along the top
+    ring.insert(ring.end(), top.rbegin(), top.rend());
+    std::rotate(ring.begin(), ring.begin() + std::ptrdiff_t(ring.size() / 4), ring.end());
+    std::ostringstream obj, face;
+    face << "f";
+    double twiceArea = 0.0;
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+        obj << "v " << ring[i].x() << ' ' << ring[i].y() << " 0\n";
+        face << ' ' << i + 1;
+        const Eigen::Vector2d& q = ring[(i + 1) % ring.size()];
+        twiceArea += ring[i].x() * q.y() - q.x() * ring[i].y();
+    }
+    obj << face.str() << '\n';
+    return {obj.str(), 0.5 * twiceArea};
+}
+
+TEST(ObjIo, APolygonWithFewEarsIsClippedWhole) {
+    // Ear clipping that rescanned from the first corner after each ear took a minute on 10,000
+    // corners of this band (O(n^3)); each corner's ear is now checked again only when a
+    // neighbour is clipped.
+    TempDir dir;
+    for (const std::size_t n : {12u, 2000u}) {
+        const auto [obj, area] = zigzagBand(n);
+        const MeshReadResult r = readMesh(dir.write("zigzag.obj", obj), {.weldTolerance = std::nullopt, .repair = false});
+        EXPECT_EQ(r.mesh.faces.size(), n - 2) << n;
+        expectExactCover(r.mesh, area);
+        for (const std::string& w : r.diagnostics.warnings) EXPECT_FALSE(contains(w, "cross themselves")) << w;
+    }
+}
+
 TEST(ObjIo, ASelfIntersectingPolygonIsFannedWithAWarning) {
     // A bow tie drawn as one quad: its two halves turn opposite ways, so no ear can be clipped.
     TempDir dir;
     const MeshReadResult r = readMesh(dir.write("bow.obj", "v 0 0 0\nv 2 2 0\nv 2 0 0\nv 0 2 0\nv 1 1 5\nf 1 2 3 4\nf 1 3 5\n"));
     ASSERT_FALSE(r.diagnostics.warnings.empty());
     EXPECT_TRUE(contains(r.diagnostics.warnings[0], "1 polygons cross themselves")) << r.diagnostics.warnings[0];
+    // One that doubles back along its own edges (8 2, 5 2, 9 2): ears are clipped until none is
+    // left, then every corner is checked again from one still there, and the polygon fanned.
+    // (A first version of the ear ring checked from a clipped corner there and never returned.)
+    const MeshReadResult back = readMesh(dir.write("back.obj", "v 8 8 0\nv 0 9 0\nv 2 7 0\nv 1 5 0\nv 0 2 0\nv 1 1 0\nv 3 0 0\n"
+                                                               "v 1 4 0\nv 2 2 0\nv 8 2 0\nv 5 2 0\nv 9 2 0\nv 9 3 0\nv 9 4 0\n"
+                                                               "v 6 5 0\nv 4 6 0\nv 9 6 0\nv 9 8 0\n"
+                                                               "f 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18\n"));
+    ASSERT_FALSE(back.diagnostics.warnings.empty());
+    EXPECT_TRUE(contains(back.diagnostics.warnings[0], "1 polygons cross themselves")) << back.diagnostics.warnings[0];
 }
 
 TEST(ObjIo, RepeatedPositionsAreWeldedAsTheFormatsWelding) {
