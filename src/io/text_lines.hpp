@@ -33,14 +33,22 @@ inline std::vector<std::string_view> tokenize(std::string_view line) {
     return tokens;
 }
 
-// Walks the text line by line, skipping blank lines, remembering line numbers.
+// The text without a UTF-8 byte order mark in front (editors on Windows write one).
+inline std::string_view withoutByteOrderMark(std::string_view text) {
+    return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
+}
+
+// Walks the text line by line, skipping blank lines, remembering line numbers. Lines end at
+// '\n' (a '\r' before it is blank), or at '\r' in a text with no '\n' (classic Mac OS files).
 class LineCursor {
 public:
-    explicit LineCursor(std::string_view text) : text_(text) {}
+    explicit LineCursor(std::string_view text)
+        : text_(withoutByteOrderMark(text)),
+          end_(text_.find('\n') == std::string_view::npos && text_.find('\r') != std::string_view::npos ? '\r' : '\n') {}
 
     // The raw first line (a .tri model's name), without its end of line.
     std::string_view firstLine() {
-        const std::size_t end = text_.find('\n');
+        const std::size_t end = text_.find(end_);
         std::string_view line = text_.substr(0, end);
         pos_ = end == std::string_view::npos ? text_.size() : end + 1;
         lineNumber_ = 1;
@@ -50,7 +58,7 @@ public:
     // Next non-blank line; false at the end of the text.
     bool next(TextLine& out) {
         while (pos_ < text_.size()) {
-            const std::size_t end = std::min(text_.find('\n', pos_), text_.size());
+            const std::size_t end = std::min(text_.find(end_, pos_), text_.size());
             std::string_view raw = text_.substr(pos_, end - pos_);
             pos_ = end + 1;
             ++lineNumber_;
@@ -65,6 +73,7 @@ public:
 
 private:
     std::string_view text_;
+    char end_;  // of a line
     std::size_t pos_ = 0;
     std::size_t lineNumber_ = 0;
 };

@@ -37,6 +37,25 @@ TEST(ObjIo, KeepsTheFilesVertexOrderAndEveryBit) {
     EXPECT_TRUE(r.diagnostics.warnings.empty());
 }
 
+TEST(ObjIo, AByteOrderMarkAndClassicMacLineEndsReadAsPlainText) {
+    // A BOM in front had made the first line an unknown keyword: its vertex was skipped and every
+    // index after it shifted. Lines ended by '\r' alone had read as one line.
+    const std::string plain = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+    std::string mac = plain;
+    std::replace(mac.begin(), mac.end(), '\n', '\r');
+    TempDir dir;
+    const MeshReadResult expected = readMesh(dir.write("plain.obj", plain));
+    for (const auto& [name, text] : {std::pair{"bom.obj", "\xEF\xBB\xBF" + plain}, std::pair{"mac.obj", mac}}) {
+        const MeshReadResult r = readMesh(dir.write(name, text));
+        EXPECT_EQ(r.mesh.vertices, expected.mesh.vertices) << name;
+        EXPECT_EQ(r.mesh.faces, expected.mesh.faces) << name;
+        EXPECT_TRUE(r.diagnostics.warnings.empty()) << name;
+    }
+    // Line numbers count '\r' lines too.
+    const InputError e = readObjError("v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 7\r");
+    EXPECT_EQ(e.line(), 4u) << e.what();
+}
+
 TEST(ObjIo, CornerFormsNegativeAndForwardIndices) {
     // A tetrahedron: corners as i/t, i//n, i/t/n (a face written before its last vertex) and
     // relative indices; texture coordinates, normals, groups and materials ignored.
