@@ -93,6 +93,8 @@ void run(const SimulateOptions& opt) {
     // Kicked and never pushed: the part is released (its restoration clock starts) at once.
     config.loadDuration = opt.forces.empty() && !opt.kicks.empty() ? 0.0 : opt.forceDuration;
     config.duration = opt.duration;
+    if (const std::optional<std::string> problem = stepCountProblem(opt.duration, config.part.simulation.timeStep))
+        throw InputError("option --duration", 0, *problem);
     config.stopWhenRestored = opt.untilRestored;
     config.thresholds = opt.thresholds;
 
@@ -167,7 +169,7 @@ void registerSimulate(CLI::App& app) {
     cmd->add_option("--force", opt->forces, "Point load MASS:FX,FY,FZ (repeatable)");
     cmd->add_option("--kick", opt->kicks,
                     "Velocity change MASS:VX,VY,VZ (m/s) of one mass at the start, the thesis's perturbation (repeatable)");
-    cmd->add_option("--force-duration", opt->forceDuration, "Seconds the loads act before release")->capture_default_str();
+    cmd->add_option("--force-duration", opt->forceDuration, "Seconds the loads act before release")->check(CLI::NonNegativeNumber)->capture_default_str();
     cmd->add_option("--duration", opt->duration, "Simulated seconds")->check(CLI::PositiveNumber)->capture_default_str();
     cmd->add_option("--threshold", opt->thresholds, "Activity thresholds (length units)")->capture_default_str();
     cmd->add_option("--mode", opt->mode, "rigid (never deforms), rigid-deformable (zones), full-deformable (whole-mesh MSD)")
@@ -182,7 +184,7 @@ void registerSimulate(CLI::App& app) {
     cmd->add_flag("--until-restored", opt->untilRestored, "Stop once every threshold has restored after the release");
     cmd->add_option("--csv", opt->csv, "Per-step metrics CSV");
     cmd->add_option("--every", opt->every, "Write every N-th step to the CSV")->check(CLI::PositiveNumber)->capture_default_str();
-    cmd->add_option("--obj-at", opt->objTimes, "Times (s) at which to write the deformed mesh as OBJ")->delimiter(',');
+    cmd->add_option("--obj-at", opt->objTimes, "Times (s) at which to write the deformed mesh as OBJ")->delimiter(',')->check(CLI::NonNegativeNumber);
     cmd->add_option("--obj-prefix", opt->objPrefix, "Path prefix of the OBJ frames")->capture_default_str();
     cmd->callback([opt] { run(*opt); });
 }

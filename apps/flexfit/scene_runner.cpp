@@ -109,9 +109,13 @@ std::string optionalJson(const std::optional<double>& v) { return v ? fmt::forma
 }  // namespace
 
 RunSummary runScene(const Scene& scene, const RunOptions& options) {
+    const double duration = options.duration.value_or(scene.duration);
+    if (options.duration && !(std::isfinite(*options.duration) && *options.duration > 0.0))
+        throw InputError("option --duration", 0, "must be finite and > 0");
+    if (const std::optional<std::string> problem = stepCountProblem(duration, scene.world.timeStep))
+        throw InputError(options.duration ? "option --duration" : scene.source, 0, *problem);
     SceneRun run(scene);
     World& w = run.world();
-    const double duration = options.duration.value_or(scene.duration);
     const auto steps = std::uint64_t(std::llround(duration / scene.world.timeStep));
     // Everything is written under temporary names and moved into place at the end: a run that
     // fails (a divergence, World::step) leaves no half-written CSV, frames or summary.

@@ -106,4 +106,12 @@ struct Scene {
     std::optional<BodyId> find(std::string_view name) const;
 };
 
+// The most steps a run may take: 1e10 steps (hours at the fastest step) come from a time step or
+// duration in the wrong unit, not from a run someone waits for.
+inline constexpr double kMaxRunSteps = 1e10;
+
+// Why `duration` run at `timeStep` is no run (both finite and > 0): shorter than half a step (no
+// step at all), or more than kMaxRunSteps steps. nullopt when it is one.
+std::optional<std::string> stepCountProblem(double duration, double timeStep);
+
 }  // namespace flexfit

@@ -477,9 +477,10 @@ SceneAction readAction(Table& t, const Scene& scene) {
         case Kind::Grab:
             a.grab.frequency = t.positive("frequency", a.grab.frequency);
             a.grab.stiffness = t.nonNegative("stiffness", 0.0);
-            a.grab.damping = t.number("damping", -1.0);
+            // Left out: critical damping (GrabSettings' -1); given, it must be >= 0.
+            a.grab.damping = t.has("damping") ? t.nonNegative("damping", 0.0) : -1.0;
             a.grab.angularStiffness = t.nonNegative("angular_stiffness", 0.0);
-            a.grab.angularDamping = t.number("angular_damping", -1.0);
+            a.grab.angularDamping = t.has("angular_damping") ? t.nonNegative("angular_damping", 0.0) : -1.0;
             if (part.body.motion == MotionType::Static) t.fail(*t.node("part"), "part", "a static part cannot be grabbed");
             break;
         case Kind::Move:
@@ -549,6 +550,8 @@ void readWorld(Table& root, Scene& scene) {
     s.collision.exactTest = w.choice("exact_test", ExactTest::TriangleTriangle);
     s.collision.rigidDeformable = w.choice("rigid_deformable_query", RigidDeformableQuery::Auto);
     s.collision.coherent = w.flag("coherent_collision", s.collision.coherent);
+    if (const std::optional<std::string> problem = stepCountProblem(scene.duration, s.timeStep))
+        w.fail(*w.node(w.has("time_step") ? "time_step" : "duration"), w.has("time_step") ? "time_step" : "duration", *problem);
     w.finish();
     try {
         validateSettings(s);

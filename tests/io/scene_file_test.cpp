@@ -314,6 +314,37 @@ TEST(SceneFile, ContactSlopAndDampingOutOfRangeAreReported) {
     EXPECT_NE(damping.find(":6: scene.world, key 'contact_damping': must be >= 0"), std::string::npos) << damping;
 }
 
+TEST(SceneFile, RunsOfNoStepOrOfTooManyStepsAreReported) {
+    // A time step of 1e-300 s had hung the run (duration / time_step rounded past any integer);
+    // one longer than the duration had run no step and exited as a success.
+    const auto withTimeStep = [](const std::string& value) { return replaced(kBall, "time_step = 0.002", "time_step = " + value); };
+    const std::string tiny = errorOf(withTimeStep("1e-300"));
+    EXPECT_NE(tiny.find("scene.toml:3: scene.world, key 'time_step': the duration 2.5 s at the time step 1e-300 s is 2.5e+300 steps, more than 1e+10"),
+              std::string::npos) << tiny;
+    const std::string longer = errorOf(withTimeStep("6"));
+    EXPECT_NE(longer.find(":3: scene.world, key 'time_step': the duration 2.5 s is shorter than half the time step 6 s"), std::string::npos)
+        << longer;
+    EXPECT_EQ(errorOf(withTimeStep("2.5")), "");  // one step
+    EXPECT_FALSE(stepCountProblem(1e10 * 1e-3, 1e-3).has_value());
+    EXPECT_TRUE(stepCountProblem(1.01e10 * 1e-3, 1e-3).has_value());
+}
+
+TEST(SceneFile, AGrabsDampingGivenMustNotBeNegative) {
+    // Left out it is critical (GrabSettings' -1); a negative one given had silently meant the same.
+    const auto grabOf = [](const Scene& scene) {
+        for (const SceneAction& a : scene.actions)
+            if (a.kind == SceneAction::Kind::Grab) return a.grab;
+        ADD_FAILURE() << "no grab";
+        return GrabSettings{};
+    };
+    EXPECT_EQ(grabOf(parseScene(kBall, "scene.toml", ".")).damping, -1.0);
+    for (const char* key : {"damping", "angular_damping"}) {
+        const std::string e = errorOf(withLine("type = \"grab\"", std::string(key) + " = -1e6"));
+        EXPECT_NE(e.find("key '" + std::string(key) + "': must be >= 0"), std::string::npos) << e;
+    }
+    EXPECT_EQ(grabOf(parseScene(withLine("type = \"grab\"", "damping = 0"), "scene.toml", ".")).damping, 0.0);
+}
+
 TEST(SceneFile, BoxAndPlateGeneratorsGiveTheShapesTheyState) {
     const std::string text = replaced(withMouthGenerator("generator = { type = \"plate\", half_extents = [3, 0.5, 4], hole_x = 1, hole_z = 2 }"),
                                       kSphere, "generator = { type = \"box\", half_extents = [0.5, 1, 2], divisions = 3 }");
