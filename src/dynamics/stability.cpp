@@ -91,8 +91,10 @@ StabilityReport analyzeStability(const PartModel& model, const SimulationSetting
     if (report.certainlyUnstable) {
         text << "time step " << h << " s diverges with " << labelOf(s.integrator) << ": the fastest mode (>= "
              << report.omegaLower << " rad/s) is unstable above " << report.unstableTimeStep << " s";
-        if (report.unstableTimeStep == 0.0) text << " (explicit Euler always blows up without damping)";
-        text << "; use a time step below " << report.safeTimeStep << " s or the implicit integrator (unconditionally stable)";
+        if (report.unstableTimeStep == 0.0)
+            text << " (explicit Euler always blows up without damping); add damping or use the implicit integrator (unconditionally stable)";
+        else
+            text << "; use a time step below " << report.safeTimeStep << " s or the implicit integrator (unconditionally stable)";
     } else if (report.possiblyUnstable) {
         text << "time step " << h << " s may be unstable with " << labelOf(s.integrator)
              << ": stability is guaranteed below " << report.safeTimeStep << " s (modes up to " << report.omegaUpper

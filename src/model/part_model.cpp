@@ -264,6 +264,20 @@ std::shared_ptr<const FileNumbering> fileNumbering(const FileVertices& file, con
     return numbering;
 }
 
+// PartModel::positionBound: 1e6 times the rest shape's extent (infinite for a shape of no extent).
+double divergenceBound(const std::vector<Vec3>& rest) {
+    double largest = 0.0;
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const Vec3& p : rest) {
+        largest = std::max(largest, p.cwiseAbs().maxCoeff());
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+    }
+    const double extent = rest.empty() ? 0.0 : std::max(largest, (hi - lo).norm());
+    const double bound = 1e6 * extent;
+    return extent > 0.0 && std::isfinite(bound) ? bound : std::numeric_limits<double>::infinity();
+}
+
 }  // namespace
 
 std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings) {
@@ -278,6 +292,7 @@ std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSet
         model->drawn = std::make_shared<const SurfaceEmbedding>(embedSurface(settings.drawnMesh, model->mesh, kSettingsSource));
     }
     if (!settings.fileVertices.empty()) model->file = fileNumbering(settings.fileVertices, model->userMesh());
+    model->positionBound = divergenceBound(model->restPositions);
     return model;
 }
 

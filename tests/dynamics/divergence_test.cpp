@@ -174,3 +174,32 @@ TEST(Divergence, RegionCheckFindsWhatTheMassByMassTestFinds) {
     EXPECT_TRUE(finds(throwsFor(explicitEuler, [&](PartState& s) { s.forces[100].z() = nan; }), "velocity of mass 100"));
     EXPECT_EQ(throwsFor(semiImplicit, [&](PartState& s) { s.positions[200].x() = nan; }, false), "");  // not moving: not checked
 }
+
+TEST(Divergence, APositionBeyondTheModelsBoundIsADivergence) {
+    const auto model = buildPartModel(makeTorus1());
+    // The bound, from the rest shape as this test measures it: 1e6 times the larger of its
+    // largest coordinate and its box's diagonal.
+    double largest = 0.0;
+    for (const Vec3& p : model->restPositions) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+    const double bound = 1e6 * std::max(largest, Aabb::around(model->restPositions).size());
+    EXPECT_DOUBLE_EQ(model->positionBound, bound);
+    const std::vector<Vec3> inside{Vec3(bound, -bound, 0.5 * bound)}, beyond{Vec3(0, 0, -2.0 * bound)};
+    EXPECT_TRUE(detail::allWithin(inside, bound));
+    EXPECT_FALSE(detail::allWithin(beyond, bound));
+    EXPECT_FALSE(detail::allWithin(std::vector<Vec3>{Vec3(0, std::nan(""), 0)}, bound));
+    EXPECT_TRUE(detail::allFinite(beyond));  // finite, only beyond
+    // The checks: a finite position twice the bound away throws, naming it; within, nothing.
+    PartState state = PartState::atRest(*model);
+    state.positions[7] = Vec3(0.5 * bound, 0, 0);
+    EXPECT_NO_THROW(detail::checkAllMassesFinite(*model, SimulationSettings{}, state, std::nullopt, 0.0));
+    state.positions[7] = Vec3(0, 2.0 * bound, 0);
+    try {
+        detail::checkAllMassesFinite(*model, SimulationSettings{}, state, std::nullopt, 0.0);
+        FAIL() << "no DivergenceError";
+    } catch (const DivergenceError& e) {
+        EXPECT_TRUE(contains(e.what(), "position of mass 7 is beyond")) << e.what();
+    }
+    EXPECT_FALSE(detail::allFinite(state, std::vector<Index>{7}, bound));
+    EXPECT_TRUE(detail::allFinite(state, std::vector<Index>{7}));  // no bound: finite is enough
+}
+
