@@ -57,6 +57,7 @@ namespace flexfit {
 
 struct ScenePart {
     std::string name;
+    std::size_t line = 0;     // of its [[part]] table in the scene file
     std::shared_ptr<const PartModel> model;
     PartSettings part;
     BodySettings body;

@@ -336,6 +336,7 @@ void readMaterial(Table& t, PartModelSettings& model) {
 ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
     ScenePart p;
     p.name = t.requiredText("name");
+    p.line = t.line();
     if (t.has("mesh") == t.has("generator")) t.fail("needs exactly one of 'mesh' and 'generator'");
     for (const char* key : {"repair", "remesh", "draw", "vertex_order"})
         if (t.has(key) && !t.has("mesh")) t.fail(*t.node(key), key, "applies only to a part read from a 'mesh' file");

@@ -5,8 +5,25 @@
 
 namespace flexfit {
 
+namespace {
+
+// What the world refuses (a part's mass properties, the operator's coupling) named as the scene
+// file's line it comes from.
+template <class Call>
+void atLine(const Scene& scene, std::size_t line, const std::string& what, Call call) {
+    try {
+        call();
+    } catch (const InputError& e) {
+        if (!scene.source.empty() && e.line() == 0) throw InputError(scene.source, line, what + ": " + e.problem());
+        throw;
+    }
+}
+
+}  // namespace
+
 SceneRun::SceneRun(const Scene& scene) : scene_(scene), world_(std::make_unique<World>(scene.world)) {
-    for (const ScenePart& p : scene_.parts) world_->add(p.model, p.part, p.body, p.pose);
+    for (const ScenePart& p : scene_.parts)
+        atLine(scene_, p.line, "part '" + p.name + "'", [&] { world_->add(p.model, p.part, p.body, p.pose); });
     for (const AssemblyRule& r : scene_.assemblies) world_->addAssembly(r);
 }
 
@@ -43,7 +60,9 @@ void SceneRun::step() {
 void SceneRun::start(const SceneAction& a) {
     using Kind = SceneAction::Kind;
     switch (a.kind) {
-        case Kind::Grab: world_->grab(a.body, a.grab); return;
+        case Kind::Grab:
+            atLine(scene_, a.line, "action 'grab' of part '" + scene_.parts[a.body].name + "'", [&] { world_->grab(a.body, a.grab); });
+            return;
         case Kind::Release: world_->release(); return;
         case Kind::Velocity: world_->setVelocity(a.body, a.linear, a.angular); return;
         case Kind::Kick:

@@ -117,6 +117,34 @@ TEST(SceneRun, PushActsForItsDurationExactly) {
     EXPECT_NEAR(ball.linearVelocity.x(), 3.0 * 0.25 * ball.inverseMass, 1e-12);
 }
 
+// What the world refuses when the scene runs (a part's mass properties, the operator's coupling)
+// names the scene file and the part's or action's line, not "p:" or "world:".
+TEST(SceneRun, WhatTheWorldRefusesNamesTheScenesLine) {
+    flexfit::testing::TempDir dir;
+    const auto flat = dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const std::string oneTriangle = "[world]\nduration = 0.1\n\n[[part]]\nname = \"p\"\nmesh = \"" + flat.string() +
+                                    "\"\nmode = \"rigid\"\nmotion = \"dynamic\"\n";
+    try {
+        SceneRun run(parseScene(oneTriangle, "scene.toml", "."));
+        FAIL() << "a dynamic part of no volume was accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.source(), "scene.toml");
+        EXPECT_EQ(e.line(), 4u);
+        EXPECT_EQ(e.problem().rfind("part 'p': ", 0), 0u) << e.what();
+    }
+    const std::string base = kFreeBall;
+    const auto grabLine = std::size_t(std::count(base.begin(), base.end(), '\n')) + 1;  // the appended table's first line
+    SceneRun run(parseScene(base + "[[action]]\ntime = 0.7\ntype = \"grab\"\npart = \"ball\"\nstiffness = 1e300\n", "free.toml", "."));
+    try {
+        runFor(run, 1.0);
+        FAIL() << "a grab of stiffness 1e300 was accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.source(), "free.toml");
+        EXPECT_EQ(e.line(), grabLine) << e.what();
+        EXPECT_EQ(e.problem().rfind("action 'grab' of part 'ball': ", 0), 0u) << e.what();
+    }
+}
+
 // The thesis's perturbation as a scene action: each listed mass's velocity changes at once, and a
 // free full-deformable part (no restoration, no gravity) keeps the momentum sum m_i dv.
 TEST(SceneRun, AKickActionGivesTheMassesTheirVelocityChange) {
