@@ -144,6 +144,32 @@ MeshQuality measureQuality(const TriMesh& mesh) {
 
 namespace {
 
+// The most triangles a remesh may make: about a minute and a few GB with CGAL here (the heart at
+// 917,000 took 58 s); more is a unit mistaken, not a simulation surface.
+constexpr double kMaxRemeshTriangles = 2e6;
+
+// Refuses a target edge that would make more than kMaxRemeshTriangles (the surface's area over
+// an equilateral triangle's), or that the coordinates cannot resolve (1e-9 of the largest one:
+// splitting edges there made CGAL take memory without end).
+void checkRemeshSize(const TriMesh& mesh, double edge, const std::string& source) {
+    double area = 0.0, largest = 0.0;
+    for (const Face& f : mesh.faces)
+        area += 0.5 * (mesh.vertices[f[1]] - mesh.vertices[f[0]]).cross(mesh.vertices[f[2]] - mesh.vertices[f[0]]).norm();
+    for (const Vec3& p : mesh.vertices) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+    const double triangles = area / (std::sqrt(3.0) / 4.0 * edge * edge);
+    std::ostringstream text;
+    if (edge < 1e-9 * largest)
+        text << "remesh: the target edge length " << edge << " is below 1e-9 of the largest coordinate (" << largest
+             << "): the coordinates cannot resolve it";
+    else if (!(triangles <= kMaxRemeshTriangles))
+        text << "remesh: the target edge length " << edge << " would make about " << std::llround(std::min(triangles, 1e18))
+             << " triangles (the surface's area " << area << " over equilateral triangles of that edge), more than "
+             << kMaxRemeshTriangles << ": use a longer edge";
+    else
+        return;
+    throw InputError(source, 0, text.str());
+}
+
 RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, const std::string& source) {
     RemeshResult r;
     r.diagonal = boundingBox(mesh).diagonal().norm();
@@ -155,6 +181,7 @@ RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, co
              << "): more than ~10^8 triangles";
         throw InputError(source, 0, text.str());
     }
+    checkRemeshSize(mesh, options.targetEdge, source);
     if (options.iterations < 1 || options.iterations > 100) throw InputError(source, 0, "remesh: iterations must be 1 to 100");
     if (!(options.featureAngle > 0.0 && options.featureAngle < 180.0))
         throw InputError(source, 0, "remesh: the feature angle must be between 0 and 180 degrees");

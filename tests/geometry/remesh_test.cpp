@@ -174,5 +174,32 @@ TEST(Remesh, BadOptionsAreErrors) {
     EXPECT_THROW(remeshForSimulation(mesh, {.targetEdge = 0.1, .featureAngle = 180.0}, "part.obj"), InputError);
 }
 
+TEST(Remesh, EdgesThatWouldMakeMillionsOfTrianglesOrThatTheCoordinatesCannotResolveAreRefused) {
+    // A unit sphere (area about 4 pi): 2e6 equilateral triangles of edge L cover
+    // 2e6 sqrt(3) / 4 L^2, so L = 0.003 would make about 2.8 million; 0.0036 about 1.9 million.
+    const TriMesh sphere = makeIcoSphere(1.0, 3);
+    double area = 0.0;
+    for (const Face& f : sphere.faces)
+        area += 0.5 * (sphere.vertices[f[1]] - sphere.vertices[f[0]]).cross(sphere.vertices[f[2]] - sphere.vertices[f[0]]).norm();
+    const double limitEdge = std::sqrt(area / (2e6 * std::sqrt(3.0) / 4.0));
+    try {
+        remeshForSimulation(sphere, {.targetEdge = 0.9 * limitEdge}, "ball.obj");
+        ADD_FAILURE() << "accepted an edge for ~2.5 million triangles";
+    } catch (const InputError& e) {
+        EXPECT_NE(e.problem().find("triangles"), std::string::npos) << e.problem();
+        EXPECT_NE(e.problem().find("use a longer edge"), std::string::npos) << e.problem();
+    }
+    // A tiny part far from the origin: edges of 1e-10 at x = 1e6 are below what doubles resolve
+    // there (about 1.2e-10); CGAL had split them without end, until memory ran out.
+    TriMesh far = makeIcoSphere(1e-9, 1);
+    for (Vec3& p : far.vertices) p.x() += 1e6;
+    try {
+        remeshForSimulation(far, {.targetEdge = 1e-10}, "far.obj");
+        ADD_FAILURE() << "accepted an edge the coordinates cannot resolve";
+    } catch (const InputError& e) {
+        EXPECT_NE(e.problem().find("cannot resolve"), std::string::npos) << e.problem();
+    }
+}
+
 }  // namespace
 }  // namespace flexfit
