@@ -2,6 +2,7 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 
+#include <cmath>
 #include <fmt/core.h>
 
 #include <chrono>
@@ -27,8 +28,10 @@ Pose parsePose(const std::string& translation, const std::string& rotation, cons
         if (last == std::string::npos) throw InputError("option --rotate-" + option, 0, "'" + rotation + "' is not ax,ay,az,degrees");
         const Vec3 axis = parseVec3(rotation.substr(0, last), "--rotate-" + option);
         const Vec3 angle = parseVec3(rotation.substr(last + 1) + ",0,0", "--rotate-" + option);
-        if (!(axis.norm() > 0)) throw InputError("option --rotate-" + option, 0, "the rotation axis is zero");
-        pose.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(angle.x() * M_PI / 180.0, axis.normalized()));
+        if (!(axis.norm() > 0) || !std::isfinite(axis.norm()))
+            throw InputError("option --rotate-" + option, 0, "the rotation axis must be non-zero (and its length finite)");
+        // In one turn first: 1e308 degrees times pi overflowed to a NaN pose (NaN contacts).
+        pose.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(std::fmod(angle.x(), 360.0) * M_PI / 180.0, axis.normalized()));
     }
     return pose;
 }
