@@ -93,6 +93,7 @@ struct SceneWarning {
 
 struct Scene {
     std::string source;       // the file, for messages
+    std::string linesFile;    // the file the parts' and actions' lines are in, when not `source` (a sweep run's base scene)
     WorldSettings world;
     double duration = 1.0;    // s
     std::vector<ScenePart> parts;

@@ -149,8 +149,9 @@ namespace {
 constexpr double kMaxRemeshTriangles = 2e6;
 
 // Refuses a target edge that would make more than kMaxRemeshTriangles (the surface's area over
-// an equilateral triangle's), or that the coordinates cannot resolve (1e-9 of the largest one:
-// splitting edges there made CGAL take memory without end).
+// an equilateral triangle's), or that the coordinates barely resolve (below 10^4 units in the
+// last place of the largest one: splitting edges of 1e-10 at x = 1e6, where a unit in the last
+// place is 1.2e-10, made CGAL take memory without end).
 void checkRemeshSize(const TriMesh& mesh, double edge, const std::string& source) {
     double area = 0.0, largest = 0.0;
     for (const Face& f : mesh.faces)
@@ -158,9 +159,9 @@ void checkRemeshSize(const TriMesh& mesh, double edge, const std::string& source
     for (const Vec3& p : mesh.vertices) largest = std::max(largest, p.cwiseAbs().maxCoeff());
     const double triangles = area / (std::sqrt(3.0) / 4.0 * edge * edge);
     std::ostringstream text;
-    if (edge < 1e-9 * largest)
-        text << "remesh: the target edge length " << edge << " is below 1e-9 of the largest coordinate (" << largest
-             << "): the coordinates cannot resolve it";
+    if (edge < 1e4 * std::numeric_limits<double>::epsilon() * largest)
+        text << "remesh: the target edge length " << edge << " is below 10^4 units in the last place of the largest coordinate ("
+             << largest << "): the coordinates cannot resolve it";
     else if (!(triangles <= kMaxRemeshTriangles))
         text << "remesh: the target edge length " << edge << " would make about " << std::llround(std::min(triangles, 1e18))
              << " triangles (the surface's area " << area << " over equilateral triangles of that edge), more than "

@@ -104,7 +104,7 @@ PlyType typeOf(std::string_view token, const std::string& source, std::size_t li
 
 PlyHeader readHeader(std::string_view text, const std::string& source) {
     PlyHeader header;
-    std::size_t offset = 0, line = 0;
+    std::size_t offset = std::size_t(detail::withoutByteOrderMark(text).data() - text.data()), line = 0;
     bool formatSeen = false;
     while (true) {
         if (offset >= text.size()) throw InputError(source, line, "the header has no end_header line");

@@ -551,8 +551,6 @@ void readWorld(Table& root, Scene& scene) {
     s.collision.exactTest = w.choice("exact_test", ExactTest::TriangleTriangle);
     s.collision.rigidDeformable = w.choice("rigid_deformable_query", RigidDeformableQuery::Auto);
     s.collision.coherent = w.flag("coherent_collision", s.collision.coherent);
-    if (const std::optional<std::string> problem = stepCountProblem(scene.duration, s.timeStep))
-        w.fail(*w.node(w.has("time_step") ? "time_step" : "duration"), w.has("time_step") ? "time_step" : "duration", *problem);
     w.finish();
     try {
         validateSettings(s);
@@ -571,7 +569,16 @@ Scene parseScene(std::string_view text, const std::string& source, const std::fi
     } catch (const toml::parse_error& e) {
         throw InputError(source, e.source().begin.line, "TOML syntax: " + std::string(e.description()));
     }
-    return detail::readSceneDocument(document, source, baseDirectory, options);
+    Scene scene = detail::readSceneDocument(document, source, baseDirectory, options);
+    // Checked here, not in readWorld: a sweep's run sets its own duration after reading.
+    if (const std::optional<std::string> problem = stepCountProblem(scene.duration, scene.world.timeStep)) {
+        const toml::node* world = document.get("world");
+        const toml::table* w = world != nullptr ? world->as_table() : nullptr;
+        const char* key = w != nullptr && w->contains("time_step") ? "time_step" : "duration";
+        const toml::node* at = w != nullptr ? w->get(key) : nullptr;
+        throw InputError(source, at != nullptr ? lineOf(*at) : 0, std::string("scene.world, key '") + key + "': " + *problem);
+    }
+    return scene;
 }
 
 AssemblyRule detail::readAssemblyTable(const toml::table& table, const std::string& source, const std::vector<std::string>& partNames,

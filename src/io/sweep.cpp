@@ -279,18 +279,22 @@ Scene sweepScene(const Sweep& sweep, std::size_t run) {
     if (run >= sweep.runs.size()) throw InputError(sweep.file.string(), 0, "no run " + std::to_string(run) + " (the sweep has " + std::to_string(sweep.runs.size()) + ")");
     const toml::table document = runDocument(sweep, run);
     const std::string source = sweep.file.string() + " run " + sweep.runs[run].id;
+    std::string values;
+    for (std::size_t p = 0; p < sweep.parameters.size(); ++p)
+        values += (p ? ", " : "") + sweep.parameters[p].name + " = " + sweep.parameters[p].labels[sweep.runs[run].cases[p]];
+    const auto inRun = [&](const std::string& problem) { return "run " + sweep.runs[run].id + " (" + values + "): " + problem; };
     Scene scene;
     try {
         scene = detail::readSceneDocument(document, source, sweep.scene.parent_path(), {});
     } catch (const InputError& e) {
         // The problem is in a value the sweep set (line 0) or in the base scene (its line).
-        std::string values;
-        for (std::size_t p = 0; p < sweep.parameters.size(); ++p)
-            values += (p ? ", " : "") + sweep.parameters[p].name + " = " + sweep.parameters[p].labels[sweep.runs[run].cases[p]];
-        if (e.line() == 0) throw InputError(sweep.file.string(), lineOfValue(sweep, e.problem()), "run " + sweep.runs[run].id + " (" + values + "): " + e.problem());
+        if (e.line() == 0) throw InputError(sweep.file.string(), lineOfValue(sweep, e.problem()), inRun(e.problem()));
         throw InputError(sweep.scene.string(), e.line(), e.problem() + " (in run " + sweep.runs[run].id + " of " + sweep.file.string() + ": " + values + ")");
     }
     if (sweep.duration) scene.duration = *sweep.duration;
+    scene.linesFile = sweep.scene.string();
+    if (const std::optional<std::string> problem = stepCountProblem(scene.duration, scene.world.timeStep))
+        throw InputError(sweep.file.string(), lineOfValue(sweep, "'time_step'"), inRun(*problem));
     return scene;
 }
 

@@ -14,8 +14,9 @@ void atLine(const Scene& scene, std::size_t line, const std::string& what, Call 
     try {
         call();
     } catch (const InputError& e) {
-        if (!scene.source.empty() && e.line() == 0) throw InputError(scene.source, line, what + ": " + e.problem());
-        throw;
+        if (scene.source.empty() || e.line() != 0) throw;
+        if (scene.linesFile.empty()) throw InputError(scene.source, line, what + ": " + e.problem());
+        throw InputError(scene.linesFile, line, what + " (in " + scene.source + "): " + e.problem());
     }
 }
 

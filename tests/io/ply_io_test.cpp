@@ -122,6 +122,15 @@ TEST(PlyIo, ElementsWithoutPropertiesAndAFinalEndOfLine) {
     EXPECT_EQ(r.mesh.vertices, mesh.vertices);
 }
 
+TEST(PlyIo, AByteOrderMarkBeforeTheHeaderIsSkipped) {
+    // The binary data starts after the header as the file has it, the mark included.
+    const TriMesh mesh = makeIcoSphere(1.0, 0);
+    TempDir dir;
+    const MeshReadResult r = readMesh(dir.write("m.ply", "\xEF\xBB\xBF" + binaryPly(mesh, false)));
+    EXPECT_EQ(r.mesh.vertices, mesh.vertices);
+    EXPECT_EQ(r.mesh.faces, mesh.faces);
+}
+
 TEST(PlyIo, FloatCoordinatesAreTheFloatsValues) {
     TempDir dir;
     std::string text = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"

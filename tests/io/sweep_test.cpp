@@ -136,6 +136,16 @@ TEST(Sweep, ErrorsNameTheSweepFileAndLine) {
     expectError("bogus = 1\n", 3, "unknown key 'bogus'");
 }
 
+TEST(Sweep, ARunOfNoStepOrOfTooManyIsRefusedWithTheSweepsDuration) {
+    // The sweep's own duration (0.25 s) is the one its runs take: a time step of 1 s there runs
+    // no step, and is refused at load naming the parameter; 1e-9 s (2.5e8 steps) is a run, though
+    // the base scene's 1 s at that step would have been 1e9.
+    const std::string timeSteps = "[[parameter]]\nname = \"h\"\nkey = \"world.time_step\"\nvalues = [";
+    expectError(timeSteps + "0.001, 1.0]\n", 3, "shorter than half the time step 1 s");
+    TempDir dir;
+    EXPECT_NO_THROW(load(dir, timeSteps + "1e-9]\n"));
+}
+
 TEST(Sweep, SetGivesEveryRunTheSameValues) {
     TempDir dir;
     dir.write("scene.toml", kScene);

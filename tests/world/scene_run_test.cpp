@@ -132,6 +132,17 @@ TEST(SceneRun, WhatTheWorldRefusesNamesTheScenesLine) {
         EXPECT_EQ(e.line(), 4u);
         EXPECT_EQ(e.problem().rfind("part 'p': ", 0), 0u) << e.what();
     }
+    // A sweep's run: the lines are its base scene's, the run is named beside them.
+    Scene sweepRun = parseScene(oneTriangle, "sweep.toml run 1a2b", ".");
+    sweepRun.linesFile = "scene.toml";
+    try {
+        SceneRun refused(sweepRun);
+        FAIL() << "a dynamic part of no volume was accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.source(), "scene.toml");
+        EXPECT_EQ(e.line(), 4u);
+        EXPECT_EQ(e.problem().rfind("part 'p' (in sweep.toml run 1a2b): ", 0), 0u) << e.what();
+    }
     const std::string base = kFreeBall;
     const auto grabLine = std::size_t(std::count(base.begin(), base.end(), '\n')) + 1;  // the appended table's first line
     SceneRun run(parseScene(base + "[[action]]\ntime = 0.7\ntype = \"grab\"\npart = \"ball\"\nstiffness = 1e300\n", "free.toml", "."));
