@@ -10,6 +10,10 @@
 
 namespace flexfit {
 
+// The most vertices a generator makes: 2048 x 2048 (about 20 s and 6 GB as a part here); more
+// is refused (InputError) rather than failing to allocate after minutes.
+inline constexpr long long kMaxGeneratedVertices = 2048LL * 2048LL;
+
 // Torus around the y axis (the thesis's container mouth is open along y), centred at the
 // origin. U segments around the axis, V around the tube: U*V vertices, 2UV faces, 3UV edges.
 // Requires majorRadius > minorRadius > 0, U >= 3, V >= 3.

@@ -5,6 +5,7 @@
 #include <map>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 namespace flexfit {
 namespace {
@@ -15,6 +16,12 @@ bool positiveFinite(double x) { return std::isfinite(x) && x > 0.0; }
 
 void require(bool ok, const char* what) {
     if (!ok) throw InputError("generator", 0, what);
+}
+
+void requireVertexCount(long long count, const char* shape) {
+    if (count > kMaxGeneratedVertices)
+        throw InputError("generator", 0, std::string(shape) + " of " + std::to_string(count) + " vertices: at most " +
+                                             std::to_string(kMaxGeneratedVertices) + " (2048 x 2048)");
 }
 
 // Quad (a, b, c, d) counter-clockwise from outside -> two triangles.
@@ -73,6 +80,7 @@ TriMesh makeTorus(double majorRadius, double minorRadius, int segmentsU, int seg
     require(positiveFinite(minorRadius) && positiveFinite(majorRadius) && majorRadius > minorRadius,
             "torus needs finite radii with major > minor > 0");
     require(segmentsU >= 3 && segmentsV >= 3, "torus needs at least 3 x 3 segments");
+    requireVertexCount(static_cast<long long>(segmentsU) * segmentsV, "torus");
     TriMesh mesh;
     mesh.name = "torus";
     for (int u = 0; u < segmentsU; ++u) {
@@ -92,6 +100,7 @@ TriMesh makeTorus(double majorRadius, double minorRadius, int segmentsU, int seg
 TriMesh makeUvSphere(double radius, int segments, int rings) {
     require(positiveFinite(radius), "sphere needs a finite radius > 0");
     require(segments >= 3 && rings >= 2, "sphere needs segments >= 3 and rings >= 2");
+    requireVertexCount(static_cast<long long>(segments) * (rings - 1) + 2, "sphere");
     TriMesh mesh = makePolarGrid(segments, rings, [&](double t, double p) { return Vec3(radius * unitDirection(t, p)); });
     mesh.name = "sphere";
     return mesh;
@@ -192,6 +201,7 @@ TriMesh makePlateWithHole(const Vec3& halfExtents, double holeX, double holeZ) {
 TriMesh makeHeart(double size, int segments, int rings) {
     require(positiveFinite(size), "heart needs a finite size > 0");
     require(segments >= 3 && rings >= 2, "heart needs segments >= 3 and rings >= 2");
+    requireVertexCount(static_cast<long long>(segments) * (rings - 1) + 2, "heart");
     // The implicit heart spans y in about [-1, 1.1]; centre it and scale its height to `size`.
     TriMesh unit = makePolarGrid(segments, rings, [](double t, double p) {
         const Vec3 dir = unitDirection(t, p);

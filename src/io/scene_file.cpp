@@ -268,7 +268,11 @@ TriMesh generatePartMesh(Table& t) {
     if (type == "torus") {
         const double major = g.positive("major", 10.0), minor = g.positive("minor", 2.5);
         if (!(minor < major)) g.fail("minor radius must be smaller than the major radius");
-        mesh = makeTorus(major, minor, g.integer("u", 24, 3, 4096), g.integer("v", 24, 3, 4096));
+        const int u = g.integer("u", 24, 3, 4096), v = g.integer("v", 24, 3, 4096);
+        if (static_cast<long long>(u) * v > kMaxGeneratedVertices)
+            g.fail(*g.node("u"), "u", "u x v = " + std::to_string(static_cast<long long>(u) * v) + " vertices: at most " +
+                                          std::to_string(kMaxGeneratedVertices) + " (2048 x 2048)");
+        mesh = makeTorus(major, minor, u, v);
     } else if (type == "sphere") {
         mesh = makeIcoSphere(g.positive("radius", 1.0), g.integer("level", 3, 0, 7));
     } else if (type == "box") {

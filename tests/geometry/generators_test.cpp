@@ -68,6 +68,22 @@ double radialXZ(const Vec3& p) { return std::hypot(p.x(), p.z()); }
 // ---------------------------------------------------------------------------------------------
 // The thesis's models
 
+TEST(Generators, MoreThan2048x2048VerticesAreRefusedBeforeAnyIsMade) {
+    // gen torus --u 100000 --v 100000 had failed to allocate after 39 s.
+    for (const auto& make : std::vector<std::function<TriMesh()>>{[] { return makeTorus(10, 2.5, 2049, 2048); },
+                                                                  [] { return makeTorus(10, 2.5, 100000, 100000); },
+                                                                  [] { return makeUvSphere(1, 2048, 2050); },
+                                                                  [] { return makeHeart(20, 4096, 4096); }}) {
+        try {
+            make();
+            ADD_FAILURE() << "accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(e.problem().find("at most 4194304 (2048 x 2048)"), std::string::npos) << e.problem();
+        }
+    }
+    EXPECT_EQ(makeUvSphere(1, 2048, 2048).vertices.size(), 2048u * 2047u + 2u);  // at the limit, made
+}
+
 TEST(Generators, Torus1MatchesTheThesis) {
     const TriMesh mesh = makeTorus1();
     EXPECT_EQ(mesh.name, "torus1");

@@ -329,6 +329,11 @@ TEST(SceneFile, RunsOfNoStepOrOfTooManyStepsAreReported) {
     EXPECT_TRUE(stepCountProblem(1.01e10 * 1e-3, 1e-3).has_value());
 }
 
+TEST(SceneFile, AGeneratedTorusOfMoreThan2048x2048VerticesIsReported) {
+    const std::string e = errorOf(withMouthGenerator("generator = { type = \"torus\", major = 10, minor = 2.5, u = 4096, v = 2048 }"));
+    EXPECT_NE(e.find("key 'u': u x v = 8388608 vertices: at most 4194304 (2048 x 2048)"), std::string::npos) << e;
+}
+
 TEST(SceneFile, AGrabsDampingGivenMustNotBeNegative) {
     // Left out it is critical (GrabSettings' -1); a negative one given had silently meant the same.
     const auto grabOf = [](const Scene& scene) {
