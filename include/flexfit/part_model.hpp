@@ -125,11 +125,12 @@ struct PartModel {
     std::vector<Index> massSpringAdr;  // (V+1)
     std::vector<Index> massSprings;    // (2E)
     std::size_t bendingSpringCount = 0;
-    // A mass with a position coordinate (part frame) beyond this in magnitude has diverged, even
-    // if finite: 1e6 times the rest shape's extent (its largest rest coordinate or bounding-box
-    // diagonal, whichever is larger), as the divergence checks test it, within a factor 2 (a
-    // power of two). Explicit Euler far above its stability bound can stay finite for a while,
-    // at 1e39 units. buildPartModel sets it; infinite (finite positions only) otherwise.
+    // A mass farther than this from mass 0 along an axis has diverged, even if finite: 1e6 times
+    // the rest shape's bounding-box diagonal, as the divergence checks test it, within a factor 2
+    // (a power of two). Explicit Euler far above its stability bound can stay finite for a
+    // while, at 1e39 units. Relative to mass 0, not to the part's origin: a fully deformable part
+    // in free fall moves its masses, not its frame, and may fall any distance together.
+    // buildPartModel sets it; infinite (finite positions only) otherwise.
     double positionBound = std::numeric_limits<double>::infinity();
     std::span<const Index> springsAt(Index v) const {
         return {massSprings.data() + massSpringAdr[v], massSprings.data() + massSpringAdr[v + 1]};

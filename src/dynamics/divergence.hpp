@@ -14,19 +14,22 @@ namespace flexfit::detail {
 
 // True when every coordinate is finite. No early exit: one vectorised pass over the array.
 bool allFinite(std::span<const Vec3> values);
-// True when every coordinate is finite and at most `bound` in magnitude (exactly: below the
-// power of two above it; PartModel::positionBound).
-bool allWithin(std::span<const Vec3> values, double bound);
-// True when every coordinate of the masses' positions (within `positionBound`), velocities and
-// pending forces is finite.
+// True when every coordinate is finite and every value within `bound` of `origin` along each
+// axis (exactly: below the power of two above it; PartModel::positionBound).
+bool allWithin(std::span<const Vec3> values, const Vec3& origin, double bound);
+// True when every coordinate of the masses' positions, velocities and pending forces is
+// finite, and every position within `positionBound` of mass 0's (as allWithin).
 bool allFinite(const PartState& state, std::span<const Index> masses,
                double positionBound = std::numeric_limits<double>::infinity());
 
 // "velocity of mass 17 is not finite (nan, nan, nan)" when the mass's position, velocity or
-// pending force (tested in that order) is not finite, or its position beyond `positionBound`
-// (as allWithin); nothing when all are fine.
-std::optional<std::string> nonFiniteMass(const PartState& state, Index mass,
-                                         double positionBound = std::numeric_limits<double>::infinity());
+// pending force (tested in that order) is not finite; nothing when all are.
+std::optional<std::string> nonFiniteMass(const PartState& state, Index mass);
+// "position of mass 3 is beyond B units (1e6 times the part's size) from the part's median
+// position (...)": the mass farthest from the median position along an axis (the median, so
+// that one runaway mass cannot hide itself), for a part whose positions are finite but whose
+// spread failed the check against `positionBound`. O(masses).
+std::string outlyingMass(const PartState& state, double positionBound);
 
 // The likely cause of a part's divergence, in words, from the stability bounds of its model
 // under `settings` (with the time step it was stepped with, analyzeStability): the time step
@@ -35,8 +38,8 @@ std::optional<std::string> nonFiniteMass(const PartState& state, Index mass,
 std::string likelyCause(const PartModel& model, const SimulationSettings& settings);
 
 // Throw DivergenceError (`body`, `time`) naming the first mass whose position, velocity or
-// pending force is not finite, or whose position is beyond model.positionBound, and the likely
-// cause. The first checks `masses`, in O(|masses|);
+// pending force is not finite, or, when a position is farther than model.positionBound from mass
+// 0's, the mass farthest out (outlyingMass); and the likely cause. The first checks `masses`, in O(|masses|);
 // the second every mass, in one vectorised pass over the positions when all are finite (and
 // over the velocities with explicit Euler): for stepFullModel, right after its step.
 void checkMassesFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,

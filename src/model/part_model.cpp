@@ -1,5 +1,6 @@
 #include "flexfit/part_model.hpp"
 
+#include "flexfit/bounding_volume.hpp"
 #include "flexfit/surface_embedding.hpp"
 #include "model/spring_blocks.hpp"
 #include "model/vertex_order.hpp"
@@ -264,16 +265,9 @@ std::shared_ptr<const FileNumbering> fileNumbering(const FileVertices& file, con
     return numbering;
 }
 
-// PartModel::positionBound: 1e6 times the rest shape's extent (infinite for a shape of no extent).
+// PartModel::positionBound: 1e6 times the rest shape's diagonal (infinite for a shape of no extent).
 double divergenceBound(const std::vector<Vec3>& rest) {
-    double largest = 0.0;
-    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (const Vec3& p : rest) {
-        largest = std::max(largest, p.cwiseAbs().maxCoeff());
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-    }
-    const double extent = rest.empty() ? 0.0 : std::max(largest, (hi - lo).norm());
+    const double extent = rest.empty() ? 0.0 : Aabb::around(rest).size();
     const double bound = 1e6 * extent;
     return extent > 0.0 && std::isfinite(bound) ? bound : std::numeric_limits<double>::infinity();
 }

@@ -177,29 +177,60 @@ TEST(Divergence, RegionCheckFindsWhatTheMassByMassTestFinds) {
 
 TEST(Divergence, APositionBeyondTheModelsBoundIsADivergence) {
     const auto model = buildPartModel(makeTorus1());
-    // The bound, from the rest shape as this test measures it: 1e6 times the larger of its
-    // largest coordinate and its box's diagonal.
-    double largest = 0.0;
-    for (const Vec3& p : model->restPositions) largest = std::max(largest, p.cwiseAbs().maxCoeff());
-    const double bound = 1e6 * std::max(largest, Aabb::around(model->restPositions).size());
+    // The bound, from the rest shape as this test measures it: 1e6 times its box's diagonal.
+    Vec3 lo = model->restPositions[0], hi = lo;
+    for (const Vec3& p : model->restPositions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double bound = 1e6 * (hi - lo).norm();
     EXPECT_DOUBLE_EQ(model->positionBound, bound);
-    const std::vector<Vec3> inside{Vec3(bound, -bound, 0.5 * bound)}, beyond{Vec3(0, 0, -2.0 * bound)};
-    EXPECT_TRUE(detail::allWithin(inside, bound));
-    EXPECT_FALSE(detail::allWithin(beyond, bound));
-    EXPECT_FALSE(detail::allWithin(std::vector<Vec3>{Vec3(0, std::nan(""), 0)}, bound));
+    const Vec3 origin(3.0 * bound, 0, -bound);
+    const std::vector<Vec3> inside{origin + Vec3(bound, -bound, 0.5 * bound), origin},
+        beyond{origin, origin + Vec3(0, 0, -2.0 * bound)};
+    EXPECT_TRUE(detail::allWithin(inside, origin, bound));
+    EXPECT_FALSE(detail::allWithin(inside, Vec3::Zero(), bound));  // 3 bounds from the origin
+    EXPECT_FALSE(detail::allWithin(beyond, origin, bound));
+    EXPECT_FALSE(detail::allWithin(std::vector<Vec3>{Vec3(0, std::nan(""), 0)}, Vec3::Zero(), bound));
     EXPECT_TRUE(detail::allFinite(beyond));  // finite, only beyond
-    // The checks: a finite position twice the bound away throws, naming it; within, nothing.
+    // The checks: a finite position twice the bound from mass 0's throws, naming it; within, nothing.
     PartState state = PartState::atRest(*model);
-    state.positions[7] = Vec3(0.5 * bound, 0, 0);
+    state.positions[7] = state.positions[0] + Vec3(0.5 * bound, 0, 0);
     EXPECT_NO_THROW(detail::checkAllMassesFinite(*model, SimulationSettings{}, state, std::nullopt, 0.0));
-    state.positions[7] = Vec3(0, 2.0 * bound, 0);
+    state.positions[7] = state.positions[0] + Vec3(0, 2.0 * bound, 0);
     try {
         detail::checkAllMassesFinite(*model, SimulationSettings{}, state, std::nullopt, 0.0);
         FAIL() << "no DivergenceError";
     } catch (const DivergenceError& e) {
         EXPECT_TRUE(contains(e.what(), "position of mass 7 is beyond")) << e.what();
+        EXPECT_TRUE(contains(e.what(), "from the part's median position")) << e.what();
     }
     EXPECT_FALSE(detail::allFinite(state, std::vector<Index>{7}, bound));
     EXPECT_TRUE(detail::allFinite(state, std::vector<Index>{7}));  // no bound: finite is enough
+}
+
+// A fully deformable part falls as masses, its frame still: the whole part 100 bounds from where
+// it started (a long free fall) is no divergence, every check agreeing; one mass left behind is.
+TEST(Divergence, APartFarFromItsOriginIsNoDivergenceWhileItHoldsTogether) {
+    const auto model = buildPartModel(makeTorus1());
+    PartState state = PartState::atRest(*model);
+    const Vec3 fall(0, -100.0 * model->positionBound, 0);
+    for (Vec3& x : state.positions) x += fall;
+    std::vector<Index> every(state.positions.size());
+    for (Index m = 0; m < every.size(); ++m) every[m] = m;
+    EXPECT_NO_THROW(detail::checkAllMassesFinite(*model, SimulationSettings{}, state, std::nullopt, 0.0));
+    EXPECT_NO_THROW(detail::checkMassesFinite(*model, SimulationSettings{}, state, every, std::nullopt, 0.0));
+    EXPECT_TRUE(detail::allFinite(state, every, model->positionBound));
+    state.positions[40] -= fall;  // left where it was
+    EXPECT_FALSE(detail::allFinite(state, every, model->positionBound));
+    EXPECT_TRUE(contains(detail::outlyingMass(state, model->positionBound), "position of mass 40 is beyond"));
+    // Mass 0 itself left behind: the check measures from it, the report still names it.
+    state.positions[40] += fall;
+    state.positions[0] -= fall;
+    for (const std::vector<Index>& masses : {every, std::vector<Index>{5, 6}}) {
+        try {
+            detail::checkMassesFinite(*model, SimulationSettings{}, state, masses, std::nullopt, 0.0);
+            ADD_FAILURE() << "no DivergenceError";
+        } catch (const DivergenceError& e) {
+            EXPECT_TRUE(contains(e.what(), "position of mass 0 is beyond")) << e.what();
+        }
+    }
 }
 
