@@ -128,6 +128,21 @@ PendingFiles::~PendingFiles() {
         std::error_code ec;
         std::filesystem::remove(f.temporary, ec);  // best effort: nothing to report it to
     }
+    for (auto d = createdDirectories_.rbegin(); d != createdDirectories_.rend(); ++d) {
+        std::error_code ec;
+        std::filesystem::remove(*d, ec);  // removes only an empty directory
+    }
+}
+
+void PendingFiles::makeDirectory(const std::filesystem::path& dir) {
+    std::vector<std::filesystem::path> missing;
+    std::error_code ec;
+    for (std::filesystem::path d = dir; !d.empty() && !std::filesystem::exists(d, ec); d = d.parent_path()) {
+        missing.push_back(d);
+        if (d == d.parent_path()) break;
+    }
+    cli::makeDirectory(dir);
+    createdDirectories_.insert(createdDirectories_.end(), missing.rbegin(), missing.rend());
 }
 
 std::filesystem::path PendingFiles::add(const std::filesystem::path& path) {
@@ -147,6 +162,7 @@ void PendingFiles::commit() {
         if (ec) throw InputError(f.path.string(), 0, "cannot move the finished file into place: " + ec.message());
         files_.erase(files_.begin());
     }
+    createdDirectories_.clear();
 }
 
 bool runPlotScript(const std::string& script, const std::vector<std::string>& args) {

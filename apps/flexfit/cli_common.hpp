@@ -82,6 +82,9 @@ public:
     // The temporary path to write `path` to (`path` itself when it exists and is not a regular
     // file: a device or a pipe, which cannot be replaced).
     std::filesystem::path add(const std::filesystem::path& path);
+    // makeDirectory, remembering the directories it created: a run that fails before commit
+    // leaves none of them behind (only where they are still empty).
+    void makeDirectory(const std::filesystem::path& dir);
     // Renames every temporary to its path (close streams first); throws InputError when one
     // cannot be renamed (the rest are then removed).
     void commit();
@@ -91,6 +94,7 @@ private:
         std::filesystem::path temporary, path;
     };
     std::vector<File> files_;
+    std::vector<std::filesystem::path> createdDirectories_;  // outermost first
 };
 
 // Runs tools/<script> with Debian's /usr/bin/python3 (matplotlib); returns false (after a

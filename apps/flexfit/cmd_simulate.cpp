@@ -94,7 +94,7 @@ void run(const SimulateOptions& opt) {
     config.loadDuration = opt.forces.empty() && !opt.kicks.empty() ? 0.0 : opt.forceDuration;
     config.duration = opt.duration;
     if (const std::optional<std::string> problem = stepCountProblem(opt.duration, config.part.simulation.timeStep))
-        throw InputError("option --duration", 0, *problem);
+        throw InputError("options --duration and --dt", 0, *problem);
     config.stopWhenRestored = opt.untilRestored;
     config.thresholds = opt.thresholds;
 

@@ -123,7 +123,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     std::ofstream csv;
     const std::filesystem::path csvPath = options.out / "metrics.csv";
     if (!options.out.empty()) {
-        makeDirectory(options.out);
+        files.makeDirectory(options.out);
         csv.open(files.add(csvPath));
         if (!csv) throw InputError(csvPath.string(), 0, "cannot write");
         csv << csvHeader(scene);

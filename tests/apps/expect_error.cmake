@@ -1,9 +1,13 @@
 # Runs EXE with ARGS (a ;-list) and checks: exit status 2, stderr matching REGEX, nothing on stdout.
 # With EMPTY_DIR: that directory is emptied first and must hold no file afterwards (a run that
-# fails writes nothing half-done).
+# fails writes nothing half-done). With ABSENT_DIR: that directory is removed first and must not
+# exist afterwards (a run that fails leaves no directory it made).
 if(DEFINED EMPTY_DIR)
   file(REMOVE_RECURSE ${EMPTY_DIR})
   file(MAKE_DIRECTORY ${EMPTY_DIR})
+endif()
+if(DEFINED ABSENT_DIR)
+  file(REMOVE_RECURSE ${ABSENT_DIR})
 endif()
 execute_process(COMMAND ${EXE} ${ARGS} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT status EQUAL 2)
@@ -20,4 +24,7 @@ if(DEFINED EMPTY_DIR)
   if(left)
     message(FATAL_ERROR "expected no file in ${EMPTY_DIR}, found: ${left}")
   endif()
+endif()
+if(DEFINED ABSENT_DIR AND EXISTS ${ABSENT_DIR})
+  message(FATAL_ERROR "expected no directory ${ABSENT_DIR} after the failed run")
 endif()
