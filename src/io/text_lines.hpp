@@ -38,29 +38,24 @@ inline std::string_view withoutByteOrderMark(std::string_view text) {
     return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
 }
 
-// Walks the text line by line, skipping blank lines, remembering line numbers. Lines end at
-// '\n' (a '\r' before it is blank), or at '\r' in a text with no '\n' (classic Mac OS files).
+// Walks the text line by line, skipping blank lines, remembering line numbers. A line ends at
+// '\n', at "\r\n" or at a '\r' alone (classic Mac OS files; a stray one in a file edited on
+// several systems), each counted as one line.
 class LineCursor {
 public:
-    explicit LineCursor(std::string_view text)
-        : text_(withoutByteOrderMark(text)),
-          end_(text_.find('\n') == std::string_view::npos && text_.find('\r') != std::string_view::npos ? '\r' : '\n') {}
+    explicit LineCursor(std::string_view text) : text_(withoutByteOrderMark(text)) {}
 
     // The raw first line (a .tri model's name), without its end of line.
     std::string_view firstLine() {
-        const std::size_t end = text_.find(end_);
-        std::string_view line = text_.substr(0, end);
-        pos_ = end == std::string_view::npos ? text_.size() : end + 1;
+        pos_ = 0;
         lineNumber_ = 1;
-        return line;
+        return nextRaw();
     }
 
     // Next non-blank line; false at the end of the text.
     bool next(TextLine& out) {
         while (pos_ < text_.size()) {
-            const std::size_t end = std::min(text_.find(end_, pos_), text_.size());
-            std::string_view raw = text_.substr(pos_, end - pos_);
-            pos_ = end + 1;
+            const std::string_view raw = nextRaw();
             ++lineNumber_;
             out.number = lineNumber_;
             out.tokens = tokenize(raw);
@@ -72,8 +67,15 @@ public:
     std::size_t lineNumber() const { return lineNumber_; }
 
 private:
+    // The line at pos_, without its end; pos_ moved past the end.
+    std::string_view nextRaw() {
+        const std::size_t end = std::min(text_.find_first_of("\r\n", pos_), text_.size());
+        const std::string_view line = text_.substr(pos_, end - pos_);
+        pos_ = end + (text_.substr(end, 2) == "\r\n" ? 2 : 1);
+        return line;
+    }
+
     std::string_view text_;
-    char end_;  // of a line
     std::size_t pos_ = 0;
     std::size_t lineNumber_ = 0;
 };

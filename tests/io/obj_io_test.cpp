@@ -45,7 +45,11 @@ TEST(ObjIo, AByteOrderMarkAndClassicMacLineEndsReadAsPlainText) {
     std::replace(mac.begin(), mac.end(), '\n', '\r');
     TempDir dir;
     const MeshReadResult expected = readMesh(dir.write("plain.obj", plain));
-    for (const auto& [name, text] : {std::pair{"bom.obj", "\xEF\xBB\xBF" + plain}, std::pair{"mac.obj", mac}}) {
+    // Mixed: a '\r' alone in a file of "\r\n" and '\n' (it had merged two lines into one, whose
+    // second vertex was dropped as an OBJ w coordinate).
+    const std::string mixed = "v 0 0 0\r\nv 1 0 0\rv 0 1 0\nv 0 0 1\r\rf 1 3 2\nf 1 2 4\r\nf 2 3 4\rf 1 4 3";
+    for (const auto& [name, text] :
+         {std::pair{"bom.obj", "\xEF\xBB\xBF" + plain}, std::pair{"mac.obj", mac}, std::pair{"mixed.obj", mixed}}) {
         const MeshReadResult r = readMesh(dir.write(name, text));
         EXPECT_EQ(r.mesh.vertices, expected.mesh.vertices) << name;
         EXPECT_EQ(r.mesh.faces, expected.mesh.faces) << name;
@@ -54,6 +58,7 @@ TEST(ObjIo, AByteOrderMarkAndClassicMacLineEndsReadAsPlainText) {
     // Line numbers count '\r' lines too.
     const InputError e = readObjError("v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 7\r");
     EXPECT_EQ(e.line(), 4u) << e.what();
+    EXPECT_EQ(readObjError("v 0 0 0\r\nv 1 0 0\rv 0 1 0\n\r\nf 1 2 7\n").line(), 5u);
 }
 
 TEST(ObjIo, CornerFormsNegativeAndForwardIndices) {
