@@ -2,7 +2,7 @@
 //
 // A TriMesh is plain data. validateMesh() is the single gate every reader and generator
 // passes through: it rejects what would give a broken mass-spring model (empty mesh, index out
-// of range, NaN/Inf coordinates, degenerate or duplicate faces) and counts what is merely
+// of range, NaN/Inf coordinates, a scale outside 1e-20..1e20 units, degenerate or duplicate faces) and counts what is merely
 // unusual (open boundaries, non-manifold edges) as warnings.
 #pragma once
 
@@ -37,6 +37,14 @@ struct MeshSourceLines {
     std::vector<std::size_t> vertexLine;  // (V) or empty
     std::vector<std::size_t> faceLine;    // (F) or empty
 };
+
+// The scales Flexfit computes with: a coordinate beyond kMaxMeshCoordinate in magnitude, or a
+// mesh whose bounding-box diagonal is below kMinMeshSize, is refused (validateMesh). Collision
+// and the spring model multiply up to five coordinates together; within these bounds no such
+// product overflows or underflows to zero (1e20^5 = 1e100), and every unit in use (nm to km)
+// fits many times over.
+inline constexpr double kMaxMeshCoordinate = 1e20;
+inline constexpr double kMinMeshSize = 1e-20;
 
 // Throws InputError naming `source` (and the line, when `lines` knows it) for the first
 // problem found. Faces are degenerate when two indices repeat or their area is below

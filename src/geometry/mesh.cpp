@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <sstream>
 #include <bit>
 #include <cstdint>
 #include <cmath>
@@ -20,12 +21,31 @@ std::string faceText(std::size_t f, const Face& face) {
     return "face " + std::to_string(f) + " (" + std::to_string(face[0]) + " " + std::to_string(face[1]) + " " + std::to_string(face[2]) + ")";
 }
 
+void requireWorkableScale(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
+    std::size_t largest = 0;
+    for (std::size_t v = 1; v < mesh.vertices.size(); ++v)
+        if (mesh.vertices[v].cwiseAbs().maxCoeff() > mesh.vertices[largest].cwiseAbs().maxCoeff()) largest = v;
+    const double magnitude = mesh.vertices[largest].cwiseAbs().maxCoeff();
+    std::ostringstream problem;
+    if (magnitude > kMaxMeshCoordinate) {
+        problem << "vertex " << largest << " has a coordinate of magnitude " << magnitude << ", beyond the " << kMaxMeshCoordinate
+                << " units Flexfit computes with (products of coordinates would overflow): rescale the mesh (a unit mistaken?)";
+        throw InputError(source, lineOf(lines.vertexLine, largest), problem.str());
+    }
+    if (const double size = boundingBox(mesh).diagonal().norm(); size < kMinMeshSize) {
+        problem << "the mesh's size (its bounding-box diagonal) is " << size << ", below the " << kMinMeshSize
+                << " units Flexfit computes with (products of coordinates would underflow): rescale the mesh (a unit mistaken?)";
+        throw InputError(source, 0, problem.str());
+    }
+}
+
 void requireWellFormed(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
     if (mesh.vertices.empty()) throw InputError(source, 0, "empty mesh: no vertices");
     if (mesh.faces.empty()) throw InputError(source, 0, "empty mesh: no faces");
     for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
         if (!mesh.vertices[v].allFinite())
             throw InputError(source, lineOf(lines.vertexLine, v), "vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+    requireWorkableScale(mesh, source, lines);
     const std::size_t n = mesh.vertices.size();
     for (std::size_t f = 0; f < mesh.faces.size(); ++f)
         for (Index idx : mesh.faces[f])

@@ -13,7 +13,8 @@ std::size_t lineOf(const std::vector<std::size_t>& lines, std::size_t i);  // 0 
 std::string faceText(std::size_t f, const Face& face);                     // "face 3 (0 1 2)"
 
 // Throws InputError for what no repair can mend: an empty mesh, a NaN or infinite coordinate,
-// an index out of range.
+// a scale outside what Flexfit computes with (kMaxMeshCoordinate, kMinMeshSize), an index out of
+// range.
 void requireWellFormed(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines);
 
 // A face is of zero area when its double area, edges scaled by areaScale() (the inverse

@@ -103,6 +103,31 @@ TEST(ValidateMesh, InfiniteCoordinate) {
     }
 }
 
+// Scales whose coordinate products overflow or underflow (collide had printed depth inf and
+// a made-up normal for every contact of a torus scaled by 1e200, and by 1e-200) are refused,
+// naming the farthest vertex's line; the bounds themselves are accepted.
+TEST(ValidateMesh, AScaleBeyondWhatProductsOfCoordinatesTakeIsRefused) {
+    auto scaled = [](double factor, const Vec3& shift = Vec3::Zero()) {
+        TriMesh mesh = tetrahedron();
+        for (Vec3& v : mesh.vertices) v = factor * v + shift;
+        return mesh;
+    };
+    EXPECT_NO_THROW(validateMesh(scaled(0.9 * kMaxMeshCoordinate), "t"));
+    EXPECT_NO_THROW(validateMesh(scaled(2.0 * kMinMeshSize), "t"));
+    for (double factor : {1e21, 1e200, -1e300}) {
+        const InputError e = expectInvalid(scaled(factor), {{3, 4, 5, 6}, {}});
+        EXPECT_EQ(e.line(), 4u) << factor;  // vertex 1, the first with the largest coordinate
+        EXPECT_TRUE(contains(e.problem(), "vertex 1 has a coordinate of magnitude")) << e.problem();
+        EXPECT_TRUE(contains(e.problem(), "rescale")) << e.problem();
+    }
+    // Small but far out: the size is fine, the coordinate is not.
+    EXPECT_TRUE(contains(expectInvalid(scaled(1.0, Vec3(0, 0, 5e20))).problem(), "beyond the 1e+20 units"));
+    for (double factor : {1e-21, 1e-200}) {
+        const InputError e = expectInvalid(scaled(factor));
+        EXPECT_TRUE(contains(e.problem(), "below the 1e-20 units")) << e.problem();
+    }
+}
+
 TEST(ValidateMesh, NonFiniteUnreferencedVertexIsStillAnError) {
     TriMesh mesh = tetrahedron();
     mesh.vertices.emplace_back(std::numeric_limits<double>::quiet_NaN(), 0, 0);
@@ -153,9 +178,9 @@ TEST(ValidateMesh, ZeroAreaThresholdIsRelativeToTheMeshSize) {
 }
 
 // The threshold is documented as relative (1e-12 x diagonal^2), so a valid mesh stays valid at
-// any finite scale: the area must neither underflow (scale 1e-100) nor overflow (1e160).
+// every scale validateMesh accepts, up to its bounds (kMinMeshSize, kMaxMeshCoordinate).
 TEST(ValidateMesh, ZeroAreaThresholdHoldsAtExtremeScales) {
-    for (double scale : {1e-100, 1e-150, 1e160, 1e200}) {
+    for (double scale : {1e-19, 1e-15, 1e15, 0.99e20}) {
         TriMesh mesh = tetrahedron();
         for (Vec3& v : mesh.vertices) v *= scale;
         EXPECT_NO_THROW(validateMesh(mesh, "scaled")) << scale;

@@ -163,10 +163,10 @@ TEST(TriIo, FormatParseRoundTripIsBitExact) {
     std::uniform_real_distribution<double> jitter(-1e-3, 1e-3);
     for (Vec3& v : noisy.vertices) v += Vec3(jitter(rng), jitter(rng), jitter(rng));
     meshes.push_back(noisy);
-    TriMesh tiny = makeIcoSphere(1e-60, 1);
+    TriMesh tiny = makeIcoSphere(3e-20, 1);  // near kMinMeshSize, kMaxMeshCoordinate
     tiny.name = "tiny";
     meshes.push_back(tiny);
-    TriMesh huge = makeIcoSphere(1e100, 1);
+    TriMesh huge = makeIcoSphere(0.99e20, 1);
     huge.name = "huge";
     meshes.push_back(huge);
     for (const TriMesh& mesh : meshes) {
