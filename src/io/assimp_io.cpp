@@ -11,10 +11,13 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include <charconv>
 #include <cctype>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 namespace flexfit {
@@ -75,11 +78,38 @@ std::size_t lineOfNonFiniteToken(const std::filesystem::path& path) {
     return 0;
 }
 
+// An ASCII STL cut short still imports (assimp reads the facets it finds): a file that starts
+// with "solid" and is not a binary STL by its size (84 + 50 n bytes, n at offset 80) must end
+// with an "endsolid" line.
+void requireWholeAsciiStl(const std::filesystem::path& path) {
+    std::string extension = path.extension().string();
+    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".stl") return;
+    std::ifstream in(path, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t first = text.find_first_not_of(" \t\r\n");
+    if (first == std::string::npos || text.compare(first, 5, "solid") != 0) return;
+    if (text.size() >= 84) {
+        std::uint32_t facets = 0;
+        std::memcpy(&facets, text.data() + 80, 4);
+        if (text.size() == 84 + 50 * std::uint64_t(facets)) return;  // binary, whatever its header says
+    }
+    const std::size_t last = text.find_last_not_of(" \t\r\n");
+    const std::size_t lineStart = text.find_last_of("\r\n", last);
+    const std::size_t start = lineStart == std::string::npos ? 0 : lineStart + 1;
+    if (text.compare(start, 8, "endsolid") == 0) return;
+    std::size_t line = 1;
+    for (std::size_t i = 0; i <= last; ++i)
+        if (text[i] == '\n' || (text[i] == '\r' && (i + 1 >= text.size() || text[i + 1] != '\n'))) ++line;
+    throw InputError(path.string(), line, "the ASCII STL ends without an 'endsolid' line: the file is cut short");
+}
+
 }  // namespace
 
 MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadOptions& options) {
     const std::string file = path.string();
     if (!std::filesystem::exists(path)) throw InputError(file, 0, "cannot open the file for reading: it does not exist");
+    requireWholeAsciiStl(path);
     Assimp::Importer importer;
     const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
     if (scene == nullptr) throw InputError(file, 0, std::string("cannot import: ") + importer.GetErrorString());
