@@ -84,7 +84,8 @@ std::size_t lineOfNonFiniteToken(const std::filesystem::path& path) {
 void requireWholeAsciiStl(const std::filesystem::path& path) {
     std::string extension = path.extension().string();
     for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (extension != ".stl") return;
+    std::error_code ec;
+    if (extension != ".stl" || !std::filesystem::is_regular_file(path, ec)) return;  // assimp names what else is wrong
     std::ifstream in(path, std::ios::binary);
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const std::size_t first = text.find_first_not_of(" \t\r\n");
