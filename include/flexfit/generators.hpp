@@ -7,12 +7,16 @@
 #include "flexfit/mesh.hpp"
 
 #include <array>
+#include <optional>
+#include <string>
 
 namespace flexfit {
 
 // The most vertices a generator makes: 2048 x 2048 (about 20 s and 6 GB as a part here); more
 // is refused (InputError) rather than failing to allocate after minutes.
 inline constexpr long long kMaxGeneratedVertices = 2048LL * 2048LL;
+// "N vertices: at most 4194304 (2048 x 2048)" when `count` is beyond it; nullopt otherwise.
+std::optional<std::string> generatedVertexCountProblem(long long count);
 
 // Torus around the y axis (the thesis's container mouth is open along y), centred at the
 // origin. U segments around the axis, V around the tube: U*V vertices, 2UV faces, 3UV edges.

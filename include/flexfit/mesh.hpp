@@ -91,4 +91,9 @@ VertexMap firstFileVertices(const FileVertices& file, std::size_t meshVertexCoun
 // Axis-aligned bounds of the vertices.
 Eigen::AlignedBox3d boundingBox(const TriMesh& mesh);
 
+// The area of face f over the positions x (a mesh's vertices, or a part's masses).
+inline double faceArea(const std::vector<Vec3>& x, const Face& f) {
+    return 0.5 * (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]).norm();
+}
+
 }  // namespace flexfit

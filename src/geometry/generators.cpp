@@ -19,10 +19,18 @@ void require(bool ok, const char* what) {
 }
 
 void requireVertexCount(long long count, const char* shape) {
-    if (count > kMaxGeneratedVertices)
-        throw InputError("generator", 0, std::string(shape) + " of " + std::to_string(count) + " vertices: at most " +
-                                             std::to_string(kMaxGeneratedVertices) + " (2048 x 2048)");
+    if (const std::optional<std::string> problem = generatedVertexCountProblem(count))
+        throw InputError("generator", 0, std::string(shape) + " of " + *problem);
 }
+
+}  // namespace
+
+std::optional<std::string> generatedVertexCountProblem(long long count) {
+    if (count <= kMaxGeneratedVertices) return std::nullopt;
+    return std::to_string(count) + " vertices: at most " + std::to_string(kMaxGeneratedVertices) + " (2048 x 2048)";
+}
+
+namespace {
 
 // Quad (a, b, c, d) counter-clockwise from outside -> two triangles.
 void addQuad(std::vector<Face>& faces, Index a, Index b, Index c, Index d) {

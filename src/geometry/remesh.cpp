@@ -154,8 +154,7 @@ constexpr double kMaxRemeshTriangles = 2e6;
 // place is 1.2e-10, made CGAL take memory without end).
 void checkRemeshSize(const TriMesh& mesh, double edge, const std::string& source) {
     double area = 0.0, largest = 0.0;
-    for (const Face& f : mesh.faces)
-        area += 0.5 * (mesh.vertices[f[1]] - mesh.vertices[f[0]]).cross(mesh.vertices[f[2]] - mesh.vertices[f[0]]).norm();
+    for (const Face& f : mesh.faces) area += faceArea(mesh.vertices, f);
     for (const Vec3& p : mesh.vertices) largest = std::max(largest, p.cwiseAbs().maxCoeff());
     const double triangles = area / (std::sqrt(3.0) / 4.0 * edge * edge);
     std::ostringstream text;

@@ -269,9 +269,8 @@ TriMesh generatePartMesh(Table& t) {
         const double major = g.positive("major", 10.0), minor = g.positive("minor", 2.5);
         if (!(minor < major)) g.fail("minor radius must be smaller than the major radius");
         const int u = g.integer("u", 24, 3, 4096), v = g.integer("v", 24, 3, 4096);
-        if (static_cast<long long>(u) * v > kMaxGeneratedVertices)
-            g.fail(*g.node("u"), "u", "u x v = " + std::to_string(static_cast<long long>(u) * v) + " vertices: at most " +
-                                          std::to_string(kMaxGeneratedVertices) + " (2048 x 2048)");
+        if (const std::optional<std::string> problem = generatedVertexCountProblem(static_cast<long long>(u) * v))
+            g.fail(*g.node("u"), "u", "u x v = " + *problem);
         mesh = makeTorus(major, minor, u, v);
     } else if (type == "sphere") {
         mesh = makeIcoSphere(g.positive("radius", 1.0), g.integer("level", 3, 0, 7));

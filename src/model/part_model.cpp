@@ -47,8 +47,6 @@ void checkShell(const ShellMaterial& m, const PartModelSettings& s) {
         fail("gives the masses and the spring constants: per-vertex masses or per-spring materials cannot be set beside it");
 }
 
-double faceArea(const std::vector<Vec3>& x, const Face& f) { return 0.5 * (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]).norm(); }
-
 // A spring's two ends and, for the shell's rules, the area of the faces it spans (its edge's
 // faces, or the two faces a bending spring crosses) and the edge it crosses (bending only).
 struct SpringSpec {
