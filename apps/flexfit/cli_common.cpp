@@ -141,8 +141,9 @@ void PendingFiles::makeDirectory(const std::filesystem::path& dir) {
         missing.push_back(d);
         if (d == d.parent_path()) break;
     }
-    cli::makeDirectory(dir);
+    // Remembered first: if a parent is made and the leaf is not, the parent goes too.
     createdDirectories_.insert(createdDirectories_.end(), missing.rbegin(), missing.rend());
+    cli::makeDirectory(dir);
 }
 
 std::filesystem::path PendingFiles::add(const std::filesystem::path& path) {

@@ -33,6 +33,12 @@ std::uint64_t carryBeyond(double bound) {
     return (0x800 - (e + 1)) << 52;
 }
 
+// Where a position bound is measured from: mass 0 (a spread); nowhere for no bound, so that
+// finite is enough (x - x0 of two finite values may overflow).
+Vec3 boundOrigin(const PartState& state, double positionBound) {
+    return positionBound < std::numeric_limits<double>::infinity() && !state.positions.empty() ? state.positions[0] : Vec3::Zero();
+}
+
 std::string describe(const char* what, Index mass, const Vec3& value, const char* problem = "is not finite") {
     std::ostringstream text;
     text << what << " of mass " << mass << " " << problem << " (" << value.x() << ", " << value.y() << ", " << value.z() << ")";
@@ -69,7 +75,7 @@ bool allFinite(const PartState& state, std::span<const Index> masses, double pos
     // The same bit, gathered over the masses' three vectors: no call and no branch per mass.
     if (masses.empty()) return true;
     const std::uint64_t carry = carryBeyond(positionBound);
-    const Vec3 origin = state.positions[0];
+    const Vec3 origin = boundOrigin(state, positionBound);
     std::uint64_t any = 0;
     for (Index m : masses)
         any |= beyondBit(state.positions[m] - origin, carry) | nonFiniteBit(state.velocities[m]) | nonFiniteBit(state.forces[m]);
@@ -85,7 +91,7 @@ namespace {
 bool regionFinite(const PartState& state, const ActiveRegion& region, bool velocitiesToo, double positionBound) {
     if (state.positions.empty()) return true;
     const std::uint64_t carry = carryBeyond(positionBound);
-    const Vec3 origin = state.positions[0];
+    const Vec3 origin = boundOrigin(state, positionBound);
     double origin24[24], zero24[24] = {};
     for (std::size_t k = 0; k < 24; ++k) origin24[k] = origin[int(k % 3)];
     std::uint64_t lanes[8] = {};
@@ -114,22 +120,32 @@ std::optional<std::string> nonFiniteMass(const PartState& state, Index m) {
 }
 
 std::string outlyingMass(const PartState& state, double positionBound) {
-    // The median along each axis stands for where the part is: one runaway mass cannot move it.
-    Vec3 median;
-    std::vector<double> axis(state.positions.size());
+    const std::vector<Vec3>& x = state.positions;
+    // The pair the check tripped on: mass 0 and the finite mass farthest from it along an axis.
+    Index m = 0;
+    double apart = 0.0;
+    for (Index k = 0; k < x.size(); ++k)
+        if (const double d = (x[k] - x[0]).cwiseAbs().maxCoeff(); finite(x[k]) && d > apart) m = k, apart = d;
+    // Of the two, the one farther from the median position (per axis, over the finite masses: one
+    // runaway mass cannot move it) is named as the outlier.
+    std::vector<double> axis;
+    Vec3 median = Vec3::Zero();
     for (int c = 0; c < 3; ++c) {
-        for (std::size_t m = 0; m < axis.size(); ++m) axis[m] = state.positions[m][c];
+        axis.clear();
+        for (const Vec3& p : x)
+            if (finite(p)) axis.push_back(p[c]);
+        if (axis.empty()) break;
         std::nth_element(axis.begin(), axis.begin() + std::ptrdiff_t(axis.size() / 2), axis.end());
         median[c] = axis[axis.size() / 2];
     }
-    Index farthest = 0;
-    double distance = -1.0;
-    for (Index m = 0; m < state.positions.size(); ++m)
-        if (const double d = (state.positions[m] - median).cwiseAbs().maxCoeff(); d > distance) farthest = m, distance = d;
+    auto fromMedian = [&](Index k) { return k < x.size() ? (x[k] - median).cwiseAbs().maxCoeff() : 0.0; };
+    const Index named = fromMedian(m) >= fromMedian(0) ? m : 0, other = named == m ? 0 : m;
+    if (x.empty() || named == other) return "the part's positions are within its bound";  // not reached after a failed check
     std::ostringstream problem;
-    problem << "is beyond " << positionBound << " units (1e6 times the part's size) from the part's median position ("
-            << median.x() << ", " << median.y() << ", " << median.z() << "):";
-    return describe("position", farthest, state.positions[farthest], problem.str().c_str());
+    problem << "is " << apart << " units along an axis from mass " << other << "'s (" << x[other].x() << ", " << x[other].y()
+            << ", " << x[other].z() << "), beyond the part's bound of " << positionBound
+            << " units (1e6 times its size, tested within a factor 2): it is at";
+    return describe("position", named, x[named], problem.str().c_str());
 }
 
 std::string likelyCause(const PartModel& model, const SimulationSettings& settings) {
@@ -179,7 +195,7 @@ void checkAllMassesFinite(const PartModel& model, const SimulationSettings& sett
     // One pass over the positions: with semi-implicit Euler a non-finite force or velocity makes
     // the position non-finite in the same step (x += h v_new); explicit Euler moves x with the
     // old velocity, so its velocities are read as well.
-    if (allWithin(state.positions, state.positions.empty() ? Vec3::Zero() : state.positions[0], model.positionBound) && (settings.integrator != Integrator::ExplicitEuler || allFinite(state.velocities)))
+    if (allWithin(state.positions, boundOrigin(state, model.positionBound), model.positionBound) && (settings.integrator != Integrator::ExplicitEuler || allFinite(state.velocities)))
         return;
     for (Index m = 0; m < state.positions.size(); ++m)
         if (const std::optional<std::string> problem = nonFiniteMass(state, m))

@@ -25,10 +25,11 @@ bool allFinite(const PartState& state, std::span<const Index> masses,
 // "velocity of mass 17 is not finite (nan, nan, nan)" when the mass's position, velocity or
 // pending force (tested in that order) is not finite; nothing when all are.
 std::optional<std::string> nonFiniteMass(const PartState& state, Index mass);
-// "position of mass 3 is beyond B units (1e6 times the part's size) from the part's median
-// position (...)": the mass farthest from the median position along an axis (the median, so
-// that one runaway mass cannot hide itself), for a part whose positions are finite but whose
-// spread failed the check against `positionBound`. O(masses).
+// For a part whose positions are finite but whose spread failed the check against
+// `positionBound` (from mass 0, along an axis): "position of mass 3 is D units along an axis from
+// mass 0's (...), beyond the part's bound of B units ...", the pair the check tripped on (mass 0
+// and the finite mass farthest from it), the one farther from the median position named (the
+// median, so one runaway mass, even mass 0, cannot hide itself). O(masses).
 std::string outlyingMass(const PartState& state, double positionBound);
 
 // The likely cause of a part's divergence, in words, from the stability bounds of its model

@@ -6,12 +6,12 @@
 // split them per face corner.
 #include "flexfit/mesh_io.hpp"
 #include "io_internal.hpp"
+#include "text_lines.hpp"
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -63,46 +63,54 @@ bool isNonFiniteToken(const std::string& token) {
 }
 
 // First line of a text file holding a NaN/Inf token; 0 when none (binary files, or none found).
+// Lines as the text readers count them (text_lines.hpp).
 std::size_t lineOfNonFiniteToken(const std::filesystem::path& path) {
     std::ifstream file(path, std::ios::binary);
-    std::string line, token;
-    for (std::size_t number = 1; std::getline(file, line); ++number) {
-        std::size_t i = 0;
-        while (i < line.size()) {
-            while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
-            const std::size_t start = i;
-            while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
-            if (i > start && isNonFiniteToken(line.substr(start, i - start))) return number;
-        }
-    }
+    const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    detail::LineCursor cursor(text);
+    detail::TextLine line;
+    while (cursor.next(line))
+        for (std::string_view token : line.tokens)
+            if (isNonFiniteToken(std::string(token))) return line.number;
     return 0;
 }
 
 // An ASCII STL cut short still imports (assimp reads the facets it finds): a file that starts
 // with "solid" and is not a binary STL by its size (84 + 50 n bytes, n at offset 80) must end
-// with an "endsolid" line.
+// with an "endsolid" line (indented or not; blanks, NULs and a DOS end-of-file byte after it
+// are ignored). Reads the first 84 bytes and the last 4 KiB; the whole file only to name the
+// line of a refusal.
 void requireWholeAsciiStl(const std::filesystem::path& path) {
-    std::string extension = path.extension().string();
-    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
     std::error_code ec;
-    if (extension != ".stl" || !std::filesystem::is_regular_file(path, ec)) return;  // assimp names what else is wrong
+    if (lowerExtension(path) != ".stl" || !std::filesystem::is_regular_file(path, ec)) return;  // assimp names what else is wrong
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec) return;
     std::ifstream in(path, std::ios::binary);
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::size_t first = text.find_first_not_of(" \t\r\n");
-    if (first == std::string::npos || text.compare(first, 5, "solid") != 0) return;
-    if (text.size() >= 84) {
+    std::string head(std::size_t(std::min<std::uintmax_t>(size, 84)), '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    const std::size_t first = head.find_first_not_of(" \t\r\n");
+    if (first == std::string::npos || head.compare(first, 5, "solid") != 0) return;  // binary, or not an STL assimp reads as text
+    if (head.size() == 84) {
         std::uint32_t facets = 0;
-        std::memcpy(&facets, text.data() + 80, 4);
-        if (text.size() == 84 + 50 * std::uint64_t(facets)) return;  // binary, whatever its header says
+        std::memcpy(&facets, head.data() + 80, 4);
+        if (size == 84 + 50 * std::uint64_t(facets)) return;  // binary, whatever its header says
     }
-    const std::size_t last = text.find_last_not_of(" \t\r\n");
-    const std::size_t lineStart = text.find_last_of("\r\n", last);
-    const std::size_t start = lineStart == std::string::npos ? 0 : lineStart + 1;
-    if (text.compare(start, 8, "endsolid") == 0) return;
-    std::size_t line = 1;
-    for (std::size_t i = 0; i <= last; ++i)
-        if (text[i] == '\n' || (text[i] == '\r' && (i + 1 >= text.size() || text[i + 1] != '\n'))) ++line;
-    throw InputError(path.string(), line, "the ASCII STL ends without an 'endsolid' line: the file is cut short");
+    const std::uintmax_t tailStart = size > 4096 ? size - 4096 : 0;
+    std::string tail(std::size_t(size - tailStart), '\0');
+    in.seekg(std::streamoff(tailStart));
+    in.read(tail.data(), std::streamsize(tail.size()));
+    constexpr std::string_view kTrailing(" \t\r\n\v\f\x1a\0", 8);
+    const std::size_t last = tail.find_last_not_of(kTrailing);
+    if (last != std::string::npos) {
+        const std::size_t lineStart = tail.find_last_of("\r\n", last);
+        const std::size_t start = tail.find_first_not_of(" \t", lineStart == std::string::npos ? 0 : lineStart + 1);
+        if (tail.compare(start, 8, "endsolid") == 0) return;
+    }
+    std::ifstream whole(path, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(whole)), std::istreambuf_iterator<char>());
+    const std::size_t end = text.find_last_not_of(kTrailing);
+    throw InputError(path.string(), end == std::string::npos ? 0 : detail::lineNumberAt(text, end),
+                     "the ASCII STL ends without an 'endsolid' line: the file is cut short");
 }
 
 }  // namespace

@@ -5,6 +5,9 @@
 #include "flexfit/mesh_io.hpp"
 
 namespace flexfit {
+// The file's extension in lower case (".stl").
+std::string lowerExtension(const std::filesystem::path& path);
+
 MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadOptions& options);
 // OBJ in the file's vertex order (obj_io.cpp).
 MeshReadResult parseObj(std::string_view text, const std::string& source, const MeshReadOptions& options);

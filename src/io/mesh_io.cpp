@@ -11,15 +11,12 @@
 #include <fstream>
 
 namespace flexfit {
-namespace {
 
 std::string lowerExtension(const std::filesystem::path& path) {
     std::string ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     return ext;
 }
-
-}  // namespace
 
 namespace {
 

@@ -288,6 +288,13 @@ TriMesh generatePartMesh(Table& t) {
         mesh = makePlateWithHole(half, hx, hz);
     }
     g.finish();
+    // What the generators take but Flexfit cannot compute with (a radius of 1e30: validateMesh's
+    // scale bounds) is refused here, at the generator's line, as a file's mesh would be.
+    try {
+        validateMesh(mesh, "generator");
+    } catch (const InputError& e) {
+        g.fail(e.problem());
+    }
     return mesh;
 }
 

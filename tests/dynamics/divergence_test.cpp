@@ -199,8 +199,8 @@ TEST(Divergence, APositionBeyondTheModelsBoundIsADivergence) {
         detail::checkAllMassesFinite(*model, SimulationSettings{}, state, std::nullopt, 0.0);
         FAIL() << "no DivergenceError";
     } catch (const DivergenceError& e) {
-        EXPECT_TRUE(contains(e.what(), "position of mass 7 is beyond")) << e.what();
-        EXPECT_TRUE(contains(e.what(), "from the part's median position")) << e.what();
+        EXPECT_TRUE(contains(e.what(), "position of mass 7 is ")) << e.what();
+        EXPECT_TRUE(contains(e.what(), "units along an axis from mass 0's")) << e.what();
     }
     EXPECT_FALSE(detail::allFinite(state, std::vector<Index>{7}, bound));
     EXPECT_TRUE(detail::allFinite(state, std::vector<Index>{7}));  // no bound: finite is enough
@@ -220,7 +220,7 @@ TEST(Divergence, APartFarFromItsOriginIsNoDivergenceWhileItHoldsTogether) {
     EXPECT_TRUE(detail::allFinite(state, every, model->positionBound));
     state.positions[40] -= fall;  // left where it was
     EXPECT_FALSE(detail::allFinite(state, every, model->positionBound));
-    EXPECT_TRUE(contains(detail::outlyingMass(state, model->positionBound), "position of mass 40 is beyond"));
+    EXPECT_TRUE(contains(detail::outlyingMass(state, model->positionBound), "position of mass 40 is "));
     // Mass 0 itself left behind: the check measures from it, the report still names it.
     state.positions[40] += fall;
     state.positions[0] -= fall;
@@ -229,7 +229,7 @@ TEST(Divergence, APartFarFromItsOriginIsNoDivergenceWhileItHoldsTogether) {
             detail::checkMassesFinite(*model, SimulationSettings{}, state, masses, std::nullopt, 0.0);
             ADD_FAILURE() << "no DivergenceError";
         } catch (const DivergenceError& e) {
-            EXPECT_TRUE(contains(e.what(), "position of mass 0 is beyond")) << e.what();
+            EXPECT_TRUE(contains(e.what(), "position of mass 0 is ")) << e.what();
         }
     }
 }

@@ -288,8 +288,8 @@ TEST(MsdStep, AHugeForceDivergesAndThrowsNamingThePartTheTimeAndTheCause) {
         EXPECT_EQ(start, 0.0);
         const std::string what = error->what();
         EXPECT_TRUE(contains(what, "part diverged at t = 0 s")) << what;
-        EXPECT_TRUE(contains(what, "position of mass 0 is beyond ")) << what;
-        EXPECT_TRUE(contains(what, "1e6 times the part's size")) << what;
+        EXPECT_TRUE(contains(what, "position of mass 0 is ")) << what;
+        EXPECT_TRUE(contains(what, "1e6 times its size")) << what;
         EXPECT_TRUE(contains(what, "likely cause: a force beyond what the model can take")) << what;
     }
 }
@@ -316,7 +316,7 @@ TEST(MsdStep, ExplicitEulerFarAboveItsBoundStopsBeforeItsGarbageGrows) {
     settings.integrator = Integrator::ExplicitEuler;
     const auto [error, start] = stepUntilDivergence(*model, settings, {0, Vec3(0, 0, 5)}, 50);
     ASSERT_TRUE(error) << "50 steps far above the stability bound ran to the end";
-    EXPECT_TRUE(contains(error->what(), "is beyond ")) << error->what();
+    EXPECT_TRUE(contains(error->what(), "beyond the part's bound of ")) << error->what();
     EXPECT_TRUE(contains(error->what(), "likely cause: the time step 0.001 s is above the stability bound")) << error->what();
 }
 

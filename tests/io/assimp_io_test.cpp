@@ -451,6 +451,14 @@ TEST(AssimpIo, TruncatedAsciiStlIsRejected) {
     std::string crlf;
     for (char c : whole) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
     expectTetrahedronResult(readMesh(dir.write("crlf.stl", crlf)));
+    std::string indented = whole;
+    indented.replace(indented.rfind("endsolid"), 0, "   ");
+    expectTetrahedronResult(readMesh(dir.write("indented.stl", indented)));
+    expectTetrahedronResult(readMesh(dir.write("padded.stl", whole + std::string("\0\0\x1a", 3))));
+    // A long file is checked by its last 4 KiB: the endsolid there is found, a cut one refused.
+    const std::string longer = "solid tet\n" + std::string(10000, ' ') + "\n" + whole.substr(whole.find('\n') + 1);
+    expectTetrahedronResult(readMesh(dir.write("long.stl", longer)));
+    EXPECT_THROW(readMesh(dir.write("long_cut.stl", longer.substr(0, longer.rfind("endsolid")))), InputError);
 }
 
 TEST(AssimpIo, DegenerateAndDuplicateFacesAreRepairedOrRefused) {

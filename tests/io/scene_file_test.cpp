@@ -334,6 +334,17 @@ TEST(SceneFile, AGeneratedTorusOfMoreThan2048x2048VerticesIsReported) {
     EXPECT_NE(e.find("key 'u': u x v = 8388608 vertices: at most 4194304 (2048 x 2048)"), std::string::npos) << e;
 }
 
+// A generator's parameters it takes but Flexfit cannot compute with (validateMesh's scale
+// bounds) are refused at the generator's table, as a mesh file's would be.
+TEST(SceneFile, AGeneratedMeshBeyondTheScaleBoundsIsReported) {
+    const std::string big = errorOf(withMouthGenerator("generator = { type = \"sphere\", radius = 1e30 }"));
+    EXPECT_NE(big.find("beyond the 1e+20 units Flexfit computes with"), std::string::npos) << big;
+    EXPECT_NE(big.find("scene.toml:"), std::string::npos) << big;
+    const std::string small = errorOf(withMouthGenerator("generator = { type = \"box\", half_extents = [1e-30, 1e-30, 1e-30] }"));
+    EXPECT_NE(small.find("below the 1e-20 units"), std::string::npos) << small;
+    EXPECT_EQ(errorOf(withMouthGenerator("generator = { type = \"sphere\", radius = 1e15 }")), "");
+}
+
 TEST(SceneFile, AGrabsDampingGivenMustNotBeNegative) {
     // Left out it is critical (GrabSettings' -1); a negative one given had silently meant the same.
     const auto grabOf = [](const Scene& scene) {
