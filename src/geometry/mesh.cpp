@@ -3,10 +3,10 @@
 
 #include <algorithm>
 #include <array>
-#include <sstream>
 #include <bit>
 #include <cstdint>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -23,9 +23,9 @@ std::string faceText(std::size_t f, const Face& face) {
 
 void requireWorkableScale(const TriMesh& mesh, const std::string& source, const MeshSourceLines& lines) {
     std::size_t largest = 0;
-    for (std::size_t v = 1; v < mesh.vertices.size(); ++v)
-        if (mesh.vertices[v].cwiseAbs().maxCoeff() > mesh.vertices[largest].cwiseAbs().maxCoeff()) largest = v;
-    const double magnitude = mesh.vertices[largest].cwiseAbs().maxCoeff();
+    double magnitude = 0.0;
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+        if (const double m = mesh.vertices[v].cwiseAbs().maxCoeff(); m > magnitude) largest = v, magnitude = m;
     std::ostringstream problem;
     if (magnitude > kMaxMeshCoordinate) {
         problem << "vertex " << largest << " has a coordinate of magnitude " << magnitude << ", beyond the " << kMaxMeshCoordinate

@@ -53,7 +53,7 @@ void appendNode(const aiScene& scene, const aiNode& node, const Eigen::Matrix4d&
 
 // A whole token that is a number assimp cannot hold: NaN, infinity, or beyond float range
 // (assimp stores coordinates as 32-bit floats). Words that merely start with "inf" do not count.
-bool isNonFiniteToken(const std::string& token) {
+bool isNonFiniteToken(std::string_view token) {
     double value = 0.0;
     const char* begin = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
     const auto [end, ec] = std::from_chars(begin, token.data() + token.size(), value);
@@ -71,7 +71,7 @@ std::size_t lineOfNonFiniteToken(const std::filesystem::path& path) {
     detail::TextLine line;
     while (cursor.next(line))
         for (std::string_view token : line.tokens)
-            if (isNonFiniteToken(std::string(token))) return line.number;
+            if (isNonFiniteToken(token)) return line.number;
     return 0;
 }
 
@@ -108,9 +108,12 @@ void requireWholeAsciiStl(const std::filesystem::path& path) {
     }
     std::ifstream whole(path, std::ios::binary);
     const std::string text((std::istreambuf_iterator<char>(whole)), std::istreambuf_iterator<char>());
-    const std::size_t end = text.find_last_not_of(kTrailing);
-    throw InputError(path.string(), end == std::string::npos ? 0 : detail::lineNumberAt(text, end),
-                     "the ASCII STL ends without an 'endsolid' line: the file is cut short");
+    // The last line with something on it, counted as the text readers count lines.
+    detail::LineCursor cursor(std::string_view(text).substr(0, text.find_last_not_of(kTrailing) + 1));
+    detail::TextLine line;
+    std::size_t lastLine = 0;
+    while (cursor.next(line)) lastLine = line.number;
+    throw InputError(path.string(), lastLine, "the ASCII STL ends without an 'endsolid' line: the file is cut short");
 }
 
 }  // namespace

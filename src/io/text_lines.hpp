@@ -38,14 +38,6 @@ inline std::string_view withoutByteOrderMark(std::string_view text) {
     return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
 }
 
-// The line (from 1) holding text[pos], line ends counted as LineCursor counts them.
-inline std::size_t lineNumberAt(std::string_view text, std::size_t pos) {
-    std::size_t line = 1;
-    for (std::size_t i = 0; i < pos && i < text.size(); ++i)
-        if (text[i] == '\n' || (text[i] == '\r' && (i + 1 >= text.size() || text[i + 1] != '\n'))) ++line;
-    return line;
-}
-
 // Walks the text line by line, skipping blank lines, remembering line numbers. A line ends at
 // '\n', at "\r\n" or at a '\r' alone (classic Mac OS files; a stray one in a file edited on
 // several systems), each counted as one line.
