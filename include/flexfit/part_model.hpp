@@ -186,7 +186,10 @@ struct PartModel {
     std::size_t faceCount() const { return mesh.faces.size(); }
 };
 
-// Builds a model from a validated mesh. Throws InputError (source "part model settings") for
+// Builds a model from a mesh. The mesh passes validateMesh here too (source: its name, else
+// "part model mesh"), as a mesh built in code reaches this without a reader: a NaN or a
+// coordinate beyond kMaxMeshCoordinate is refused, not simulated. Throws InputError (source
+// "part model settings") for
 // non-positive or non-finite masses and constants, or per-vertex / per-spring arrays of the
 // wrong size, a shell material out of range (or set beside per-vertex masses or per-spring
 // materials), or one that leaves a vertex without mass (in no face of positive area); a drawn

@@ -273,6 +273,7 @@ double divergenceBound(const std::vector<Vec3>& rest) {
 }  // namespace
 
 std::shared_ptr<const PartModel> buildPartModel(TriMesh mesh, const PartModelSettings& settings) {
+    validateMesh(mesh, mesh.name.empty() ? std::string("part model mesh") : mesh.name);
     std::shared_ptr<PartModel> model = buildInGivenOrder(std::move(mesh), settings);
     if (settings.vertexOrder == VertexOrder::Locality)
         if (auto renumbered = renumberedForLocality(*model, settings)) {

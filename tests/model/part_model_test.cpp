@@ -215,6 +215,41 @@ TEST(PartModel, BadSettingsThrowInputError) {
     expectEachRefused(cases);
 }
 
+// A mesh built in code (the API, Python) reaches buildPartModel without a reader: the model
+// build is its gate, as validateMesh is the readers'. Each defect is refused naming the mesh.
+TEST(PartModel, AnInvalidMeshIsRefusedNamingIt) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    auto edited = [](const std::function<void(TriMesh&)>& edit) {
+        TriMesh mesh = tetrahedron();
+        edit(mesh);
+        return mesh;
+    };
+    const std::vector<std::tuple<std::string, TriMesh, std::string>> cases = {
+        {"NaN vertex", edited([&](TriMesh& m) { m.vertices[3].z() = nan; }), "vertex 3 has a NaN or infinite coordinate"},
+        {"huge vertex", edited([](TriMesh& m) { m.vertices[1].x() = 1e30; }), "vertex 1 has a coordinate of magnitude 1e+30"},
+        {"face out of range", edited([](TriMesh& m) { m.faces[2][1] = 9; }), "face 2 (0 9 2): index 9 out of range"},
+        {"zero-area face", edited([](TriMesh& m) { m.faces.push_back({0, 1, 1}); }), "degenerate"},
+        {"no faces", edited([](TriMesh& m) { m.faces.clear(); }), "no faces"},
+    };
+    for (const auto& [label, mesh, phrase] : cases) {
+        try {
+            buildPartModel(mesh);
+            ADD_FAILURE() << label << ": accepted";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.source(), "tet") << label;
+            EXPECT_TRUE(contains(e.problem(), phrase)) << label << ": " << e.problem();
+        }
+    }
+    TriMesh unnamed = edited([&](TriMesh& m) { m.vertices[0].x() = nan; });
+    unnamed.name.clear();
+    try {
+        buildPartModel(unnamed);
+        ADD_FAILURE() << "unnamed: accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.source(), "part model mesh");
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Shell materials
 

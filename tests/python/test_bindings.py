@@ -140,6 +140,21 @@ def test_scene_errors_carry_file_and_line(tmp_path):
         flexfit.World().add(flexfit.PartModel(flexfit.sphere(1, 1)), mode="bendy")
 
 
+def test_a_mesh_built_in_python_is_validated_by_its_model():
+    faces = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    corner = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    nan_vertex = corner.copy()
+    nan_vertex[3, 2] = np.nan
+    with pytest.raises(flexfit.InputError, match="vertex 3 has a NaN") as error:
+        flexfit.PartModel(flexfit.Mesh(nan_vertex, faces, "tet"), material="elastic")
+    assert error.value.source == "tet"
+    with pytest.raises(flexfit.InputError, match="magnitude 1e\\+30"):
+        flexfit.PartModel(flexfit.Mesh(corner * 1e30, faces, "tet"), material="elastic")
+    with pytest.raises(flexfit.InputError, match="beyond the 1e\\+20 units"):
+        flexfit.PartModel(flexfit.sphere(1e30, 2), material="elastic")
+    assert flexfit.PartModel(flexfit.Mesh(corner, faces, "tet"), material="elastic").mass_count == 4
+
+
 def test_divergence_is_an_exception():
     world = flexfit.World()
     torus = world.add(flexfit.PartModel(flexfit.torus(10, 2.5, 24, 24)), mode="rigid-deformable")
