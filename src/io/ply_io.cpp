@@ -14,7 +14,9 @@
 // those with a repeated corner (how strips join and turn) are part of the encoding, not faces.
 // Other elements and properties (colours, normals, texture coordinates, edges, materials) are
 // read past. ASCII files hold one element per line.
-// Header lines that are not PLY are read past with a warning (Blender 2.4 wrote one).
+// Header lines that are not PLY are read past with a warning (Blender 2.4 wrote one). Lines end
+// at \n, \r\n or a lone \r (text_lines.hpp), in the header as in an ASCII body; binary data
+// after a lone \r is refused (its first byte could be a \n).
 // Refused, each with its place: a missing `ply` line, an unknown format or type, a header
 // without `end_header`, no x/y/z, no faces (point clouds), a face of fewer than 3 corners or with
 // an index out of range, a value that is not a number of its type, a file that ends early or
@@ -104,19 +106,18 @@ PlyType typeOf(std::string_view token, const std::string& source, std::size_t li
 
 PlyHeader readHeader(std::string_view text, const std::string& source) {
     PlyHeader header;
-    std::size_t offset = std::size_t(detail::withoutByteOrderMark(text).data() - text.data()), line = 0;
+    if (detail::withoutByteOrderMark(text).empty()) throw InputError(source, 0, "the header has no end_header line: the file is empty");
+    detail::LineCursor cursor(text);  // any line end, as the ASCII body: \n, \r\n or a lone \r
+    if (detail::tokenize(cursor.firstLine()) != std::vector<std::string_view>{"ply"})
+        throw InputError(source, 1, "not a PLY file: the first line is not 'ply'");
     bool formatSeen = false;
+    std::size_t line = 1;
+    detail::TextLine next;
     while (true) {
-        if (offset >= text.size()) throw InputError(source, line, "the header has no end_header line");
-        const std::size_t end = std::min(text.find('\n', offset), text.size());
-        const std::vector<std::string_view> tokens = detail::tokenize(text.substr(offset, end - offset));
-        offset = end + 1;
-        ++line;
-        if (line == 1) {
-            if (tokens.size() != 1 || tokens[0] != "ply") throw InputError(source, 1, "not a PLY file: the first line is not 'ply'");
-            continue;
-        }
-        if (tokens.empty() || tokens[0] == "comment" || tokens[0] == "obj_info") continue;
+        if (!cursor.next(next)) throw InputError(source, cursor.lineNumber(), "the header has no end_header line");
+        line = next.number;
+        const std::vector<std::string_view>& tokens = next.tokens;
+        if (tokens[0] == "comment" || tokens[0] == "obj_info") continue;
         const std::string_view keyword = tokens[0];
         if (keyword == "end_header") break;
         if (keyword == "format") {
@@ -156,7 +157,11 @@ PlyHeader readHeader(std::string_view text, const std::string& source) {
         }
     }
     if (!formatSeen) throw InputError(source, line, "the header has no format line");
-    header.bodyOffset = std::min(offset, text.size());
+    header.bodyOffset = std::min(text.size() - detail::withoutByteOrderMark(text).size() + cursor.offset(), text.size());
+    // A binary body's first byte could be taken for the end of end_header's line: "\r\n"
+    // (most writers) is read as one end; a lone \r before binary data is refused, not guessed.
+    if (header.format != PlyFormat::Ascii && header.bodyOffset > 0 && text[header.bodyOffset - 1] == '\r')
+        throw InputError(source, line, "a binary file's end_header line must end with \\n or \\r\\n (it ends with a lone \\r)");
     header.lines = line;
     return header;
 }

@@ -65,6 +65,8 @@ public:
     }
 
     std::size_t lineNumber() const { return lineNumber_; }
+    // Where the next line starts, in the text without its byte order mark.
+    std::size_t offset() const { return std::min(pos_, text_.size()); }
 
 private:
     // The line at pos_, without its end; pos_ moved past the end.

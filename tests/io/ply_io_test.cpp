@@ -131,6 +131,38 @@ TEST(PlyIo, AByteOrderMarkBeforeTheHeaderIsSkipped) {
     EXPECT_EQ(r.mesh.faces, mesh.faces);
 }
 
+// Every line end (\n, \r\n, a lone \r) in the header as in the ASCII body, as the other text
+// readers; before binary data a lone \r cannot be told from the data's first byte and is refused.
+std::string withLineEnds(std::string text, const std::string& end) {
+    std::string out;
+    for (char c : text) c == '\n' ? out += end : out += c;
+    return out;
+}
+
+TEST(PlyIo, EveryLineEndReadsTheSameMesh) {
+    const TriMesh mesh = flexfit::testing::shuffledVertices(makeIcoSphere(1.7, 1), 3);
+    TempDir dir;
+    for (const std::string end : {"\r\n", "\r"}) {
+        const MeshReadResult ascii = readMesh(dir.write("a.ply", withLineEnds(asciiPly(mesh), end)));
+        EXPECT_EQ(ascii.mesh.vertices, mesh.vertices) << int(end.size());
+        EXPECT_EQ(ascii.mesh.faces, mesh.faces) << int(end.size());
+    }
+    const std::string binary = binaryPly(mesh, false);
+    const std::size_t body = binary.find("end_header\n") + 11;
+    const std::string header = binary.substr(0, body), data = binary.substr(body);
+    const MeshReadResult crlf = readMesh(dir.write("b.ply", withLineEnds(header, "\r\n") + data));
+    EXPECT_EQ(crlf.mesh.vertices, mesh.vertices);
+    const InputError lone = readPlyError(withLineEnds(header, "\r") + data);
+    EXPECT_EQ(lone.line(), 15u) << lone.what();
+    EXPECT_TRUE(contains(lone.problem(), "lone \\r")) << lone.what();
+    const InputError typo = readPlyError(withLineEnds("plyy\nformat ascii 1.0\n", "\r"));
+    EXPECT_EQ(typo.line(), 1u);
+    EXPECT_TRUE(contains(typo.problem(), "not a PLY file")) << typo.what();
+    const InputError unended = readPlyError(withLineEnds("ply\nformat ascii 1.0\nelement vertex 0\n", "\r"));
+    EXPECT_EQ(unended.line(), 3u) << unended.what();
+    EXPECT_TRUE(contains(unended.problem(), "no end_header")) << unended.what();
+}
+
 TEST(PlyIo, FloatCoordinatesAreTheFloatsValues) {
     TempDir dir;
     std::string text = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
