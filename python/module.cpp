@@ -515,6 +515,9 @@ PYBIND11_MODULE(_flexfit, m) {
             for (const Contact& c : w.contacts()) out.append(contactDict(w, c));
             return out;
         }, "The last step's contacts, as dicts (part_a, part_b, point, normal, depth, ...).")
+        .def("prepare", &World::prepare,
+             "Before a real-time loop: does now what the first step would do once (each touching pair's first collision "
+             "traversal, the contact scratch), so the first step costs what the next ones do. Changes no result.")
         .def("profile", [](const World& w) { return profileDict(w.profile()); }, "Per-stage times of the last step and in total (s).")
         .def("state_hash", &World::stateHash, "64-bit FNV-1a of the whole state, bit for bit (equal hashes: the same run).")
         .def("centre_of_mass", &World::centreOfMass, py::arg("id"), "World position of a body's centre of mass.")

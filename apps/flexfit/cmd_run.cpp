@@ -42,6 +42,7 @@ void registerRun(CLI::App& app) {
             fmt::print("; in contact {} steps at {:.0f} steps/s (step p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us)", s.contactSteps,
                        double(s.contactSteps) / s.contactWallSeconds, nearestRankPercentile(s.contactStepMicros, 50.0),
                        nearestRankPercentile(s.contactStepMicros, 99.0), nearestRankPercentile(s.contactStepMicros, 100.0));
+        fmt::print("; slowest step {:.1f} us at t = {:.3f} s", s.maxStepMicros, s.maxStepTime);
         fmt::print("\n  max contacts {}, zones {}, moving masses {}, computed springs {}, deformation {:.4g}\n", s.maxContacts, s.maxZones,
                    s.maxMovingMasses, s.maxComputedSprings, s.maxDeformation);
         const double perStep = 1e6 / double(std::max<std::uint64_t>(1, s.steps));

@@ -146,6 +146,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         run.step();
         const double wall = std::chrono::duration<double>(Clock::now() - before).count();
         const std::size_t contacts = w.contacts().size();
+        if (const double micros = w.profile().lastStepSeconds * 1e6; micros > s.maxStepMicros) {
+            s.maxStepMicros = micros;
+            s.maxStepTime = w.time();
+        }
         if (contacts > 0) {
             ++s.contactSteps;
             s.contactWallSeconds += wall;
@@ -203,6 +207,7 @@ std::string summaryJson(const Scene& scene, const RunSummary& s) {
     for (const auto& [key, p] : {std::pair{"p50", 50.0}, std::pair{"p99", 99.0}, std::pair{"max", 100.0}})
         j += fmt::format("  \"contact_step_us_{}\": {},\n", key,
                          s.contactStepMicros.empty() ? std::string("null") : fmt::format("{:.3f}", nearestRankPercentile(s.contactStepMicros, p)));
+    j += fmt::format("  \"step_us_max\": {:.3f},\n  \"step_us_max_time\": {:.6f},\n", s.maxStepMicros, s.maxStepTime);
     j += fmt::format("  \"max_contacts\": {},\n  \"max_zones\": {},\n  \"max_moving_masses\": {},\n  \"max_computed_springs\": {},\n",
                      s.maxContacts, s.maxZones, s.maxMovingMasses, s.maxComputedSprings);
     j += fmt::format("  \"max_deformation\": {:.9g},\n  \"last_contact\": {},\n  \"restored_at\": {},\n  \"max_coupling_force\": {:.9g},\n",

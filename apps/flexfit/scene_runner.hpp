@@ -33,6 +33,10 @@ struct RunSummary {
     std::uint64_t contactSteps = 0;
     double contactWallSeconds = 0.0;
     std::vector<double> contactStepMicros;  // each in-contact step's World::step, us (profile)
+    // The slowest World::step of the run, in contact or not (a haptic loop misses its deadline
+    // on any step), and the simulated time at its end.
+    double maxStepMicros = 0.0;
+    double maxStepTime = 0.0;
     Profile profile;
     std::vector<AssemblyEvent> events;
     std::uint64_t stateHash = 0;

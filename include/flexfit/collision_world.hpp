@@ -118,6 +118,13 @@ public:
     // others wait. Same pairs and order as update() + narrowPhase() restricted to that body;
     // with rigidPartnersOnly, pairs with deformable parts are skipped.
     const std::vector<Contact>& contactsOf(BodyId id, bool rigidPartnersOnly = false);
+    // update(), then every candidate pair's query run for its coherence alone: what the pair's
+    // first query would traverse (a point shell's walk of the rest masses near the rigid part,
+    // a face pair's traversal) is done now, at the current poses, so that the next
+    // narrowPhase() starts from it. Contacts, stats(), contacts() and the query counters are
+    // left as they were; the next narrowPhase() gives the contacts it would have given without.
+    // For a real-time loop: the haptic scene's first step cost 1.6 ms without it.
+    void warmUp();
     const std::vector<Contact>& contacts() const { return contacts_; }  // of the last narrowPhase()
     const QueryStats& stats() const { return stats_; }                  // of the last narrowPhase()
     // The bodies whose hierarchy the last narrowPhase() or contactsOf() refitted from their

@@ -157,6 +157,13 @@ public:
     // force beyond what the model can take). The check costs O(bodies + moving masses); the
     // world then holds the non-finite state and must not be stepped again.
     void step();
+    // Optional, before a real-time loop: does now what the first step would do once and then
+    // not again, so that the first step costs what the next ones do. The collision world's
+    // first query of each pair whose spheres touch (CollisionWorld::warmUp) and the contact
+    // response's scratch, sized for every mass. Changes no result: a run with it gives the
+    // same states, bit for bit. Call it after adding the parts (a part added later, or a pair
+    // that comes into reach later, is warmed by its first step). SceneRun calls it.
+    void prepare();
     double time() const;
     std::uint64_t stepCount() const;
 

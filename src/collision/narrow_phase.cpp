@@ -24,6 +24,20 @@ const std::vector<Contact>& CollisionWorld::narrowPhase(const KnownContacts* kno
     return contacts_;
 }
 
+void CollisionWorld::warmUp() {
+    update();
+    const std::uint64_t queries = faceQueries_, traversals = faceTraversals_;
+    std::vector<Contact> discarded;
+    QueryStats ignored;
+    for (auto [i, j] : pairs_) {
+        if (!pressesFirst(i, j)) std::swap(i, j);
+        queryPair(i, j, discarded, ignored);
+        discarded.clear();
+    }
+    faceQueries_ = queries;
+    faceTraversals_ = traversals;
+}
+
 const std::vector<Contact>& CollisionWorld::findContacts() {
     update();
     return narrowPhase();

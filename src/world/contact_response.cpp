@@ -229,6 +229,13 @@ double effectiveContactStiffness(const Part& part, double timeStep) {
     return springs;
 }
 
+void sizeResponseScratch(const Bodies& bodies, ContactResponse& response) {
+    response.pushed.growTo(bodies.massCount());
+    response.reacting.growTo(bodies.massCount());
+    response.reactionOwner.resize(bodies.massCount(), 0u);
+    response.reactionCount.resize(bodies.size(), 0u);
+}
+
 void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response) {
     collectPushes(contacts, bodies, response);
     displacePushedMasses(bodies, response);

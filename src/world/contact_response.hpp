@@ -66,6 +66,10 @@ struct ContactResponse {
 void respondToContacts(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
                        ContactResponse& response);
 
+// The scratch above sized for every mass of `bodies` (each step grows it as needed; this does
+// it ahead of the first, for World::prepare).
+void sizeResponseScratch(const Bodies& bodies, ContactResponse& response);
+
 // The deformable pushes alone (zones at the contacted faces, masses moved out): for a body
 // pressing parts in the middle of its sub-steps.
 void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response);

@@ -26,6 +26,7 @@ SceneRun::SceneRun(const Scene& scene) : scene_(scene), world_(std::make_unique<
     for (const ScenePart& p : scene_.parts)
         atLine(scene_, p.line, "part '" + p.name + "'", [&] { world_->add(p.model, p.part, p.body, p.pose); });
     for (const AssemblyRule& r : scene_.assemblies) world_->addAssembly(r);
+    world_->prepare();
 }
 
 namespace {

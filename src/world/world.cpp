@@ -182,6 +182,12 @@ bool World::assembled(std::size_t rule) const {
 
 // --- The step ---
 
+void World::prepare() {
+    detail::WorldData& d = *data_;
+    d.collision.warmUp();
+    detail::sizeResponseScratch(d.bodies, d.response);
+}
+
 void World::step() {
     detail::WorldData& d = *data_;
     const StepContext step = d.context();

@@ -4,7 +4,8 @@ world_step_seconds is there, every stage is named, and the stages add up to the 
 (0.97 <= sum / total <= 1.0; the profile partitions the step, so this fails only when a stage
 is missing from stage_seconds or the file is inconsistent). And the in-contact step-time tail:
 contact_step_us_p50, _p99 and _max equal the nearest-rank percentiles computed here from
-metrics.csv's per-step us_world_step over the steps with contacts (null when there are none).
+metrics.csv's per-step us_world_step over the steps with contacts (null when there are none),
+and step_us_max the largest over every step.
 
 Usage: check_profile.py FLEXFIT SCENE OUT_DIR [--duration SECONDS]
 """
@@ -47,6 +48,9 @@ def nearest_rank(values, p):
 def check_tail(scene, summary, metrics):
     with metrics.open() as f:
         rows = list(csv.DictReader(f))
+    every = [float(r["us_world_step"]) for r in rows]
+    if every and abs(summary["step_us_max"] - max(every)) > 1e-3:
+        sys.exit(f"{scene}: step_us_max {summary['step_us_max']}, expected {max(every)} from metrics.csv")
     steps = [float(r["us_world_step"]) for r in rows if int(r["contacts"]) > 0]
     for key, p in (("p50", 50), ("p99", 99), ("max", 100)):
         got = summary[f"contact_step_us_{key}"]

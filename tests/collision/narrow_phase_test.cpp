@@ -2,6 +2,7 @@
 // for, one body's contacts against the whole narrow phase, and the hierarchies refitted only
 // when a query needs them, never by reading them.
 #include "flexfit/flexfit.hpp"
+#include "same_contacts.hpp"
 #include "test_bodies.hpp"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <tuple>
 
 using namespace flexfit;
+using flexfit::testing::expectSameContacts;
 using flexfit::testing::rigidPart;
 
 namespace {
@@ -142,4 +144,57 @@ TEST(NarrowPhase, PointShellPairsNeedNoRefit) {
     for (const Contact& c : contacts) EXPECT_NE(c.massB, kNoMass);  // point-shell contacts
     EXPECT_TRUE(world.refittedBodies().empty());
     EXPECT_EQ(world.collider(1).refitNodeCount(), 0u);
+}
+
+namespace {
+
+// A ball pressed into a deformed torus2, answered by the point shell: each world built the same.
+struct PressedTorus {
+    Part ball{buildPartModel(makeIcoSphere(3.0, 2)), rigidPart()};
+    Part torus{buildPartModel(makeTorus2())};
+    CollisionWorld world;
+
+    explicit PressedTorus(RigidDeformableQuery query) : world([&] {
+        CollisionSettings settings;
+        settings.rigidDeformable = query;
+        return settings;
+    }()) {
+        ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(12.0, 0.5, 0.0)});
+        world.add(0, ball);
+        world.add(1, torus);
+        for (int i = 0; i < 100; ++i) {
+            torus.applyForce(0, Vec3(-10.0, 0.0, 0.0));
+            torus.step();
+        }
+    }
+};
+
+}  // namespace
+
+TEST(NarrowPhase, AWarmUpTakesThePairsFirstTraversalAndChangesNoContact) {
+    // The same pair twice, by the point shell and by faces: a warmed world's first narrow phase
+    // gives a cold one's contacts field for field, without the cold one's walk or traversal;
+    // the warm-up itself reports nothing (no contacts, stats or query counts).
+    for (const RigidDeformableQuery query : {RigidDeformableQuery::PointShell, RigidDeformableQuery::Faces}) {
+        PressedTorus warm(query), cold(query);
+        warm.world.warmUp();
+        EXPECT_TRUE(warm.world.contacts().empty());
+        EXPECT_EQ(warm.world.stats().volumeTests, 0u);
+        EXPECT_EQ(warm.world.faceQueries(), 0u);
+        EXPECT_EQ(warm.world.faceTraversals(), 0u);
+        const std::vector<Contact> warmContacts = warm.world.findContacts();
+        const std::vector<Contact> coldContacts = cold.world.findContacts();
+        ASSERT_FALSE(coldContacts.empty());
+        expectSameContacts(warmContacts, coldContacts, 0);
+        if (query == RigidDeformableQuery::PointShell) {
+            // The cold query walks the torus's rest masses near the ball; the warm one reads the
+            // list the warm-up walked.
+            EXPECT_LT(warm.world.stats().volumeTests * 4, cold.world.stats().volumeTests)
+                << warm.world.stats().volumeTests << " against " << cold.world.stats().volumeTests;
+        } else {
+            EXPECT_EQ(warm.world.faceQueries(), 1u);
+            EXPECT_EQ(warm.world.faceTraversals(), 0u);  // the warm-up's candidates still cover
+            EXPECT_EQ(cold.world.faceTraversals(), 1u);
+        }
+    }
 }

@@ -155,6 +155,21 @@ def test_a_mesh_built_in_python_is_validated_by_its_model():
     assert flexfit.PartModel(flexfit.Mesh(corner, faces, "tet"), material="elastic").mass_count == 4
 
 
+def test_prepare_changes_no_result():
+    hashes = []
+    for prepared in (False, True):
+        world, m, b = ball_on_torus()
+        if prepared:
+            world.prepare()
+            assert world.step_count == 0 and world.contacts() == []
+        for _ in range(250):
+            world.apply_force(b, [0, -2500, 0])
+            world.step()
+        assert world.contacts()
+        hashes.append(world.state_hash())
+    assert hashes[0] == hashes[1]
+
+
 def test_divergence_is_an_exception():
     world = flexfit.World()
     torus = world.add(flexfit.PartModel(flexfit.torus(10, 2.5, 24, 24)), mode="rigid-deformable")

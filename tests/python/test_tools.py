@@ -1,6 +1,8 @@
 """The measuring scripts' own geometry (tools/): checked against what the mesh must keep."""
 
+import csv
 import math
+import subprocess
 import sys
 
 import pytest
@@ -54,3 +56,20 @@ def test_refine_away_stays_closed_and_oriented_and_keeps_the_near_faces(near, in
     far_before = sum(1 for f in faces if all(vertices[v][0] < 0.0 for v in f))
     far_after = sum(1 for f in refined if all(refined_vertices[v][0] < 0.0 for v in f))
     assert far_before and far_after >= 16 * far_before
+
+
+def test_step_tails_reads_the_runs_metrics(tmp_path, flexfit_exe, examples):
+    # Two names for one build: the same hash, and each tail read from metrics.csv's steps.
+    import step_tails
+    table = tmp_path / "tails.csv"
+    subprocess.run([sys.executable, str(ROOT / "tools" / "step_tails.py"), "--flexfit", f"a={flexfit_exe}", "--flexfit", f"b={flexfit_exe}",
+                    "--scene", str(examples / "contact.toml"), "--rounds", "1", "--csv", str(table)], check=True)
+    with open(table) as f:
+        rows = list(csv.DictReader(f))
+    assert [r["build"] for r in rows] == ["a", "b"] and rows[0]["state_hash"] == rows[1]["state_hash"]
+    for r in rows:
+        first, slowest, p50, p99, worst = (float(r[c]) for c in step_tails.COLUMNS)
+        assert 0 < first <= slowest and 0 < p50 <= p99 <= worst <= slowest
+    metrics = tmp_path / "metrics.csv"
+    metrics.write_text("time,contacts,us_world_step\n0.001,0,7.5\n0.002,3,2.0\n0.003,4,9.0\n0.004,0,1.0\n")
+    assert step_tails.tails(metrics) == [7.5, 9.0, 2.0, 9.0, 9.0]
