@@ -248,6 +248,9 @@ struct PointShellCoherence {
     bool valid = false;
     std::size_t traversalCost = 0;                     // its nodes
     std::uint64_t traversals = 0;                      // walks completed
+    // Walks the motion outran: finished (or made) inside one query, a step-time spike.
+    std::uint64_t walksAtOnce = 0;
+    RelativePose lastQuery;                            // B in A at the last query: its speed
     Walk walk;                                         // the next list, under way
     // By mass of B, its last sample as a moving mass: the point (A's frame), and the square of
     // the motion from it over which the mass stays clear (SignedDistanceField::

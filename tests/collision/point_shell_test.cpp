@@ -84,6 +84,26 @@ TEST(PointShellCoherent, AWanderingBallOverADeformingTorusGetsTheFullQuerysConta
     EXPECT_LT(coherence.traversals, 300u / 2) << "the rest masses' list is reused";
 }
 
+TEST(PointShellCoherent, AWalkKeepsAheadOfASteadyMotion) {
+    // A ball sliding across the torus at a steady speed, a margin every ~7 queries (a 1/16 share
+    // of a walk a query would be outrun): each new list is walked in slices sized by the motion,
+    // none finished inside one query, and the contacts stay the full query's.
+    BallOverTorus s;
+    PointShellCoherence coherence;
+    std::size_t contacts = 0, largestSlice = 0;
+    for (int step = 0; step < 300; ++step) {
+        s.ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(-1.5 + 0.01 * step, 0.5, 0.1)});
+        QueryStats stats;
+        const std::vector<Contact> got = s.coherent(coherence, stats);
+        expectSameContacts(got, s.full(), step);
+        contacts += got.size();
+        if (step > 0) largestSlice = std::max(largestSlice, stats.volumeTests);
+    }
+    EXPECT_GT(contacts, 0u);
+    EXPECT_GT(coherence.traversals, 10u) << "the motion needs new lists";
+    EXPECT_EQ(coherence.walksAtOnce, 0u) << "largest slice " << largestSlice << " nodes";
+}
+
 TEST(PointShellCoherent, MovingMassesOutsideTheGridAreSampledOnceTheBallComes) {
     // A zone moves masses of the tube far below the ball, outside its field's grid;
     // the ball then comes down and presses them: the coherent query must sample them again
