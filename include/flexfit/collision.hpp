@@ -248,7 +248,8 @@ struct PointShellCoherence {
     bool valid = false;
     std::size_t traversalCost = 0;                     // its nodes
     std::uint64_t traversals = 0;                      // walks completed
-    // Walks the motion outran: finished (or made) inside one query, a step-time spike.
+    // Walks the motion outran: finished after the old list ran out, or made whole in one query
+    // that had no other to spread it over (a step-time spike either way).
     std::uint64_t walksAtOnce = 0;
     RelativePose lastQuery;                            // B in A at the last query: its speed
     Walk walk;                                         // the next list, under way

@@ -187,8 +187,10 @@ struct PartModel {
 };
 
 // Builds a model from a mesh. The mesh passes validateMesh here too (source: its name, else
-// "part model mesh"), as a mesh built in code reaches this without a reader: a NaN or a
-// coordinate beyond kMaxMeshCoordinate is refused, not simulated. Throws InputError (source
+// "part model mesh"), as a mesh built in code reaches this without a reader: whatever a reader
+// refuses (a NaN, a coordinate beyond kMaxMeshCoordinate, an index out of range, a degenerate
+// or duplicate face, no faces, a mesh below kMinMeshSize) is refused, not simulated. A mesh
+// from a reader is checked twice (the duplicate-face sort: O(F log F)). Throws InputError (source
 // "part model settings") for
 // non-positive or non-finite masses and constants, or per-vertex / per-spring arrays of the
 // wrong size, a shell material out of range (or set beside per-vertex masses or per-spring

@@ -16,6 +16,11 @@ void CollisionWorld::updateBounds() {
 }
 
 void CollisionWorld::update() {
+    updatePairs();
+    dropStaleCoherence();
+}
+
+void CollisionWorld::updatePairs() {
     updateBounds();
     if (settings_.broadPhase == BroadPhaseUpdate::Rebuild)
         broadPhase_.build(partSpheres_);
@@ -40,7 +45,6 @@ void CollisionWorld::update() {
         }
     }
     std::sort(pairs_.begin(), pairs_.end());
-    dropStaleCoherence();
 }
 
 // A pair unused for this many updates loses its coherence (it is rebuilt by one traversal if

@@ -25,8 +25,15 @@ const std::vector<Contact>& CollisionWorld::narrowPhase(const KnownContacts* kno
 }
 
 void CollisionWorld::warmUp() {
-    update();
-    const std::uint64_t queries = faceQueries_, traversals = faceTraversals_;
+    if (!settings_.coherent) return;
+    updatePairs();  // not update(): the coherence clock is the steps'
+    refitted_.clear();
+    // The query counters as they were, however the queries end.
+    struct KeptCounters {
+        std::uint64_t &queries, &traversals;
+        std::uint64_t queriesBefore = queries, traversalsBefore = traversals;
+        ~KeptCounters() { queries = queriesBefore, traversals = traversalsBefore; }
+    } kept{faceQueries_, faceTraversals_};
     std::vector<Contact> discarded;
     QueryStats ignored;
     for (auto [i, j] : pairs_) {
@@ -34,8 +41,6 @@ void CollisionWorld::warmUp() {
         queryPair(i, j, discarded, ignored);
         discarded.clear();
     }
-    faceQueries_ = queries;
-    faceTraversals_ = traversals;
 }
 
 const std::vector<Contact>& CollisionWorld::findContacts() {

@@ -170,12 +170,14 @@ std::size_t walkRestPoints(const SignedDistanceField& field, const Bvh<Aabb>& re
 // 1 / kShellWalkShare of the last walk's nodes (at least kShellMinWalkNodes) per query, or more
 // when the last query's motion says the old list runs out sooner: the rest of the last walk's
 // nodes spread over the queries it still covers but one (walkBudget). A walk the motion still
-// outruns (an acceleration) is finished inside one query (walksAtOnce counts them).
+// outruns (an acceleration, or more than about 0.3 of the margin a query) is finished inside
+// one query (walksAtOnce counts them).
 // Measured on the ball-torus haptic scene: a walk of ~8,000 nodes costs ~750 us; the ball
 // leaves a margin in ~35 steps. With the fixed share alone, every walk of that scene after the
 // first was outrun and finished at once (265 to 2,200 nodes in one step); with the budget none
-// is, though the scene's in-contact tail did not measurably change (step_tails: p99 318 -> 326
-// us, 10 alternating rounds): those finishes cost less than the step's own variation.
+// is (walksAtOnce, printed while measuring), though the scene's in-contact tail did not
+// measurably change (bench/results/walk_budget.csv: p99 318 -> 326 us, 10 alternating rounds):
+// those finishes cost less than the step's own variation.
 constexpr double kMarginCells = 2.0;
 constexpr double kShellWalkStart = 0.4;
 constexpr std::size_t kShellWalkShare = 16;
@@ -338,7 +340,10 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
         motion = motionSince(c.pose);
     } else {
         if (!c.walk.active && motion > kShellWalkStart * c.margin) startWalk(c.walk, bInA, margin);
-        if (c.walk.active && advanceWalk(c.walk, fieldA, restPointsB, walkBudget(c, motion, speed), stats)) {
+        const std::size_t budget = walkBudget(c, motion, speed);
+        const bool whole = budget == std::numeric_limits<std::size_t>::max() && c.walk.nodes == 0;  // started now, no query to spread over
+        if (c.walk.active && advanceWalk(c.walk, fieldA, restPointsB, budget, stats)) {
+            c.walksAtOnce += whole;
             if (motionSince(c.walk.pose) <= c.walk.margin) {
                 takeWalk(c);
                 motion = motionSince(c.pose);

@@ -110,6 +110,7 @@ PlyHeader readHeader(std::string_view text, const std::string& source) {
     detail::LineCursor cursor(text);  // any line end, as the ASCII body: \n, \r\n or a lone \r
     if (detail::tokenize(cursor.firstLine()) != std::vector<std::string_view>{"ply"})
         throw InputError(source, 1, "not a PLY file: the first line is not 'ply'");
+    const bool loneCarriageReturns = text[cursor.offset() - 1] == '\r';  // how the first line ended
     bool formatSeen = false;
     std::size_t line = 1;
     detail::TextLine next;
@@ -157,11 +158,13 @@ PlyHeader readHeader(std::string_view text, const std::string& source) {
         }
     }
     if (!formatSeen) throw InputError(source, line, "the header has no format line");
-    header.bodyOffset = std::min(text.size() - detail::withoutByteOrderMark(text).size() + cursor.offset(), text.size());
+    header.bodyOffset = std::min(cursor.offset(), text.size());
     // A binary body's first byte could be taken for the end of end_header's line: "\r\n"
-    // (most writers) is read as one end; a lone \r before binary data is refused, not guessed.
-    if (header.format != PlyFormat::Ascii && header.bodyOffset > 0 && text[header.bodyOffset - 1] == '\r')
-        throw InputError(source, line, "a binary file's end_header line must end with \\n or \\r\\n (it ends with a lone \\r)");
+    // (most writers) is read as one end; lone \r line ends before binary data are refused, not
+    // guessed (a first data byte 0x0A would look like "\r\n"), whether the first line or the
+    // end_header line shows them.
+    if (header.format != PlyFormat::Ascii && (loneCarriageReturns || text[header.bodyOffset - 1] == '\r'))
+        throw InputError(source, line, "a binary file's header lines must end with \\n or \\r\\n (they end with a lone \\r)");
     header.lines = line;
     return header;
 }

@@ -43,7 +43,7 @@ inline std::string_view withoutByteOrderMark(std::string_view text) {
 // several systems), each counted as one line.
 class LineCursor {
 public:
-    explicit LineCursor(std::string_view text) : text_(withoutByteOrderMark(text)) {}
+    explicit LineCursor(std::string_view text) : text_(withoutByteOrderMark(text)), markLength_(text.size() - text_.size()) {}
 
     // The raw first line (a .tri model's name), without its end of line.
     std::string_view firstLine() {
@@ -65,8 +65,8 @@ public:
     }
 
     std::size_t lineNumber() const { return lineNumber_; }
-    // Where the next line starts, in the text without its byte order mark.
-    std::size_t offset() const { return std::min(pos_, text_.size()); }
+    // Where the next line starts, in the text as given (a byte order mark counted).
+    std::size_t offset() const { return markLength_ + std::min(pos_, text_.size()); }
 
 private:
     // The line at pos_, without its end; pos_ moved past the end.
@@ -78,6 +78,7 @@ private:
     }
 
     std::string_view text_;
+    std::size_t markLength_ = 0;
     std::size_t pos_ = 0;
     std::size_t lineNumber_ = 0;
 };

@@ -15,7 +15,7 @@ namespace {
 
 // Zones at the contacted faces and each mass's deepest push, in first-contact order.
 void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& r) {
-    r.pushed.growTo(bodies.massCount());
+    sizeResponseScratch(bodies, r);
     r.pushed.clear();
     r.pushes.clear();
     // Pushes the face's masses, or only `mass` when the contact has one (point shell).
@@ -150,7 +150,6 @@ FLEXFIT_AVX2_LANES std::size_t applyFrictionlessReactions256(const PairTerms& te
 
 // Each reaction (applyReaction), pair by pair (reactions come grouped by pair).
 void applyReactionForces(const StepContext& step, double dampingRatio, Bodies& bodies, ContactResponse& r) {
-    r.reactionCount.resize(bodies.size(), 0u);
     for (const ContactResponse::Reaction& reaction : r.reactions) r.reactionCount[reaction.body] = 0;
     for (const ContactResponse::Reaction& reaction : r.reactions) ++r.reactionCount[reaction.body];
     const double h = step.timeStep;
@@ -184,8 +183,7 @@ struct ReactingSides {
 // feels its masses' reactions, for the next step.
 void applyDeformableReactions(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
                               ContactResponse& r) {
-    r.reacting.growTo(bodies.massCount());
-    r.reactionOwner.resize(bodies.massCount(), 0u);
+    sizeResponseScratch(bodies, r);
     r.reacting.clear();
     for (const ContactResponse::Reaction& reaction : r.reactions) bodies.rigid[reaction.body].deformableContactForce.setZero();  // last step's
     r.reactions.clear();
@@ -229,11 +227,17 @@ double effectiveContactStiffness(const Part& part, double timeStep) {
     return springs;
 }
 
-void sizeResponseScratch(const Bodies& bodies, ContactResponse& response) {
-    response.pushed.growTo(bodies.massCount());
-    response.reacting.growTo(bodies.massCount());
-    response.reactionOwner.resize(bodies.massCount(), 0u);
-    response.reactionCount.resize(bodies.size(), 0u);
+void sizeResponseScratch(const Bodies& bodies, ContactResponse& r) {
+    const std::size_t masses = bodies.massCount();
+    r.pushed.growTo(masses);
+    r.reacting.growTo(masses);
+    r.reactionOwner.resize(masses, 0u);
+    r.reactionCount.resize(bodies.size(), 0u);
+    // Each list holds a mass at most once (per body for the reactions): no step reallocates.
+    r.pushes.reserve(masses);
+    r.runMasses.reserve(masses);
+    r.runDisplacements.reserve(masses);
+    r.reactions.reserve(masses);
 }
 
 void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response) {

@@ -66,8 +66,10 @@ struct ContactResponse {
 void respondToContacts(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
                        ContactResponse& response);
 
-// The scratch above sized for every mass of `bodies` (each step grows it as needed; this does
-// it ahead of the first, for World::prepare).
+// The scratch above sized for every mass of `bodies`: every response calls it (a no-op once
+// sized), and World::prepare ahead of the first step. A list's capacity is the world's mass
+// count (a reaction list holds a mass once per pressing body, so with several bodies pressing one
+// mass it can still grow).
 void sizeResponseScratch(const Bodies& bodies, ContactResponse& response);
 
 // The deformable pushes alone (zones at the contacted faces, masses moved out): for a body

@@ -185,6 +185,7 @@ bool World::assembled(std::size_t rule) const {
 void World::prepare() {
     detail::WorldData& d = *data_;
     d.collision.warmUp();
+    detail::clearRefittedChanges(d.collision, d.bodies);  // as after every narrow phase
     detail::sizeResponseScratch(d.bodies, d.response);
 }
 

@@ -51,6 +51,9 @@ def check_tail(scene, summary, metrics):
     every = [float(r["us_world_step"]) for r in rows]
     if every and abs(summary["step_us_max"] - max(every)) > 1e-3:
         sys.exit(f"{scene}: step_us_max {summary['step_us_max']}, expected {max(every)} from metrics.csv")
+    slowest_at = float(rows[every.index(max(every))]["time"]) if every else None
+    if every and abs(summary["step_us_max_time"] - slowest_at) > 1e-9:
+        sys.exit(f"{scene}: step_us_max_time {summary['step_us_max_time']}, expected {slowest_at} from metrics.csv")
     steps = [float(r["us_world_step"]) for r in rows if int(r["contacts"]) > 0]
     for key, p in (("p50", 50), ("p99", 99), ("max", 100)):
         got = summary[f"contact_step_us_{key}"]

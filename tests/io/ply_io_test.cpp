@@ -155,6 +155,11 @@ TEST(PlyIo, EveryLineEndReadsTheSameMesh) {
     const InputError lone = readPlyError(withLineEnds(header, "\r") + data);
     EXPECT_EQ(lone.line(), 15u) << lone.what();
     EXPECT_TRUE(contains(lone.problem(), "lone \\r")) << lone.what();
+    // Data whose first byte is 0x0A after a lone \r reads as "\r\n": the first line tells.
+    const InputError newlineByte = readPlyError(withLineEnds(header, "\r") + "\n" + data);
+    EXPECT_TRUE(contains(newlineByte.problem(), "lone \\r")) << newlineByte.what();
+    const MeshReadResult mark = readMesh(dir.write("c.ply", "\xEF\xBB\xBF" + withLineEnds(header, "\r\n") + data));
+    EXPECT_EQ(mark.mesh.vertices, mesh.vertices);
     const InputError typo = readPlyError(withLineEnds("plyy\nformat ascii 1.0\n", "\r"));
     EXPECT_EQ(typo.line(), 1u);
     EXPECT_TRUE(contains(typo.problem(), "not a PLY file")) << typo.what();
