@@ -20,21 +20,19 @@ import subprocess
 import tempfile
 from pathlib import Path
 
+from ab_stages import percentile  # nearest rank, as every other table here
+
 COLUMNS = ["first_step_us", "slowest_step_us", "contact_step_us_p50", "contact_step_us_p99", "contact_step_us_max"]
 
 
-def nearest_rank(values, percent):
-    ordered = sorted(values)
-    return ordered[max(1, math.ceil(percent / 100.0 * len(ordered))) - 1] if ordered else float("nan")
-
-
 def tails(metrics):
-    """The COLUMNS of one run, from its metrics.csv."""
+    """The COLUMNS of one run, from its metrics.csv (the in-contact ones NaN without contact)."""
     with open(metrics) as f:
         rows = list(csv.DictReader(f))
     every = [float(r["us_world_step"]) for r in rows]
-    contact = [float(r["us_world_step"]) for r in rows if int(r["contacts"]) > 0]
-    return [every[0], max(every), nearest_rank(contact, 50), nearest_rank(contact, 99), nearest_rank(contact, 100)]
+    contact = sorted(float(r["us_world_step"]) for r in rows if int(r["contacts"]) > 0)
+    ranks = [percentile(contact, p) if contact else float("nan") for p in (50, 99, 100)]
+    return [every[0], max(every), *ranks]
 
 
 def run(flexfit, scene, out):

@@ -15,7 +15,6 @@ namespace {
 
 // Zones at the contacted faces and each mass's deepest push, in first-contact order.
 void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& r) {
-    sizeResponseScratch(bodies, r);
     r.pushed.clear();
     r.pushes.clear();
     // Pushes the face's masses, or only `mass` when the contact has one (point shell).
@@ -183,7 +182,6 @@ struct ReactingSides {
 // feels its masses' reactions, for the next step.
 void applyDeformableReactions(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
                               ContactResponse& r) {
-    sizeResponseScratch(bodies, r);
     r.reacting.clear();
     for (const ContactResponse::Reaction& reaction : r.reactions) bodies.rigid[reaction.body].deformableContactForce.setZero();  // last step's
     r.reactions.clear();
@@ -241,6 +239,7 @@ void sizeResponseScratch(const Bodies& bodies, ContactResponse& r) {
 }
 
 void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response) {
+    sizeResponseScratch(bodies, response);  // once a response: respondToContacts starts here too
     collectPushes(contacts, bodies, response);
     displacePushedMasses(bodies, response);
 }

@@ -66,8 +66,8 @@ struct ContactResponse {
 void respondToContacts(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
                        ContactResponse& response);
 
-// The scratch above sized for every mass of `bodies`: every response calls it (a no-op once
-// sized), and World::prepare ahead of the first step. A list's capacity is the world's mass
+// The scratch above sized for every mass of `bodies`: every response calls it once, in
+// pushDeformableMasses (a no-op once sized), and World::prepare ahead of the first step. A list's capacity is the world's mass
 // count (a reaction list holds a mass once per pressing body, so with several bodies pressing one
 // mass it can still grow).
 void sizeResponseScratch(const Bodies& bodies, ContactResponse& response);
