@@ -60,8 +60,16 @@ struct RelativePose {
 };
 
 // Overlap of a volume in frame A with a volume in frame B (touching counts as overlap).
+// Boxes turned against each other are tested on their 6 face axes only (overlapRotated): a
+// conservative test that may report two boxes apart along an edge-edge axis as overlapping.
 bool overlap(const Sphere& a, const Sphere& b, const RelativePose& bInA);
-bool overlapRotated(const Aabb& a, const Aabb& b, const RelativePose& bInA);  // the oriented-box case
+// The oriented-box case: the separating-axis test on A's and B's face axes, not the 9 cross
+// products of their edges ("SAT lite", van den Bergen, J. Graphics Tools 2(4), 1997). Those
+// rarely separate boxes in a traversal, and they were most of its cost: a rigid ball coming to
+// rest on the rigid mouth took its coherent list 24 % faster without them (and without the
+// bounding-sphere pre-test, which the face axes reject as cheaply), though it visits more node
+// pairs. It errs only towards overlap: a traversal may descend further, never miss a leaf pair.
+bool overlapRotated(const Aabb& a, const Aabb& b, const RelativePose& bInA);
 // Inline: the traversals call it per node pair, and parts not turned against each other (a
 // tool moved without rotation, parts at rest) need only the plain box test.
 inline bool overlap(const Aabb& a, const Aabb& b, const RelativePose& bInA) {

@@ -41,31 +41,17 @@ bool overlap(const Sphere& a, const Sphere& b, const RelativePose& bInA) {
     return (bInA.apply(b.centre) - a.centre).squaredNorm() <= reach * reach;
 }
 
-// Separating-axis test of two oriented boxes: A's box axis-aligned in frame A, B's in frame B.
+// Separating-axis test of two oriented boxes on their face axes (bounding_volume.hpp): A's box
+// axis-aligned in frame A, B's in frame B.
 bool overlapRotated(const Aabb& a, const Aabb& b, const RelativePose& bInA) {
     const Vec3 ea = a.halfExtents(), eb = b.halfExtents();
     const Eigen::Matrix3d& r = bInA.rotation;
     const Eigen::Matrix3d& ar = bInA.absRotation;
     const Vec3 t = bInA.apply(b.centre()) - a.centre();  // in A's frame
-    // Bounding spheres of the boxes first: most pairs that miss are rejected here.
-    const double reach = ea.norm() + eb.norm();
-    if (t.squaredNorm() > reach * reach) return false;
-    // A's axes.
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 3; ++i)  // A's axes
         if (std::abs(t[i]) > ea[i] + ar.row(i).dot(eb)) return false;
-    // B's axes.
-    for (int j = 0; j < 3; ++j)
+    for (int j = 0; j < 3; ++j)  // B's axes
         if (std::abs(t.dot(r.col(j))) > ea.dot(ar.col(j)) + eb[j]) return false;
-    // Cross products of an axis of A with an axis of B.
-    for (int i = 0; i < 3; ++i) {
-        const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
-        for (int j = 0; j < 3; ++j) {
-            const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-            const double ra = ea[i1] * ar(i2, j) + ea[i2] * ar(i1, j);
-            const double rb = eb[j1] * ar(i, j2) + eb[j2] * ar(i, j1);
-            if (std::abs(t[i2] * r(i1, j) - t[i1] * r(i2, j)) > ra + rb) return false;
-        }
-    }
     return true;
 }
 
