@@ -120,7 +120,7 @@ bool advanceTake(PairCoherence::Take& t, std::size_t budget, const Bvh<BA>& bvhA
         if (separation > margin) return;
         separation = std::max(separation, tester.separationByB(fa, fb));
         if (separation > margin) return;
-        separation = std::max(separation, tester.separationOfTriangles(fa, fb));
+        separation = std::max(separation, tester.separationOfTriangles(fa, fb, margin));
         if (separation <= margin) t.candidates.push_back({fa, fb, separation});
     };
     auto beyondMargin = [&](Index fa, const auto& volumeB) { return tester.prunesBeyond(fa, volumeB, margin); };

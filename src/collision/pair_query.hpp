@@ -336,14 +336,16 @@ public:
         return std::max({0.0, lowest - margin, -highest - margin}) * (1.0 - 1e-12);
     }
     // How far apart the two faces are along the best separating axis (triangleGap), less a
-    // margin far above intersectTriangles' rounding; 0 when none separates them.
-    double separationOfTriangles(Index fa, Index fb) {
+    // margin far above intersectTriangles' rounding; 0 when none separates them. Stops once it
+    // exceeds `enough`.
+    double separationOfTriangles(Index fa, Index fb, double enough = std::numeric_limits<double>::infinity()) {
         if (test_ != ExactTest::TriangleTriangle) return 0.0;
         const Face& f = facesB_[fb];
         const Triangle tb{bInA_.apply(pb_[f[0]]), bInA_.apply(pb_[f[1]]), bInA_.apply(pb_[f[2]])};
         const Triangle ta = triangleOf(pa_, facesA_[fa]);
         const double scale = std::max({ta.a.norm(), ta.b.norm(), ta.c.norm(), tb.a.norm(), tb.b.norm(), tb.c.norm()});
-        return std::max(0.0, triangleGap(ta, tb) - 1e-9 * (1.0 + scale));
+        const double tolerance = 1e-9 * (1.0 + scale);
+        return std::max(0.0, triangleGap(ta, tb, enough + tolerance) - tolerance);
     }
     // B's subtrees beyond a plane of A's (rigid) leaf face by more than `margin`.
     template <class Volume>

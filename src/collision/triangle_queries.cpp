@@ -216,7 +216,7 @@ std::optional<TriangleContact> sphereTriangleContact(const Vec3& centre, double 
     return TriangleContact{q, normal, radius - distance};
 }
 
-double triangleGap(const Triangle& first, const Triangle& second) {
+double triangleGap(const Triangle& first, const Triangle& second, double enough) {
     const std::array<Vec3, 3> e1{first.b - first.a, first.c - first.b, first.a - first.c};
     const std::array<Vec3, 3> e2{second.b - second.a, second.c - second.b, second.a - second.c};
     std::array<Vec3, 11> axes;
@@ -225,13 +225,17 @@ double triangleGap(const Triangle& first, const Triangle& second) {
     std::size_t count = 2;
     for (const Vec3& a : e1)
         for (const Vec3& b : e2) axes[count++] = a.cross(b);
+    // Projected on the axis as it is; only a separating axis wider than the best so far pays
+    // for its length (squared comparison first, then the square root).
     double gap = 0.0;
     for (const Vec3& axis : axes) {
-        const double length = axis.norm();
-        if (!(length > 0.0)) continue;
-        const Vec3 unit = axis / length;
-        const Interval i1 = project(first, unit), i2 = project(second, unit);
-        gap = std::max({gap, i2.min - i1.max, i1.min - i2.max});
+        const Interval i1 = project(first, axis), i2 = project(second, axis);
+        const double apart = std::max(i2.min - i1.max, i1.min - i2.max);
+        if (!(apart > 0.0)) continue;
+        const double squaredLength = axis.squaredNorm();
+        if (!(squaredLength > 0.0) || apart * apart <= gap * gap * squaredLength) continue;
+        gap = apart / std::sqrt(squaredLength);
+        if (gap > enough) break;
     }
     return gap;
 }

@@ -16,6 +16,7 @@
 #include "flexfit/core.hpp"
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 
 namespace flexfit {
@@ -60,7 +61,7 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
 // the nine edge-edge cross products, unit): a lower bound on their distance. While no vertex
 // of either side's vertices moves by more than the gap in total (along a fixed axis, the gap
 // shrinks by at most the two sides' largest moves), they stay apart. 0 when no axis separates
-// them.
-double triangleGap(const Triangle& first, const Triangle& second);
+// them. Stops at the first axis whose gap exceeds `enough` (then a lower bound on the gap).
+double triangleGap(const Triangle& first, const Triangle& second, double enough = std::numeric_limits<double>::infinity());
 
 }  // namespace flexfit
