@@ -163,22 +163,25 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
 struct PairCoherence {
     struct Candidate {
         Index faceA = 0, faceB = 0;
-        // The gap between the two faces when taken: how far B's face lay beyond a plane of A's
-        // face (A rigid), A's beyond the plane of B's, or the two apart along a separating axis
-        // of the triangles, whichever is widest; 0 when none separated them.
+        // A lower bound on the gap between the two faces at the take: how far B's face lay
+        // beyond a plane of A's face (A rigid; 0 otherwise). Settled by the first query whose
+        // reach attains it: then also A's face beyond the plane of B's, or the two apart along a
+        // separating axis of the triangles, at that query, less the motion since the take.
         double separation = 0.0;
+        bool settled = false;
     };
     // What a traversal took, and what it assumed: the relative pose it tested at, its margin,
     // and the colliders' vertex drifts and generations when it began. A traversal may be spread over
     // several queries (`stack` holds the node pairs left); it tests every node at `pose`.
     struct Take {
-        std::vector<Candidate> candidates;  // sorted by (faceA, faceB) once complete
+        std::vector<Candidate> candidates;  // in the traversal's order
         RelativePose pose;
         double margin = 0.0;
         double vertexDriftA = 0.0, vertexDriftB = 0.0;
         std::uint64_t generationA = 0, generationB = 0;
         std::vector<std::pair<std::int32_t, std::int32_t>> stack;
         std::size_t nodes = 0;              // node pairs visited
+        std::size_t settledUpTo = 0;        // candidates a walked take has settled, in order
         std::uint64_t startQuery = 0;       // the query that began it (PairCoherence::queries)
     };
     Take list;                             // the candidates in use
@@ -206,7 +209,9 @@ struct PairCoherence {
 // A candidate whose faces were farther apart (beyond a plane of either face, or along a
 // separating axis of the triangles) than their vertices have moved relative to each other since
 // (relative motion plus both vertexDrifts) is skipped: the full query's exact test would find
-// them apart. So a body at rest on another costs O(its
+// them apart. The take measures only the cheap gap (A's face plane); the others are measured
+// after its traversal by a walked take, or else by the first scan that reaches the candidate
+// (Candidate::settled). So a body at rest on another costs O(its
 // candidates' scan + the pairs near contact), not a traversal.
 // The next list is taken by a traversal at a fixed pose, spread over the queries (1/8 of the
 // last traversal's node pairs each) from when the motion reaches 0.25 of the margin: no query

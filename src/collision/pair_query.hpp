@@ -306,6 +306,8 @@ public:
     bool prunes(Index fa, const Volume& volumeB) {
         return test_ == ExactTest::TriangleTriangle && filter_.separated(fa, volumeB);
     }
+    // Whether separationByA() measures a gap (A rigid, triangle test), or is always 0.
+    bool gapsByA() const { return test_ == ExactTest::TriangleTriangle && a_.mode() == PartMode::Rigid; }
     // How far B's face may move (its vertices, in A's frame) before the exact test could find
     // a contact with A's face (A rigid).
     double separationByA(Index fa, Index fb, double enough) {

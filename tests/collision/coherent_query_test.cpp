@@ -207,6 +207,55 @@ TEST(CoherentQueryCost, APairAtRestStopsTraversing) {
     EXPECT_LT(coherentStats.volumeTests * 5, fullStats.volumeTests) << coherentStats.volumeTests << " vs " << fullStats.volumeTests;
 }
 
+TEST(CoherentQuery, AGapMeasuredAfterTheTakeCountsTheMotionBeforeIt) {
+    // A candidate's dearer gaps are measured by the first query whose reach attains it, not at
+    // the take: what bounds the take's gap is that gap less the motion since. A ball taken
+    // apart from the torus (0.1 of the margin), moved away (0.3: its gaps measured there), then
+    // back past the take's pose into contact (-0.05), all within the list's margin: the one
+    // list answers, with the full query's contacts. Kept at the later gap alone (0.3 of the
+    // margin against the 0.15 moved since the take), the contact pairs would be skipped.
+    Part torus(buildPartModel(makeTorus(3.0, 1.0, 64, 32)), rigidPart());
+    Part ball(buildPartModel(makeIcoSphere(1.0, 3)), rigidPart());
+    PartCollider ct(torus, BoundingVolumeKind::Aabb), cb(ball, BoundingVolumeKind::Aabb);
+    auto at = [&](double x) { ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(x, 0.0, 0.0)}); };
+    auto full = [&] {
+        std::vector<Contact> out;
+        QueryStats ignored;
+        queryPair(0, torus, ct, 1, ball, cb, ExactTest::TriangleTriangle, out, ignored);
+        return out;
+    };
+    // Where the ball meets the torus's outer side, by bisection on the full query.
+    double inside = 4.5, outside = 5.5;
+    for (int i = 0; i < 60; ++i) {
+        at(0.5 * (inside + outside));
+        (full().empty() ? outside : inside) = 0.5 * (inside + outside);
+    }
+    double margin = 0.0;
+    {
+        PairCoherence probe;
+        std::vector<Contact> contacts;
+        QueryStats stats;
+        at(outside + 0.1);
+        queryPairCoherent(0, torus, ct, 1, ball, cb, ExactTest::TriangleTriangle, probe, contacts, stats);
+        margin = probe.list.margin;
+    }
+    ASSERT_GT(margin, 0.0);
+    PairCoherence coherence;
+    int step = 0;
+    for (const double share : {0.1, 0.3, -0.05}) {
+        at(outside + share * margin);
+        std::vector<Contact> contacts;
+        QueryStats stats;
+        queryPairCoherent(0, torus, ct, 1, ball, cb, ExactTest::TriangleTriangle, coherence, contacts, stats);
+        expectSameContacts(contacts, full(), step++);
+        if (share < 0.0) {
+            EXPECT_FALSE(contacts.empty());
+        }
+    }
+    EXPECT_EQ(coherence.traversals, 1u) << "one list, taken by the first query, answers all three";
+    EXPECT_FALSE(coherence.walking) << "no walk began: every motion stayed within a quarter of the margin";
+}
+
 TEST(CoherentQueryCost, MotionThatOutrunsEveryListIsAnsweredByPlainQueriesUntilItSlows) {
     // A ball jumping about a tube (0.3 a step, far beyond the widest margin): the first list it
     // takes is outrun at once, and plain queries answer from then on, a list tried only where a
