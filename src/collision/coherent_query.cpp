@@ -3,6 +3,7 @@
 #include "collision/pair_query.hpp"
 
 #include <limits>
+#include <tuple>
 
 namespace flexfit {
 using namespace detail;
@@ -103,6 +104,7 @@ void startTake(PairCoherence::Take& t, const PartCollider& colliderA, const Part
     t.stack.assign(1, {0, 0});
     t.nodes = 0;
     t.settledUpTo = 0;
+    t.sorted = false;
     t.margin = margin;
     notePose(t, colliderA, colliderB, bInA);
 }
@@ -155,7 +157,7 @@ bool advanceTake(PairCoherence::Take& t, std::size_t budget, const Bvh<BA>& bvhA
     stats.volumeTests += walk.volumeTests;
     t.nodes += walk.volumeTests;
     if (!t.stack.empty()) return false;
-    if (!settling) return true;
+    if (!settling && deferred) return true;  // in traversal order: sorting every near pair would cost the scan more than it saves
     for (std::size_t spent = walk.volumeTests; t.settledUpTo < t.candidates.size(); ++t.settledUpTo) {
         PairCoherence::Candidate& k = t.candidates[t.settledUpTo];
         if (k.settled) continue;
@@ -164,6 +166,9 @@ bool advanceTake(PairCoherence::Take& t, std::size_t budget, const Bvh<BA>& bvhA
         spent += kSettleNodes;
     }
     dropUnreachable(t);
+    std::sort(t.candidates.begin(), t.candidates.end(),
+              [](const PairCoherence::Candidate& x, const PairCoherence::Candidate& y) { return std::tie(x.faceA, x.faceB) < std::tie(y.faceA, y.faceB); });
+    t.sorted = true;
     return true;
 }
 
@@ -180,7 +185,8 @@ void useNext(PairCoherence& c) {
 // Tests the list's candidates as the full query tests its leaf pairs; those whose separation
 // exceeds `reach` cannot touch and are skipped (settled first when their take's bound alone
 // does not skip them). The tests beyond those of the list's first query are what the motion
-// since added (scanCost). The contacts come in (faceA, faceB) order, as the full query's.
+// since added (scanCost). The contacts come in (faceA, faceB) order, as the full query's (from
+// a sorted list, or sorted after).
 template <class BA, class BB>
 void scanCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const RelativePose& bInA, double reach, LeafPairTester& tester,
                     PairCoherence& c, std::vector<Contact>& contacts, QueryStats& stats) {
@@ -201,7 +207,7 @@ void scanCandidates(const Bvh<BA>& bvhA, const Bvh<BB>& bvhB, const RelativePose
     }
     stats.volumeTests += tested;
     if (unreachable) dropUnreachable(c.list);
-    sortContacts(contacts, first);
+    if (!c.list.sorted) sortContacts(contacts, first);
     if (c.queriesSince == 0)
         c.testedAfterTraversal = tested;
     else
