@@ -60,8 +60,6 @@ struct RelativePose {
 };
 
 // Overlap of a volume in frame A with a volume in frame B (touching counts as overlap).
-// Boxes turned against each other are tested on their 6 face axes only (overlapRotated): a
-// conservative test that may report two boxes apart along an edge-edge axis as overlapping.
 bool overlap(const Sphere& a, const Sphere& b, const RelativePose& bInA);
 // The oriented-box case: the separating-axis test on A's and B's face axes, not the 9 cross
 // products of their edges ("SAT lite", van den Bergen, J. Graphics Tools 2(4), 1997). Those
@@ -71,7 +69,9 @@ bool overlap(const Sphere& a, const Sphere& b, const RelativePose& bInA);
 // pairs. It errs only towards overlap: a traversal may descend further, never miss a leaf pair.
 bool overlapRotated(const Aabb& a, const Aabb& b, const RelativePose& bInA);
 // Inline: the traversals call it per node pair, and parts not turned against each other (a
-// tool moved without rotation, parts at rest) need only the plain box test.
+// tool moved without rotation, parts at rest) need only the plain box test. Boxes turned
+// against each other are tested on their 6 face axes only (overlapRotated): conservative, it
+// may report two boxes apart along an edge-edge axis as overlapping.
 inline bool overlap(const Aabb& a, const Aabb& b, const RelativePose& bInA) {
     if (!bInA.pureTranslation) return overlapRotated(a, b, bInA);
     const Vec3 bMin = b.min + bInA.translation, bMax = b.max + bInA.translation;

@@ -164,9 +164,11 @@ struct PairCoherence {
     struct Candidate {
         Index faceA = 0, faceB = 0;
         // A lower bound on the gap between the two faces at the take: how far B's face lay
-        // beyond a plane of A's face (A rigid; 0 otherwise). Settled by the first query whose
-        // reach attains it: then also A's face beyond the plane of B's, or the two apart along a
-        // separating axis of the triangles, at that query, less the motion since the take.
+        // beyond a plane of A's face (A rigid; 0 otherwise), and once settled also how far A's
+        // face lay beyond the plane of B's, or the two apart along a separating axis of the
+        // triangles. Settled by the take itself when A deforms or the take is walked (those
+        // gaps at the take's pose), else by the first scan whose reach attains the pair (the
+        // gaps at that scan less its reach: the motion since the take).
         double separation = 0.0;
         bool settled = false;
     };
@@ -210,9 +212,9 @@ struct PairCoherence {
 // A candidate whose faces were farther apart (beyond a plane of either face, or along a
 // separating axis of the triangles) than their vertices have moved relative to each other since
 // (relative motion plus both vertexDrifts) is skipped: the full query's exact test would find
-// them apart. The take measures only the cheap gap (A's face plane); the others are measured
-// after its traversal by a walked take, or else by the first scan that reaches the candidate
-// (Candidate::settled). So a body at rest on another costs O(its
+// them apart. With A rigid the take measures only the cheap gap (A's face plane); the others
+// are measured after its traversal by a walked take, or else by the first scan that reaches the
+// candidate (Candidate::settled). So a body at rest on another costs O(its
 // candidates' scan + the pairs near contact), not a traversal.
 // The next list is taken by a traversal at a fixed pose, spread over the queries (1/8 of the
 // last traversal's node pairs each) from when the motion reaches 0.25 of the margin: no query

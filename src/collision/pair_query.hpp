@@ -352,7 +352,7 @@ public:
     // B's subtrees beyond a plane of A's (rigid) leaf face by more than `margin`.
     template <class Volume>
     bool prunesBeyond(Index fa, const Volume& volumeB, double margin) {
-        return test_ == ExactTest::TriangleTriangle && a_.mode() == PartMode::Rigid && filter_.separated(fa, volumeB, margin);
+        return gapsByA() && filter_.separated(fa, volumeB, margin);
     }
 
 private:

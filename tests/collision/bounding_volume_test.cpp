@@ -56,18 +56,16 @@ TEST(BoundingVolume, OrientedBoxTestMatchesFaceAxisProjections) {
             EXPECT_TRUE(overlap(a, b, pose));
         }
         overlaps += reference;
-        // What the face axes leave out: boxes apart only along an edge-edge axis. It reports
-        // them overlapping (conservative), and never reports apart boxes that all 15 axes
-        // find overlapping.
-        if (referenceBoxesOverlap(a, b, pose, true)) {
-            EXPECT_TRUE(overlap(a, b, pose)) << k;
-        } else {
-            apartOnlyAcrossEdges += reference;
-        }
+        // What the face axes leave out: boxes apart only along an edge-edge axis, which it
+        // reports overlapping (conservative; that the 15-axis reference's overlaps are among
+        // its own follows from the comparison above).
+        apartOnlyAcrossEdges += reference && !referenceBoxesOverlap(a, b, pose, true);
     }
     EXPECT_GT(overlaps, 2000);
     EXPECT_LT(disagreements, 5);
-    EXPECT_GT(apartOnlyAcrossEdges, 0) << "the 15-axis reference must separate some pairs the face axes do not";
+    // The sample holds such pairs, so agreeing with the face-axis reference above tells this
+    // test from the 15-axis one.
+    EXPECT_GT(apartOnlyAcrossEdges, 0);
 }
 
 TEST(BoundingVolume, MixedTestsAgreeWithSampling) {

@@ -251,3 +251,26 @@ TEST(TriangleGap, ALowerBoundOnTheDistanceThatKeepsPairsApart) {
     }
     EXPECT_GT(apart, 1000);
 }
+
+TEST(TriangleGap, StoppedAtEnoughItStillBoundsTheFullGap) {
+    // With `enough`, it may stop at the first axis whose gap exceeds it: the result is then
+    // above `enough` and at most the full gap; when the full gap does not exceed `enough`, the
+    // result is the full gap itself (no axis stops it).
+    std::mt19937 rng(5);
+    int stopped = 0;
+    for (int k = 0; k < 3000; ++k) {
+        const Triangle x = randomTriangle(rng), y = randomTriangle(rng);
+        const double gap = triangleGap(x, y);
+        for (const double enough : {0.0, 0.25 * gap, 0.5 * gap, 0.999 * gap, gap, 2.0 * gap}) {
+            const double early = triangleGap(x, y, enough);
+            EXPECT_LE(early, gap) << "pair " << k;
+            if (gap > enough) {
+                EXPECT_GT(early, enough) << "pair " << k;
+                stopped += early < gap;
+            } else {
+                EXPECT_EQ(early, gap) << "pair " << k;
+            }
+        }
+    }
+    EXPECT_GT(stopped, 100) << "some searches must stop before the widest axis";
+}
