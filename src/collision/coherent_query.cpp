@@ -160,15 +160,14 @@ bool advanceTake(PairCoherence::Take& t, std::size_t budget, const Bvh<BA>& bvhA
     stats.volumeTests += walk.volumeTests;
     t.nodes += walk.volumeTests;
     if (!t.stack.empty()) return false;
-    if (!settling && deferred) return true;  // in traversal order: sorting every near pair would cost the scan more than it saves
-    for (std::size_t spent = walk.volumeTests; t.settledUpTo < t.candidates.size(); ++t.settledUpTo) {
-        PairCoherence::Candidate& k = t.candidates[t.settledUpTo];
-        if (k.settled) continue;
-        if (spent >= budget) return false;
-        settle(k, 0.0, margin, tester);
-        spent += kSettleNodes;
+    if (deferred) {  // the record settled nothing: settle now, or leave all to the scans
+        if (!settling) return true;  // in traversal order: sorting every near pair would cost the scan more than it saves
+        for (std::size_t spent = walk.volumeTests; t.settledUpTo < t.candidates.size(); ++t.settledUpTo, spent += kSettleNodes) {
+            if (spent >= budget) return false;
+            settle(t.candidates[t.settledUpTo], 0.0, margin, tester);
+        }
+        dropUnreachable(t);
     }
-    dropUnreachable(t);
     std::sort(t.candidates.begin(), t.candidates.end(),
               [](const PairCoherence::Candidate& x, const PairCoherence::Candidate& y) { return std::tie(x.faceA, x.faceB) < std::tie(y.faceA, y.faceB); });
     t.sorted = true;
