@@ -13,8 +13,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <set>
+#include <tuple>
 
 using namespace flexfit;
 using flexfit::testing::expectSameContacts;
@@ -260,6 +262,54 @@ TEST(CoherentQuery, AGapMeasuredAfterTheTakeCountsTheMotionBeforeIt) {
     }
     EXPECT_EQ(coherence.traversals, 1u) << "one list, taken by the first query, answers all three";
     EXPECT_FALSE(coherence.walking) << "no walk began: every motion stayed within a quarter of the margin";
+}
+
+TEST(CoherentQuery, AWalkedTakeSettlesItsPairsOverSeveralQueries) {
+    // A rigid A's walked take settles its near pairs after its traversal, a slice of the walk's
+    // budget a query (kSettleNodes each). A ball in the torus's hole drifting slowly up and down
+    // through where it comes off the ring (a fiftieth of the margin a query; about 2,000 near
+    // pairs a take): some walk must be seen between slices with pairs settled and pairs left,
+    // every answer is the full query's, and each list in use after a walk has all its pairs
+    // settled and sorted.
+    Part torus(buildPartModel(makeTorus(3.0, 1.0, 64, 32)), rigidPart());
+    Part ball(buildPartModel(makeIcoSphere(2.2, 3)), rigidPart());
+    PairRun run(torus, ball, {BoundingVolumeKind::Aabb, ExactTest::TriangleTriangle});
+    // The ball sits in the torus's hole, touching it along a ring: many near pairs.
+    auto at = [&](double y) { ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(0.0, y, 0.0)}); };
+    // Where the ball comes off the ring, by bisection on the full query.
+    double inside = 0.5, outside = 3.0;
+    for (int i = 0; i < 60; ++i) {
+        at(0.5 * (inside + outside));
+        std::vector<Contact> full;
+        QueryStats ignored;
+        queryPair(0, torus, run.ca, 1, ball, run.cb, ExactTest::TriangleTriangle, full, ignored);
+        (full.empty() ? outside : inside) = 0.5 * (inside + outside);
+    }
+    at(outside);
+    run.check(0, false);
+    const double margin = run.coherence.list.margin;
+    ASSERT_GT(margin, 0.0);
+    int midSettle = 0, walkedLists = 0, contacts = 0;
+    double y = outside + 0.5 * margin;
+    for (int step = 1; step < 120; ++step) {
+        y += (step % 100 < 50 ? -0.02 : 0.02) * margin;  // 50 queries down, 50 up: -0.5 to +0.5 margin
+        at(y);
+        const std::uint64_t before = run.coherence.traversals;
+        contacts += int(run.check(step, step == 50) > 0);
+        const PairCoherence::Take& next = run.coherence.next;
+        if (run.coherence.walking && next.stack.empty() && next.settledUpTo > 0 && next.settledUpTo < next.candidates.size())
+            ++midSettle;
+        if (run.coherence.traversals > before && run.coherence.list.sorted) {
+            ++walkedLists;
+            for (const PairCoherence::Candidate& k : run.coherence.list.candidates) EXPECT_TRUE(k.settled) << "step " << step;
+            EXPECT_TRUE(std::is_sorted(run.coherence.list.candidates.begin(), run.coherence.list.candidates.end(),
+                                       [](const auto& p, const auto& q) { return std::tie(p.faceA, p.faceB) < std::tie(q.faceA, q.faceB); }));
+        }
+    }
+    EXPECT_GT(contacts, 0) << "the ball reaches the torus";
+    EXPECT_GT(walkedLists, 0) << "some list came from a walk";
+    EXPECT_GT(midSettle, 0) << "no walk was seen settling across queries";
+    RecordProperty("queries_mid_settle", midSettle);
 }
 
 TEST(CoherentQueryCost, MotionThatOutrunsEveryListIsAnsweredByPlainQueriesUntilItSlows) {
