@@ -69,9 +69,8 @@ bool overlap(const Sphere& a, const Sphere& b, const RelativePose& bInA);
 // pairs. It errs only towards overlap: a traversal may descend further, never miss a leaf pair.
 bool overlapRotated(const Aabb& a, const Aabb& b, const RelativePose& bInA);
 // Inline: the traversals call it per node pair, and parts not turned against each other (a
-// tool moved without rotation, parts at rest) need only the plain box test. Boxes turned
-// against each other are tested on their 6 face axes only (overlapRotated): conservative, it
-// may report two boxes apart along an edge-edge axis as overlapping.
+// tool moved without rotation, parts at rest) need only the plain box test; turned boxes go
+// to overlapRotated.
 inline bool overlap(const Aabb& a, const Aabb& b, const RelativePose& bInA) {
     if (!bInA.pureTranslation) return overlapRotated(a, b, bInA);
     const Vec3 bMin = b.min + bInA.translation, bMax = b.max + bInA.translation;

@@ -176,8 +176,8 @@ struct PairCoherence {
     // and the colliders' vertex drifts and generations when it began. A traversal may be spread over
     // several queries (`stack` holds the node pairs left); it tests every node at `pose`.
     struct Take {
-        std::vector<Candidate> candidates;  // sorted by (faceA, faceB) once complete, unless `sorted` is false
-        bool sorted = false;                // (a take finished at once with candidates to settle stays in traversal order)
+        std::vector<Candidate> candidates;  // in traversal order, by (faceA, faceB) once `sorted`
+        bool sorted = false;                // set when complete, unless finished at once with pairs left to settle
         RelativePose pose;
         double margin = 0.0;
         double vertexDriftA = 0.0, vertexDriftB = 0.0;

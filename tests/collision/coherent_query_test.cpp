@@ -45,6 +45,22 @@ std::set<std::pair<Index, Index>> bruteForceContacts(const Part& a, const Part& 
 
 using flexfit::testing::pairsOf;
 
+// Where along a line of poses the full query's contacts end, by bisection: at(s) poses the
+// parts; `inside` touches and `outside` does not. Returns the last `outside`, 2^-60 of the
+// interval from the edge.
+template <class At>
+double contactEdge(At at, const Part& a, const PartCollider& ca, const Part& b, const PartCollider& cb, double inside,
+                   double outside) {
+    for (int i = 0; i < 60; ++i) {
+        at(0.5 * (inside + outside));
+        std::vector<Contact> full;
+        QueryStats ignored;
+        queryPair(0, a, ca, 1, b, cb, ExactTest::TriangleTriangle, full, ignored);
+        (full.empty() ? outside : inside) = 0.5 * (inside + outside);
+    }
+    return outside;
+}
+
 // A small random rigid motion: a turn of up to `turn` radians about a random axis (about the
 // part's origin) and a shift of up to `shift`; now and then (1 in 25) a jump ten times as large.
 Pose nudged(const Pose& pose, std::mt19937& rng, double shift, double turn) {
@@ -226,12 +242,7 @@ TEST(CoherentQuery, AGapMeasuredAfterTheTakeCountsTheMotionBeforeIt) {
         queryPair(0, torus, ct, 1, ball, cb, ExactTest::TriangleTriangle, out, ignored);
         return out;
     };
-    // Where the ball meets the torus's outer side, by bisection on the full query.
-    double inside = 4.5, outside = 5.5;
-    for (int i = 0; i < 60; ++i) {
-        at(0.5 * (inside + outside));
-        (full().empty() ? outside : inside) = 0.5 * (inside + outside);
-    }
+    const double outside = contactEdge(at, torus, ct, ball, cb, 4.5, 5.5);  // where the ball meets the torus's outer side
     double margin = 0.0;
     {
         PairCoherence probe;
@@ -275,15 +286,7 @@ TEST(CoherentQuery, AWalkedTakeSettlesItsPairsOverSeveralQueries) {
     PairRun run(torus, ball, {BoundingVolumeKind::Aabb, ExactTest::TriangleTriangle});
     // The ball sits in the torus's hole, touching it along a ring: many near pairs.
     auto at = [&](double y) { ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(0.0, y, 0.0)}); };
-    // Where the ball comes off the ring, by bisection on the full query.
-    double inside = 0.5, outside = 3.0;
-    for (int i = 0; i < 60; ++i) {
-        at(0.5 * (inside + outside));
-        std::vector<Contact> full;
-        QueryStats ignored;
-        queryPair(0, torus, run.ca, 1, ball, run.cb, ExactTest::TriangleTriangle, full, ignored);
-        (full.empty() ? outside : inside) = 0.5 * (inside + outside);
-    }
+    const double outside = contactEdge(at, torus, run.ca, ball, run.cb, 0.5, 3.0);  // where the ball comes off the ring
     at(outside);
     run.check(0, false);
     const double margin = run.coherence.list.margin;
