@@ -3,6 +3,7 @@
 #include "collision/pair_query.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <tuple>
@@ -93,11 +94,19 @@ void PartCollider::rebuild(const Part& part) {
 
 void PartCollider::updateDisplacementBound(const Part& part) {
     // The largest squared norm, then one square root: sqrt is monotonic and correctly rounded,
-    // so this is exactly the largest norm, without a root per moving mass every refit.
-    double largest2 = 0.0;
-    for (Index m : part.movingMasses())
-        largest2 = std::max(largest2, (part.state().positions[m] - part.model().restPositions[m]).squaredNorm());
-    maxDisplacement_ = std::sqrt(largest2);
+    // so this is exactly the largest norm, without a root per moving mass every refit. Four
+    // running maxima, not one: the loop waited on each max's latency (max is exact, so the
+    // same value in any order; a NaN never wins, as before).
+    const std::span<const Index> moving = part.movingMasses();
+    const std::vector<Vec3>& positions = part.state().positions;
+    const std::vector<Vec3>& rest = part.model().restPositions;
+    const auto squaredMove = [&](Index m) { return (positions[m] - rest[m]).squaredNorm(); };
+    std::array<double, 4> largest2{};
+    std::size_t i = 0;
+    for (; i + 4 <= moving.size(); i += 4)
+        for (std::size_t j = 0; j < 4; ++j) largest2[j] = std::max(largest2[j], squaredMove(moving[i + j]));
+    for (; i < moving.size(); ++i) largest2[0] = std::max(largest2[0], squaredMove(moving[i]));
+    maxDisplacement_ = std::sqrt(std::max(std::max(largest2[0], largest2[1]), std::max(largest2[2], largest2[3])));
 }
 
 void PartCollider::refit(const Part& part, std::span<const Index> changedMasses) {

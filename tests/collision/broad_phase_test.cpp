@@ -59,3 +59,29 @@ TEST(BroadPhase, ADeformedPartsSphereGrowsByItsLargestDisplacement) {
     world.update();
     EXPECT_NEAR(world.collider(0).localSphere().radius, rest + largest, 1e-12);
 }
+
+// The bound against brute force with the largest move placed at each position of the moving
+// list in turn: every lane of its running maxima and the list's tail (a count not a multiple of
+// 4). Exact: the largest squared norm's root is the largest norm.
+TEST(BroadPhase, TheDisplacementBoundIsTheLargestMoveWhereverItLies) {
+    const auto model = buildPartModel(makeTorus1());
+    PartSettings loose;
+    loose.simulation.restoration.method = RestorationMethod::None;
+    Part part(model, loose);
+    CollisionWorld world;
+    world.add(0, part);
+    world.update();
+    const double rest = world.collider(0).localSphere().radius;
+    part.applyForce(0, Vec3(-1.0, 0.0, 0.0));
+    part.step();
+    const std::vector<Index> moving(part.movingMasses().begin(), part.movingMasses().end());
+    ASSERT_GE(moving.size(), 5u);  // at least one group of 4
+    ASSERT_NE(moving.size() % 4, 0u);
+    for (std::size_t k = 0; k < moving.size(); ++k) {
+        part.displaceMass(moving[k], Vec3(0.0, 0.0, 0.01 * double(k + 1)));  // each larger than the last
+        double largest = 0.0;
+        for (Index m : part.movingMasses()) largest = std::max(largest, (part.state().positions[m] - model->restPositions[m]).norm());
+        world.update();
+        EXPECT_EQ(world.collider(0).localSphere().radius, rest + largest) << "largest at " << k << " of " << moving.size();
+    }
+}
