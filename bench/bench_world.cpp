@@ -69,9 +69,9 @@ void stepInContact(benchmark::State& state, const char* file, bool push, int set
 
 // The machine's own tail, for reading the steps' p99 beside it: the same work every time (a
 // read-modify-write walk of kNoiseDoubles doubles, 4 MB, with a stride coprime to its size,
-// about 135 us a repetition on the Intel machine), timed kNoiseRepetitions times. Whatever spread its times
-// show is the machine's (interrupts, the hypervisor, caches shared with other guests), not the
-// work's.
+// about 130 us a repetition on the Intel machine), timed kNoiseRepetitions times. Whatever
+// spread its times show is the machine's (interrupts, the hypervisor, caches shared with other
+// guests), not the work's.
 constexpr std::size_t kNoiseDoubles = std::size_t(1) << 19;
 constexpr std::size_t kNoiseTouches = 56 * 1024;
 constexpr int kNoiseRepetitions = 3000;
