@@ -28,6 +28,14 @@ Scene scene(const char* file, bool push, bool faceQuery) {
     return s;
 }
 
+// p50 and p99 (nearest rank) of the timed steps, in µs, and their ratio. One set of names for
+// every benchmark here: Google Benchmark's CSV has one header.
+void setTailCounters(benchmark::State& state, const std::vector<double>& micros) {
+    state.counters["us_world_step_p50"] = nearestRankPercentile(micros, 50.0);
+    state.counters["us_world_step_p99"] = nearestRankPercentile(micros, 99.0);
+    state.counters["p99_over_p50"] = state.counters["us_world_step_p99"] / state.counters["us_world_step_p50"];
+}
+
 void stepInContact(benchmark::State& state, const char* file, bool push, int settle, bool faceQuery = false) {
     const Scene base = scene(file, push, faceQuery);
     double seconds = 0.0, contacts = 0.0, moving = 0.0;
@@ -62,9 +70,7 @@ void stepInContact(benchmark::State& state, const char* file, bool push, int set
     state.counters["moving_masses"] = moving / n;
     for (std::size_t s = 0; s < stages.size(); ++s) state.counters[std::string("us_") + toString(Stage(s))] = 1e6 * stages[s] / (n * kTimedSteps);
     state.counters["us_world_step"] = 1e6 * stepSeconds / (n * kTimedSteps);
-    state.counters["us_world_step_p50"] = nearestRankPercentile(stepMicros, 50.0);
-    state.counters["us_world_step_p99"] = nearestRankPercentile(stepMicros, 99.0);
-    state.counters["p99_over_p50"] = state.counters["us_world_step_p99"] / state.counters["us_world_step_p50"];
+    setTailCounters(state, stepMicros);
 }
 
 // The machine's own tail, for reading the steps' p99 beside it: the same work every time (a
@@ -98,10 +104,7 @@ void BM_FixedWorkTail(benchmark::State& state) {
         state.SetIterationTime(seconds);
     }
     benchmark::DoNotOptimize(sum);
-    // The step benchmarks' column names (a CSV has one header): here a repetition's times.
-    state.counters["us_world_step_p50"] = nearestRankPercentile(micros, 50.0);
-    state.counters["us_world_step_p99"] = nearestRankPercentile(micros, 99.0);
-    state.counters["p99_over_p50"] = state.counters["us_world_step_p99"] / state.counters["us_world_step_p50"];
+    setTailCounters(state, micros);  // the step benchmarks' column names: here a repetition's times
 }
 
 // Pushed with 2,500 through the mouth: the timed steps start 20 steps after the first contact,

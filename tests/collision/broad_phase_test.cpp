@@ -40,48 +40,56 @@ TEST(BroadPhase, EqualsBruteForceAndRefitEqualsRebuild) {
     }
 }
 
-TEST(BroadPhase, ADeformedPartsSphereGrowsByItsLargestDisplacement) {
-    const auto model = buildPartModel(makeTorus1());
-    PartSettings loose;
-    loose.simulation.restoration.method = RestorationMethod::None;
-    Part part(model, loose);
-    CollisionWorld world;
-    world.add(0, part);
-    world.update();
-    const double rest = world.collider(0).localSphere().radius;
-    for (int i = 0; i < 200; ++i) {
-        part.applyForce(0, Vec3(-20.0, 0.0, 0.0));
-        part.step();
+// torus1 with no restoration (its deformation stays) in a collision world, with its bounding
+// radius at rest and the brute-force largest displacement of its moving masses.
+struct LooseTorus {
+    static PartSettings loose() {
+        PartSettings settings;
+        settings.simulation.restoration.method = RestorationMethod::None;
+        return settings;
     }
-    double largest = 0.0;
-    for (Index m : part.movingMasses()) largest = std::max(largest, (part.state().positions[m] - model->restPositions[m]).norm());
+    LooseTorus() {
+        world.add(0, part);
+        world.update();
+        restRadius = world.collider(0).localSphere().radius;
+    }
+    double largestMove() const {
+        double largest = 0.0;
+        for (Index m : part.movingMasses()) largest = std::max(largest, (part.state().positions[m] - model->restPositions[m]).norm());
+        return largest;
+    }
+    std::shared_ptr<const PartModel> model = buildPartModel(makeTorus1());
+    Part part{model, loose()};
+    CollisionWorld world;
+    double restRadius = 0.0;
+};
+
+TEST(BroadPhase, ADeformedPartsSphereGrowsByItsLargestDisplacement) {
+    LooseTorus t;
+    for (int i = 0; i < 200; ++i) {
+        t.part.applyForce(0, Vec3(-20.0, 0.0, 0.0));
+        t.part.step();
+    }
+    const double largest = t.largestMove();
     ASSERT_GT(largest, 0.1);
-    world.update();
-    EXPECT_NEAR(world.collider(0).localSphere().radius, rest + largest, 1e-12);
+    t.world.update();
+    EXPECT_NEAR(t.world.collider(0).localSphere().radius, t.restRadius + largest, 1e-12);
 }
 
 // The bound against brute force with the largest move placed at each position of the moving
 // list in turn: every lane of its running maxima and the list's tail (a count not a multiple of
 // 4). Exact: the largest squared norm's root is the largest norm.
 TEST(BroadPhase, TheDisplacementBoundIsTheLargestMoveWhereverItLies) {
-    const auto model = buildPartModel(makeTorus1());
-    PartSettings loose;
-    loose.simulation.restoration.method = RestorationMethod::None;
-    Part part(model, loose);
-    CollisionWorld world;
-    world.add(0, part);
-    world.update();
-    const double rest = world.collider(0).localSphere().radius;
-    part.applyForce(0, Vec3(-1.0, 0.0, 0.0));
-    part.step();
-    const std::vector<Index> moving(part.movingMasses().begin(), part.movingMasses().end());
+    LooseTorus t;
+    t.part.applyForce(0, Vec3(-1.0, 0.0, 0.0));
+    t.part.step();
+    const std::vector<Index> moving(t.part.movingMasses().begin(), t.part.movingMasses().end());
     ASSERT_GE(moving.size(), 5u);  // at least one group of 4
     ASSERT_NE(moving.size() % 4, 0u);
     for (std::size_t k = 0; k < moving.size(); ++k) {
-        part.displaceMass(moving[k], Vec3(0.0, 0.0, 0.01 * double(k + 1)));  // each larger than the last
-        double largest = 0.0;
-        for (Index m : part.movingMasses()) largest = std::max(largest, (part.state().positions[m] - model->restPositions[m]).norm());
-        world.update();
-        EXPECT_EQ(world.collider(0).localSphere().radius, rest + largest) << "largest at " << k << " of " << moving.size();
+        t.part.displaceMass(moving[k], Vec3(0.0, 0.0, 0.01 * double(k + 1)));  // each larger than the last
+        const double largest = t.largestMove();
+        t.world.update();
+        EXPECT_EQ(t.world.collider(0).localSphere().radius, t.restRadius + largest) << "largest at " << k << " of " << moving.size();
     }
 }
