@@ -152,13 +152,16 @@ struct RegionWork {
 
 // Whether stepRegionByFullModel costs less than stepActiveRegion for a region doing `work`. A
 // rule on counts alone, so every machine chooses alike and a run's bits do not depend on the
-// CPU: the region step costs about 11.5 ns a loose spring (in the order the zones grew: its ends
-// and constants are random reads), 2.9 ns a block lane and 2 ns a moving mass; the full step
-// about 2.8 ns a spring by spring blocks and 5.8 ns listed (in index order), plus 0.3 ns per mass
-// put back (fitted on this project's machine, AVX-512, to both steps timed at 4-7 coverages on
-// torus1, torus2, the heart, the shuffled heart and the same renumbered for locality,
-// 2026-12-03). The cheaper estimate wins: near the crossover both cost the same. On CPUs without
-// AVX2 both steps run scalar, at 2-3 times these costs in about the same ratios.
+// CPU: the region step costs about 5 ns a loose spring on a part of a few hundred masses, rising
+// to 8 ns from 7,000 masses (its ends and constants are gathered, in the order the zones grew:
+// dearer once the state outgrows the nearest caches), 2.7 ns a block lane and 2 ns a moving
+// mass; the full step about 2.8 ns a spring by spring blocks and 6 ns listed (in index order),
+// plus 0.3 ns per mass put back. Fitted 2026-12-05 to bench_zone_coverage's records on three
+// machines (AMD EPYC with AVX2, two Intel Xeons with AVX-512), torus1, torus2, the heart, the
+// shuffled heart, the same renumbered for locality and a 24,576-mass torus: wherever one path
+// was 10 % cheaper on every record, the rule picks it (tests/dynamics/region_step_test.cpp).
+// The cheaper estimate wins: near the crossover both cost the same. On CPUs without AVX2 both
+// steps run scalar, at 2-3 times these costs in about the same ratios.
 bool fullStepCostsLess(const PartModel& model, const RegionWork& work);
 
 // Total kinetic + spring + anchor potential energy (no gravity), and linear momentum.

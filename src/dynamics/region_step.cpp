@@ -49,14 +49,16 @@ RegionWork RegionWork::of(const ActiveRegion& region) {
 }
 
 bool fullStepCostsLess(const PartModel& model, const RegionWork& work) {
-    // Costs in ns on the reference machine (simulation.hpp); only their ratios matter.
-    constexpr double kRegionSpring = 11.5, kRegionBlockLane = 2.9, kRegionMass = 2.0;
-    constexpr double kBlockSpring = 2.8, kListedSpring = 5.8, kPutBack = 0.3;
-    // No margin: near the crossover the two cost the same, and a margin towards the region step
-    // let a renumbered heart's zones at 66 % cost 1.13x its whole model. (In a world the full
-    // step's streaming also evicts what the collision stages keep in cache: measured on the
-    // haptic scene, ~35 % of the springs, no difference either way.)
-    const double region = kRegionSpring * double(work.looseSprings) + kRegionBlockLane * double(work.blockLanes) +
+    // Costs in ns on the reference machine (simulation.hpp); only their ratios matter. A loose
+    // spring's ends and constants are gathered: it costs more once the part's state outgrows
+    // the nearest caches, fitted as a ramp over the mass count (576 to 7,349 masses measured).
+    const double regionSpring = 5.0 + 3.0 * std::min(1.0, double(model.massCount()) / 7000.0);
+    constexpr double kRegionBlockLane = 2.7, kRegionMass = 2.0;
+    constexpr double kBlockSpring = 2.8, kListedSpring = 6.0, kPutBack = 0.3;
+    // No margin: near the crossover the two cost the same. (In a world the full step's
+    // streaming also evicts what the collision stages keep in cache: measured on the haptic
+    // scene, ~35 % of the springs, no difference either way.)
+    const double region = regionSpring * double(work.looseSprings) + kRegionBlockLane * double(work.blockLanes) +
                           kRegionMass * double(work.movingMasses);
     const std::size_t blocked = model.springBlocks->blockCount() * SpringBlocks::kWidth;
     const double full = kBlockSpring * double(blocked) + kListedSpring * double(model.springCount() - blocked) +

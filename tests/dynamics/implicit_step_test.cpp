@@ -266,7 +266,7 @@ TEST(ImplicitStep, PartsKeepTheRegionStepAtAnyCoverage) {
     settings.simulation = implicitSettings(1e-3);
     settings.simulation.implicit.tolerance = 1e-6;
     Part part(model, settings);
-    part.openZone(ZoneSeed::mass(0), 11);
+    part.openZone(ZoneSeed::mass(0), 13);
     ASSERT_GT(part.computedSprings().size(), model->springCount() / 2);
     ASSERT_LT(part.computedSprings().size(), model->springCount());
     ASSERT_TRUE(fullStepCostsLess(*model, RegionWork::of(part.region())));  // the explicit step would take the full step

@@ -162,27 +162,50 @@ TEST(RegionStep, ByTheFullModelHoldsInTheIntegrationPassBitForBit) {
 // The rule on counts: by spring blocks the full step is chosen past about 35 % of the springs
 // when the region's springs are loose, past about 80 % when they fill vector blocks; with every
 // spring listed (no blocks) past about 50 % (simulation.hpp).
-TEST(RegionStep, TheFullStepIsChosenWhenItCostsLess) {
-    const auto blocks = buildPartModel(makeHeart());
-    const auto listed = buildPartModel(flexfit::testing::shuffledVertices(makeHeart(), 3));
-    ASSERT_TRUE(blocks->hasSpringBlocks());
-    ASSERT_FALSE(listed->hasSpringBlocks());
-    const std::size_t springs = blocks->springCount(), masses = blocks->massCount();
-    auto share = [&](double s) { return std::size_t(s * double(springs)); };
-    auto massShare = [&](double s) { return std::size_t(s * double(masses)); };
-    // A region of `computed` springs, `inBlocks` of them as block lanes, `moving` masses.
-    auto costsLess = [](const PartModel& m, std::size_t computed, std::size_t moving, std::size_t inBlocks = 0) {
-        return fullStepCostsLess(m, RegionWork{computed - inBlocks, inBlocks, moving});
+std::shared_ptr<const PartModel> inLocalityOrder(TriMesh mesh) {
+    PartModelSettings s;
+    s.vertexOrder = VertexOrder::Locality;
+    return buildPartModel(std::move(mesh), s);
+}
+
+// The rule against measurement: bench_zone_coverage's regions (six zones, levels 2-24; 4-48 on
+// the large torus) timed by both paths on three machines (AMD EPYC with AVX2, two Intel Xeons
+// with AVX-512; bench/results/zone_coverage*.csv). Wherever every record found one path at
+// least 10 % cheaper, the rule must choose it; nearer the crossover either is within 10 %.
+TEST(RegionStep, TheFullStepIsChosenWhereMeasuredCheaper) {
+    struct Measured {
+        RegionWork work;
+        bool fullCheaper;
     };
-    EXPECT_FALSE(costsLess(*blocks, share(0.1), massShare(0.1)));
-    EXPECT_FALSE(costsLess(*blocks, share(0.2), massShare(0.2)));
-    EXPECT_TRUE(costsLess(*blocks, share(0.4), massShare(0.4)));
-    EXPECT_FALSE(costsLess(*blocks, share(0.4), massShare(0.4), share(0.4)));
-    EXPECT_FALSE(costsLess(*blocks, share(0.6), massShare(0.6), share(0.55)));  // measured: 58 against 66 us
-    EXPECT_TRUE(costsLess(*blocks, share(0.9), massShare(0.9), share(0.85)));
-    EXPECT_FALSE(costsLess(*listed, share(0.4), massShare(0.4)));
-    EXPECT_TRUE(costsLess(*listed, share(0.55), massShare(0.55)));
-    EXPECT_TRUE(costsLess(*listed, share(0.9), massShare(0.9)));
+    struct Mesh {
+        const char* name;
+        std::shared_ptr<const PartModel> model;
+        std::vector<Measured> rows;  // {loose springs, block lanes, moving masses}
+    };
+    const std::vector<Mesh> meshes = {
+        {"torus1", buildPartModel(makeTorus1()),
+         {{{180, 0, 42}, false}, {{552, 0, 168}, false}, {{200, 952, 360}, false}, {{200, 1528, 552}, true}}},
+        {"torus2", buildPartModel(makeTorus2()),
+         {{{180, 0, 42}, false}, {{483, 424, 222}, false}, {{710, 1968, 798}, false}, {{770, 3280, 1242}, true}}},
+        {"heart", buildPartModel(makeHeart()),
+         {{{356, 280, 135}, false}, {{523, 1896, 661}, false}, {{794, 6048, 2065}, false},
+          {{708, 9912, 3361}, false}, {{679, 12944, 4383}, false}}},
+        {"heart shuffled", buildPartModel(flexfit::testing::shuffledVertices(makeHeart(), 3)),
+         {{{207, 0, 49}, false}, {{820, 0, 233}, false}, {{3112, 0, 957}, false}, {{6611, 0, 2081}, false},
+          {{19280, 0, 6352}, true}}},
+        {"heart shuffled, locality order", inLocalityOrder(flexfit::testing::shuffledVertices(makeHeart(), 3)),
+         {{{203, 8, 49}, false}, {{473, 608, 259}, false}, {{1326, 2992, 1169}, false}, {{1763, 8424, 3102}, false},
+          {{2212, 19024, 6937}, true}}},
+        {"large torus shuffled, locality order",
+         inLocalityOrder(flexfit::testing::shuffledVertices(makeTorus(10.0, 2.5, 256, 96), 3)),
+         {{{516, 376, 222}, false}, {{760, 2808, 1014}, false}, {{1890, 12232, 4326}, false},
+          {{2942, 27600, 9632}, false}, {{4538, 64688, 22891}, true}}},
+    };
+    for (const Mesh& mesh : meshes)
+        for (const Measured& row : mesh.rows)
+            EXPECT_EQ(fullStepCostsLess(*mesh.model, row.work), row.fullCheaper)
+                << mesh.name << ": " << row.work.looseSprings << " loose springs, " << row.work.blockLanes
+                << " block lanes, " << row.work.movingMasses << " moving masses";
 }
 
 TEST(RegionStep, CostsTheRegionAndConsumesItsForces) {
