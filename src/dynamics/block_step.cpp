@@ -169,7 +169,7 @@ void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, Pa
 }
 
 void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel,
-                      const std::uint16_t* held) {
+                      const std::uint16_t* held, PositionCheck* check) {
     const double* x = state.positions.data()->data();
     const double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
@@ -177,11 +177,16 @@ void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartStat
     listedSpringForces(model, model.springBlocks->remainder, nullptr, x, v, f, kernel);
     std::size_t integrated = 0, heldDone = 0;  // what the vector kernels did; the scalar passes finish
 #if defined(FLEXFIT_X86_KERNELS)
-    if (kernel == BlockKernel::Avx512) heldDone = integrated = integrateAvx512(model, update, state, held);
-    if (kernel == BlockKernel::Avx2) heldDone = integrated = integrateAvx2(model, update, state, held);
+    if (kernel == BlockKernel::Avx512) heldDone = integrated = integrateAvx512(model, update, state, held, check);
+    if (kernel == BlockKernel::Avx2) heldDone = integrated = integrateAvx2(model, update, state, held, check);
 #endif
     integrateScalar(model, update, state, integrated);
     if (held != nullptr) holdAtRestFrom(model, held, state, heldDone);
+    if (check != nullptr && integrated > 0) {  // the masses after the vector groups, as the kernel checked those
+        const Vec3 origin = check->fromMassZero ? state.positions[0] : Vec3::Zero();
+        check->bits |= beyondBits(std::span<const Vec3>(state.positions).subspan(integrated), origin, check->carry);
+        check->covered = true;
+    }
 }
 
 }  // namespace flexfit::detail

@@ -25,19 +25,6 @@ inline std::uint64_t beyondBit(const Vec3& v, std::uint64_t carry) {
 inline std::uint64_t nonFiniteBit(double x) { return beyondBit(x, kExponentOne); }
 inline std::uint64_t nonFiniteBit(const Vec3& v) { return beyondBit(v, kExponentOne); }
 
-// The carry that flags a magnitude of 2^(e + 1) or more, e the exponent of `bound` (so values up
-// to `bound`, and below twice it, pass); only inf and nan for an infinite bound.
-std::uint64_t carryBeyond(double bound) {
-    if (!(bound < std::numeric_limits<double>::infinity())) return kExponentOne;
-    const std::uint64_t e = (std::bit_cast<std::uint64_t>(bound) & kExponent) >> 52;
-    return (0x800 - (e + 1)) << 52;
-}
-
-// Where a position bound is measured from: mass 0 (a spread); nowhere for no bound, so that
-// finite is enough (x - x0 of two finite values may overflow).
-Vec3 boundOrigin(const PartState& state, double positionBound) {
-    return positionBound < std::numeric_limits<double>::infinity() && !state.positions.empty() ? state.positions[0] : Vec3::Zero();
-}
 
 // The origin's coordinate for each of 8 masses' 24 doubles (x y z x y z ...).
 struct Origin24 {
@@ -65,9 +52,22 @@ std::string describe(const char* what, Index mass, const Vec3& value, const char
 
 bool allFinite(std::span<const Vec3> values) { return allWithin(values, Vec3::Zero(), std::numeric_limits<double>::infinity()); }
 
+std::uint64_t carryBeyond(double bound) {
+    if (!(bound < std::numeric_limits<double>::infinity())) return kExponentOne;
+    const std::uint64_t e = (std::bit_cast<std::uint64_t>(bound) & kExponent) >> 52;
+    return (0x800 - (e + 1)) << 52;
+}
+
+Vec3 boundOrigin(const PartState& state, double positionBound) {
+    return positionBound < std::numeric_limits<double>::infinity() && !state.positions.empty() ? state.positions[0] : Vec3::Zero();
+}
+
 bool allWithin(std::span<const Vec3> values, const Vec3& origin, double bound) {
-    if (values.empty()) return true;
-    const std::uint64_t carry = carryBeyond(bound);
+    return noneBeyond(beyondBits(values, origin, carryBeyond(bound)));
+}
+
+std::uint64_t beyondBits(std::span<const Vec3> values, const Vec3& origin, std::uint64_t carry) {
+    if (values.empty()) return 0;
     const Origin24 origin24(origin);
     const double* p = values.data()->data();
     const std::size_t n = 3 * values.size();
@@ -77,7 +77,7 @@ bool allWithin(std::span<const Vec3> values, const Vec3& origin, double bound) {
     std::uint64_t any = 0;
     for (; i < n; ++i) any |= beyondBit(p[i] - origin24.at[i % 3], carry);
     for (std::uint64_t lane : lanes) any |= lane;
-    return (any >> 63) == 0;
+    return any;
 }
 
 bool allFinite(const PartState& state, std::span<const Index> masses, double positionBound) {

@@ -17,6 +17,19 @@ bool allFinite(std::span<const Vec3> values);
 // True when every coordinate is finite and every value within `bound` of `origin` along each
 // axis (exactly: below the power of two above it; PartModel::positionBound).
 bool allWithin(std::span<const Vec3> values, const Vec3& origin, double bound);
+
+// allWithin in pieces, for a check made where the values are written (the full step's
+// integration pass, full_step.hpp). A double's exponent bits plus `carry` (carryBeyond(bound):
+// for a magnitude of 2^(e + 1) or more, e the exponent of `bound`; only inf and nan for an
+// infinite bound) carry into bit 63; or-ed over values less the origin, bit 63 says whether any
+// was beyond or not finite (noneBeyond).
+std::uint64_t carryBeyond(double bound);
+// Where a part's position bound is measured from: mass 0's position (a spread); zero for no
+// bound, so that finite is enough (x - x0 of two finite values may overflow).
+Vec3 boundOrigin(const PartState& state, double positionBound);
+// The or of every coordinate's bits, less the origin's.
+std::uint64_t beyondBits(std::span<const Vec3> values, const Vec3& origin, std::uint64_t carry);
+inline bool noneBeyond(std::uint64_t bits) { return (bits >> 63) == 0; }
 // True when every coordinate of the masses' positions, velocities and pending forces is
 // finite, and every position within `positionBound` of mass 0's (as allWithin).
 bool allFinite(const PartState& state, std::span<const Index> masses,

@@ -6,8 +6,11 @@
 // give the same bits (tested), so a run does not depend on the machine's vector unit.
 #pragma once
 
+#include "divergence.hpp"
 #include "mass_update.hpp"
 #include "model/spring_blocks.hpp"
+
+#include <limits>
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #define FLEXFIT_X86_KERNELS 1  // block_step_x86.cpp: AVX2 and AVX-512 by function target attributes
@@ -38,11 +41,28 @@ const char* toString(BlockKernel kernel);
 // fixes; the kernel must be available.
 void blockForces(const SpringBlocks& blocks, const double* x, const double* v, double* f, BlockKernel kernel);
 
+// The divergence check over the new positions (checkAllMassesFinite's, divergence.hpp), made
+// by the vector integration as it writes them instead of in a pass of its own (which cost
+// about 9 % of the heart's full step): the beyond-bits of x - origin or-ed into `bits`, the
+// origin being mass 0's new position (read back once the first group is written) when the
+// bound is finite, else zero. `covered` says whether every mass was checked (the scalar kernel
+// checks none: the caller then makes the whole check).
+struct PositionCheck {
+    explicit PositionCheck(double positionBound)
+        : carry(carryBeyond(positionBound)), fromMassZero(positionBound < std::numeric_limits<double>::infinity()) {}
+    std::uint64_t carry;
+    bool fromMassZero;
+    std::uint64_t bits = 0;
+    bool covered = false;
+    bool passed() const { return covered && noneBeyond(bits); }
+};
+
 // Springs by blocks, the remainder, then every mass. The kernel must be available. With
 // `held` (a cover count per mass), each mass whose count is 0 ends the step at rest instead,
 // velocity and force zero (what holdAtRest does after the step, in the integration's pass).
+// With `check`, the vector kernels check the new positions as they write them.
 void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel,
-                      const std::uint16_t* held = nullptr);
+                      const std::uint16_t* held = nullptr, PositionCheck* check = nullptr);
 
 // stepFullModel, or with `held` (cover counts) the full step standing for a region's
 // (stepRegionByFullModel): the masses no zone covers end the step at rest.
@@ -83,9 +103,12 @@ std::size_t listedSpringForcesAvx2(const PartModel& model, std::span<const Index
 std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
                                      const double* x, const double* v, double* f);
 // Integrates masses [0, n) for the largest n that is a multiple of the width (4, 8); returns n.
-// The masses whose `held` count is 0 (when given) end at rest, as holdAtRest leaves them.
-std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held);
-std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held);
+// The masses whose `held` count is 0 (when given) end at rest, as holdAtRest leaves them. With
+// `check` (n > 0), or-s the new positions' beyond-bits into it (PositionCheck).
+std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held,
+                          PositionCheck* check = nullptr);
+std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held,
+                            PositionCheck* check = nullptr);
 void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                            const double* x, const double* v, double* f);
 void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,

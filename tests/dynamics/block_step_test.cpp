@@ -391,3 +391,49 @@ TEST(BlockStep, ListedSpringsFollowTheListInEveryKernel) {
         }
     }
 }
+
+// The divergence check the vector integration makes as it writes the positions (PositionCheck)
+// against the separate pass over the positions it replaces (detail::beyondBits, measured from
+// mass 0's new position): the same or-ed bits exactly, whether the culprit is in the first
+// group (mass 0 itself, which moves the origin), a later one or the scalar tail, whatever it
+// is (not finite, beyond the bound, a hair within it), with and without held masses and with
+// an infinite bound. A torus of 35 masses: 4 groups of 8 and 3 masses after them (8 groups of
+// 4 and 3 for AVX2). The scalar kernel checks nothing (not covered: the caller checks).
+TEST(BlockStep, TheIntegrationPassChecksThePositionsAsTheSeparatePassWould) {
+    auto model = std::const_pointer_cast<PartModel>(buildPartModel(makeTorus(10.0, 2.5, 7, 5)));
+    ASSERT_EQ(model->massCount(), 35u);
+    const double bound = model->positionBound;
+    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+    // Position offsets that stay beyond, or within, the bound after one step's small moves.
+    const std::vector<std::pair<const char*, Vec3>> spoils = {
+        {"nothing", Vec3::Zero()},           {"nan", Vec3(nan, 0, 0)},          {"inf", Vec3(0, -inf, 0)},
+        {"3 bounds", Vec3(0, 0, 3.0 * bound)}, {"half a bound", Vec3(0.5 * bound, 0, 0)}};
+    std::vector<std::uint16_t> cover(35, 1);  // the masses checked above
+    std::fill(cover.begin() + 10, cover.begin() + 20, std::uint16_t(0));  // held: back to rest in the pass
+    for (const BlockKernel kernel : kAllKernels) {
+        if (!detail::blockKernelAvailable(kernel)) continue;
+        for (const double modelBound : {bound, inf}) {
+            model->positionBound = modelBound;
+            for (const std::uint16_t* held : std::vector<const std::uint16_t*>{nullptr, cover.data()})
+                for (const Index mass : {Index(0), Index(5), Index(13), Index(21), Index(33)})
+                    for (const auto& [name, offset] : spoils) {
+                        PartState state = kickedState(*model, 3);
+                        state.positions[mass] += offset;
+                        detail::PositionCheck check(model->positionBound);
+                        detail::stepSpringBlocks(*model, detail::MassUpdate::from(SimulationSettings{}), state, kernel, held, &check);
+                        const std::string where = std::string(detail::toString(kernel)) + ", mass " + std::to_string(mass) + " " + name +
+                                                  (held != nullptr ? ", held" : "") + (std::isinf(modelBound) ? ", no bound" : "");
+                        if (kernel == BlockKernel::Scalar) {
+                            EXPECT_FALSE(check.covered) << where;
+                            continue;
+                        }
+                        ASSERT_TRUE(check.covered) << where;
+                        const Vec3 origin = std::isinf(modelBound) ? Vec3::Zero() : state.positions[0];
+                        EXPECT_EQ(check.bits, detail::beyondBits(state.positions, origin, detail::carryBeyond(modelBound))) << where;
+                        const bool bad = std::string(name) == "nan" || std::string(name) == "inf" ||
+                                         (std::string(name) == "3 bounds" && !std::isinf(modelBound) && !(held && cover[mass] == 0));
+                        EXPECT_EQ(check.passed(), !bad) << where;
+                    }
+        }
+    }
+}
