@@ -163,7 +163,8 @@ public:
     // One step alone: advance() with the settings' time step and gravity, then
     // retireRestingZones(). Throws DivergenceError (core.hpp: "part", the time at the start of
     // the step) when a moving mass's position, velocity or force is no longer finite; the check
-    // costs O(moving masses).
+    // costs O(moving masses) (with semi-implicit Euler and a vector kernel, made as the step
+    // writes the positions).
     void step(StepCounters* counters = nullptr);
     // The moving masses by one step of context.timeStep, under context.gravity (world frame);
     // O(1) when nothing moves. Checks nothing but what stepFullModel checks (a world checks its
@@ -229,6 +230,9 @@ private:
     // Every mass changed (a step moved them all): O(1) instead of marking each.
     bool allChanged_ = false;
     bool fullModelStepped_ = false;  // the last advance() ran the full model's step (which checked every mass)
+    // advance(); with checkRegion, a region step checks its new positions as it writes them
+    // (step() then skips its own check): returns whether it did and found them within.
+    bool advanceChecking(const StepContext& context, StepCounters* counters, bool checkRegion);
     std::vector<Index> allMasses_;  // 0 .. V-1, built the first time every mass moves
 };
 

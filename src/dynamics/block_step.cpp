@@ -149,11 +149,12 @@ void listedSpringForces(const PartModel& model, std::span<const Index> springs, 
 }
 
 void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
-                     BlockKernel kernel) {
+                     BlockKernel kernel, PositionCheck* check) {
 #if defined(FLEXFIT_X86_KERNELS)
-    if (kernel == BlockKernel::Avx512) return integrateOctetsAvx512(model, update, octets, state);
-    if (kernel == BlockKernel::Avx2) return integrateOctetsAvx2(model, update, octets, state);
+    if (kernel == BlockKernel::Avx512) return integrateOctetsAvx512(model, update, octets, state, check);
+    if (kernel == BlockKernel::Avx2) return integrateOctetsAvx2(model, update, octets, state, check);
 #endif
+    (void)check;
     (void)kernel;
     for (const Index octet : octets)
         for (std::size_t i = 8 * std::size_t(octet); i < 8 * std::size_t(octet) + 8; ++i) integrateMass(model, update, state, i);

@@ -256,8 +256,9 @@ FLEXFIT_AVX512 inline __m512i orBeyondBits8(__m512i acc, __m512d x, __m512d orig
 // The origin's coordinates for the 3 vectors of `width` masses' 3 * width doubles.
 template <std::size_t kLanes>
 std::array<double, 3 * kLanes> originPattern(const PositionCheck& check, const PartState& state) {
+    const Vec3 origin = check.originKnown ? check.origin : check.fromMassZero ? state.positions[0] : Vec3::Zero();
     std::array<double, 3 * kLanes> at{};
-    for (std::size_t k = 0; k < at.size(); ++k) at[k] = check.fromMassZero ? state.positions[0][int(k % 3)] : 0.0;
+    for (std::size_t k = 0; k < at.size(); ++k) at[k] = origin[int(k % 3)];
     return at;
 }
 
@@ -273,9 +274,14 @@ FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate
     const __m512d h = _mm512_set1_pd(p.h), invH = _mm512_set1_pd(p.invH), drag = _mm512_set1_pd(p.drag);
     const __m512d anchor = _mm512_set1_pd(p.anchorStiffness), constraint = _mm512_set1_pd(p.constraint);
     const bool anchored = p.anchorStiffness != 0.0, readsRest = p.readsRest();
-    // The check needs mass 0 in group 0: the whole model's pass, not an octet list's.
-    check = octets == nullptr && groups > 0 ? check : nullptr;
+    // Without a known origin the check needs mass 0 in group 0: the whole model's pass.
+    check = check != nullptr && groups > 0 && (check->originKnown || octets == nullptr) ? check : nullptr;
+    bool haveOrigin = check != nullptr && check->originKnown;
     __m512d origin[3] = {};
+    if (haveOrigin) {
+        const auto at = originPattern<8>(*check, state);
+        for (int j = 0; j < 3; ++j) origin[j] = _mm512_loadu_pd(at.data() + 8 * j);
+    }
     __m512i beyond = _mm512_setzero_si512();
     const __m512i carry = _mm512_set1_epi64(check != nullptr ? std::int64_t(check->carry) : 0);
     for (std::size_t g = 0; g < groups; ++g) {
@@ -310,17 +316,18 @@ FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate
                 xn = _mm512_mask_loadu_pd(xn, atRest, rest + o);
                 vn = _mm512_mask_mov_pd(vn, atRest, _mm512_setzero_pd());
             }
-            if (g > 0 && check != nullptr) beyond = orBeyondBits8(beyond, xn, origin[j], carry);
+            if (haveOrigin) beyond = orBeyondBits8(beyond, xn, origin[j], carry);
             _mm512_storeu_pd(x + o, xn);
             _mm512_storeu_pd(v + o, vn);
             _mm512_storeu_pd(f + o, _mm512_setzero_pd());
         }
-        if (g == 0 && check != nullptr) {  // mass 0 written: the origin, then this group from memory
+        if (check != nullptr && !haveOrigin) {  // mass 0 written: the origin, then this group from memory
             const auto at = originPattern<8>(*check, state);
             for (int j = 0; j < 3; ++j) {
                 origin[j] = _mm512_loadu_pd(at.data() + 8 * j);
                 beyond = orBeyondBits8(beyond, _mm512_loadu_pd(x + 8 * j), origin[j], carry);
             }
+            haveOrigin = true;
         }
     }
     if (check != nullptr) check->bits |= std::uint64_t(_mm512_reduce_or_epi64(beyond));
@@ -685,8 +692,13 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
     const __m256d h = _mm256_set1_pd(p.h), invH = _mm256_set1_pd(p.invH), drag = _mm256_set1_pd(p.drag);
     const __m256d anchor = _mm256_set1_pd(p.anchorStiffness), constraint = _mm256_set1_pd(p.constraint);
     const bool anchored = p.anchorStiffness != 0.0, readsRest = p.readsRest();
-    check = octets == nullptr && groups > 0 ? check : nullptr;  // as integrate512
+    check = check != nullptr && groups > 0 && (check->originKnown || octets == nullptr) ? check : nullptr;  // as integrate512
+    bool haveOrigin = check != nullptr && check->originKnown;
     __m256d origin[3] = {};
+    if (haveOrigin) {
+        const auto at = originPattern<4>(*check, state);
+        for (int j = 0; j < 3; ++j) origin[j] = _mm256_loadu_pd(at.data() + 4 * j);
+    }
     __m256i beyond = _mm256_setzero_si256();
     const __m256i carry = _mm256_set1_epi64x(check != nullptr ? std::int64_t(check->carry) : 0);
     for (std::size_t g = 0; g < groups; ++g) {
@@ -720,17 +732,18 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
                 xn = _mm256_blendv_pd(xn, _mm256_loadu_pd(rest + o), atRest);
                 vn = _mm256_andnot_pd(atRest, vn);
             }
-            if (g > 0 && check != nullptr) beyond = orBeyondBits4(beyond, xn, origin[j], carry);
+            if (haveOrigin) beyond = orBeyondBits4(beyond, xn, origin[j], carry);
             _mm256_storeu_pd(x + o, xn);
             _mm256_storeu_pd(v + o, vn);
             _mm256_storeu_pd(f + o, _mm256_setzero_pd());
         }
-        if (g == 0 && check != nullptr) {  // as integrate512
+        if (check != nullptr && !haveOrigin) {  // as integrate512
             const auto at = originPattern<4>(*check, state);
             for (int j = 0; j < 3; ++j) {
                 origin[j] = _mm256_loadu_pd(at.data() + 4 * j);
                 beyond = orBeyondBits4(beyond, _mm256_loadu_pd(x + 4 * j), origin[j], carry);
             }
+            haveOrigin = true;
         }
     }
     if (check != nullptr) {
@@ -765,11 +778,13 @@ std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, Pa
                             PositionCheck* check) {
     return integrate512(model, update, state, nullptr, model.massCount() / 8, held, check);
 }
-void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state) {
-    integrate256(model, update, state, octets.data(), 2 * octets.size());
+void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
+                         PositionCheck* check) {
+    integrate256(model, update, state, octets.data(), 2 * octets.size(), nullptr, check);
 }
-void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state) {
-    integrate512(model, update, state, octets.data(), octets.size());
+void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
+                           PositionCheck* check) {
+    integrate512(model, update, state, octets.data(), octets.size(), nullptr, check);
 }
 void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                            const double* x, const double* v, double* f) {

@@ -66,6 +66,8 @@ bool allWithin(std::span<const Vec3> values, const Vec3& origin, double bound) {
     return noneBeyond(beyondBits(values, origin, carryBeyond(bound)));
 }
 
+std::uint64_t beyondBits(const Vec3& value, const Vec3& origin, std::uint64_t carry) { return beyondBit(value - origin, carry); }
+
 std::uint64_t beyondBits(std::span<const Vec3> values, const Vec3& origin, std::uint64_t carry) {
     if (values.empty()) return 0;
     const Origin24 origin24(origin);

@@ -27,8 +27,9 @@ std::uint64_t carryBeyond(double bound);
 // Where a part's position bound is measured from: mass 0's position (a spread); zero for no
 // bound, so that finite is enough (x - x0 of two finite values may overflow).
 Vec3 boundOrigin(const PartState& state, double positionBound);
-// The or of every coordinate's bits, less the origin's.
+// The or of every coordinate's bits, less the origin's: of many values, of one.
 std::uint64_t beyondBits(std::span<const Vec3> values, const Vec3& origin, std::uint64_t carry);
+std::uint64_t beyondBits(const Vec3& value, const Vec3& origin, std::uint64_t carry);
 inline bool noneBeyond(std::uint64_t bits) { return (bits >> 63) == 0; }
 // True when every coordinate of the masses' positions, velocities and pending forces is
 // finite, and every position within `positionBound` of mass 0's (as allWithin).

@@ -47,11 +47,15 @@ void blockForces(const SpringBlocks& blocks, const double* x, const double* v, d
 // origin being mass 0's new position (read back once the first group is written) when the
 // bound is finite, else zero. `covered` says whether every mass was checked (the scalar kernel
 // checks none: the caller then makes the whole check).
+// A region's step (region_step.hpp) knows the origin before its pass (originKnown): mass 0 is
+// integrated first, or does not move.
 struct PositionCheck {
     explicit PositionCheck(double positionBound)
         : carry(carryBeyond(positionBound)), fromMassZero(positionBound < std::numeric_limits<double>::infinity()) {}
     std::uint64_t carry;
     bool fromMassZero;
+    bool originKnown = false;
+    Vec3 origin = Vec3::Zero();
     std::uint64_t bits = 0;
     bool covered = false;
     bool passed() const { return covered && noneBeyond(bits); }
@@ -89,9 +93,10 @@ void listedSpringForces(const PartModel& model, std::span<const Index> springs, 
 inline constexpr std::size_t kListChunk = 256;
 
 // Integrates the masses of the given octets (masses 8k..8k+7, each once) as integrateScalar
-// would, mass by mass: the same bits in every kernel.
+// would, mass by mass: the same bits in every kernel. With `check` (its origin known), the
+// vector kernels or the new positions' beyond-bits into it; the scalar kernel does not.
 void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
-                     BlockKernel kernel);
+                     BlockKernel kernel, PositionCheck* check = nullptr);
 
 // The vector kernels (block_step_x86.cpp). Forces of all blocks into f (3 doubles per mass).
 void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* v, double* f);
@@ -113,8 +118,10 @@ void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> ve
                            const double* x, const double* v, double* f);
 void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                              const double* x, const double* v, double* f);
-void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state);
-void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state);
+void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
+                         PositionCheck* check = nullptr);
+void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
+                           PositionCheck* check = nullptr);
 // holdAtRest for masses [0, n), n the largest multiple of 8; returns n.
 std::size_t holdAtRestAvx512(const PartModel& model, const std::uint16_t* cover, PartState& state);
 

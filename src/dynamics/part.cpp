@@ -2,6 +2,7 @@
 #include "flexfit/surface_embedding.hpp"
 
 #include "divergence.hpp"
+#include "region_step.hpp"
 #include "model/kring.hpp"
 #include "model/spring_blocks.hpp"
 #include "core/lanes256.hpp"
@@ -247,22 +248,26 @@ void Part::kickMass(Index mass, const Vec3& worldVelocityChange) {
 
 void Part::step(StepCounters* counters) {
     const double start = state_.time;
-    advance({settings_.simulation.timeStep, settings_.simulation.gravity}, counters);
-    // The full step checks every mass itself (stepFullModel); the region step's are checked here.
-    if (!fullModelStepped_) detail::checkRegionFinite(*model_, settings_.simulation, state_, region_, std::nullopt, start);
+    const bool checked = advanceChecking({settings_.simulation.timeStep, settings_.simulation.gravity}, counters, true);
+    // The full step checks every mass itself (stepFullModel); the region step, in its pass or here.
+    if (!fullModelStepped_ && !checked)
+        detail::checkRegionFinite(*model_, settings_.simulation, state_, region_, std::nullopt, start);
     retireRestingZones();
 }
 
-void Part::advance(const StepContext& context, StepCounters* counters) {
+void Part::advance(const StepContext& context, StepCounters* counters) { advanceChecking(context, counters, false); }
+
+bool Part::advanceChecking(const StepContext& context, StepCounters* counters, bool checkRegion) {
     if (region_.empty()) {  // rigid, or no zone open: nothing moves, O(1)
         state_.time += context.timeStep;
         ++state_.stepCount;
-        return;
+        return false;
     }
     SimulationSettings s = settings_.simulation;
     s.timeStep = context.timeStep;
     s.gravity = pose_.rotateInverse(context.gravity);  // world gravity seen in the part frame
     fullModelStepped_ = true;
+    bool checked = false;
     if (region_.coversEveryMass() && settings_.zones.fullSweepWhenComplete)
         stepFullModel(*model_, s, {}, state_, counters);
     // The implicit solve holds a region's edge fixed; the full step would solve for it too.
@@ -271,12 +276,15 @@ void Part::advance(const StepContext& context, StepCounters* counters) {
         stepRegionByFullModel(*model_, s, region_, state_, counters);
     else {
         fullModelStepped_ = false;
-        stepActiveRegion(*model_, s, region_, state_, counters);
+        detail::PositionCheck check(model_->positionBound);
+        detail::stepRegion(*model_, s, region_, state_, counters, checkRegion ? &check : nullptr);
+        checked = check.passed();
     }
     if (region_.coversEveryMass())
         markAllChanged();
     else
         regionStepped_ = true;  // changedMasses() adds the region's masses when read
+    return checked;
 }
 
 // --- Contacts ---

@@ -4,14 +4,63 @@
 #include "full_step.hpp"
 #include "implicit_step.hpp"
 #include "mass_update.hpp"
+#include "region_step.hpp"
 #include "model/spring_blocks.hpp"
 
 #include <algorithm>
 
 namespace flexfit {
 
+namespace {
+
+// The moving masses: body forces, integration, restoration; pending forces consumed. Whole
+// octets by the vector kernel, then the others one at a time (each mass alone: same bits). With
+// `check`, mass 0 first when it moves (its octet, or itself), which fixes the origin; then every
+// other mass checked as it is written. Masses are independent here: the order changes no bit.
+void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const ActiveRegion& region, PartState& state,
+                     detail::PositionCheck* check) {
+    const detail::BlockKernel kernel = detail::fullStepKernel();
+    std::span<const Index> octets = region.fullOctets().members(), octetsAfter;
+    if (check == nullptr || kernel == detail::BlockKernel::Scalar) {
+        detail::integrateOctets(model, p, octets, state, kernel);
+        for (Index i : region.looseMasses()) detail::integrateMass(model, p, state, i);
+        return;
+    }
+    const bool massZeroFirst = check->fromMassZero && region.moves(0);
+    const bool octetZero = massZeroFirst && region.fullOctets().contains(0);
+    if (octetZero) {  // octet 0 alone, then the octets before and after it in the list
+        const std::size_t slot = region.fullOctets().slotOf(0);
+        detail::integrateOctets(model, p, octets.subspan(slot, 1), state, kernel);
+        octetsAfter = octets.subspan(slot + 1);
+        octets = octets.first(slot);
+    } else if (massZeroFirst) {
+        detail::integrateMass(model, p, state, 0);
+    }
+    check->origin = check->fromMassZero ? state.positions[0] : Vec3::Zero();
+    check->originKnown = true;
+    if (octetZero)
+        for (Index i = 0; i < 8; ++i) check->bits |= detail::beyondBits(state.positions[i], check->origin, check->carry);
+    else if (massZeroFirst)
+        check->bits |= detail::beyondBits(state.positions[0], check->origin, check->carry);
+    detail::integrateOctets(model, p, octets, state, kernel, check);
+    detail::integrateOctets(model, p, octetsAfter, state, kernel, check);
+    for (Index i : region.looseMasses()) {
+        if (i == 0 && massZeroFirst) continue;
+        detail::integrateMass(model, p, state, i);
+        check->bits |= detail::beyondBits(state.positions[i], check->origin, check->carry);
+    }
+    check->covered = true;
+}
+
+}  // namespace
+
 void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                       PartState& state, StepCounters* counters) {
+    detail::stepRegion(model, settings, region, state, counters, nullptr);
+}
+
+void detail::stepRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
+                        PartState& state, StepCounters* counters, PositionCheck* check) {
     const detail::FlushDenormals flush;
     if (settings.integrator == Integrator::ImplicitEuler) return detail::stepImplicit(model, settings, &region, state, counters);
     const detail::MassUpdate p = detail::MassUpdate::from(settings);
@@ -27,10 +76,7 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
         detail::regionBlockForces(*model.springBlocks, region.vectorBlocks().members(), mask, x, v, f,
                                   detail::fullStepKernel());
     detail::listedSpringForces(model, region.looseSprings().members(), mask, x, v, f, detail::fullStepKernel());
-    // Moving masses: body forces, integration, restoration; pending forces consumed. Whole
-    // octets by the vector kernel, then the others one at a time (each mass alone: same bits).
-    detail::integrateOctets(model, p, region.fullOctets().members(), state, detail::fullStepKernel());
-    for (Index i : region.looseMasses()) detail::integrateMass(model, p, state, i);
+    integrateRegion(model, p, region, state, settings.integrator == Integrator::SemiImplicitEuler ? check : nullptr);
     state.time += settings.timeStep;
     ++state.stepCount;
     if (counters != nullptr) {

@@ -1,6 +1,7 @@
 // stepActiveRegion (src/dynamics/region_step.cpp) against the naive reference with every mass
 // outside the region pinned, and its pinned hash.
 #include "dynamics/full_step.hpp"
+#include "dynamics/region_step.hpp"
 #include "flexfit/flexfit.hpp"
 #include "golden.hpp"
 #include "naive_from_mesh.hpp"
@@ -243,5 +244,54 @@ TEST(RegionStep, GoldenHash) {
         const detail::ScopedBlockKernel scope(kernel);
         EXPECT_EQ(run(SimulationSettings{}), "be316dca0d136d43") << "constraint, semi-implicit, " << detail::toString(kernel);
         EXPECT_EQ(run(anchors), "39036a1fee0db6a8") << "anchors, explicit, " << detail::toString(kernel);
+    }
+}
+
+// The region step's divergence check made as it writes the new positions (detail::stepRegion,
+// what Part::step uses) against checkRegionFinite's set after the step, computed here mass by
+// mass: the same or-ed bits exactly, with mass 0 in a whole octet (before or after others in
+// the region's list), loose, alone, or not moving (the
+// origin: mass 0's new position, or its unmoved one), a culprit in an octet, loose, or mass 0
+// itself, with and without a bound. The scalar kernel checks nothing in its pass.
+TEST(RegionStep, ItsPassChecksThePositionsAsTheCheckAfterItWould) {
+    auto model = std::const_pointer_cast<PartModel>(buildPartModel(makeTorus1()));
+    const double bound = model->positionBound, nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    const std::vector<std::pair<std::string, std::vector<Index>>> regions = {
+        {"mass 0 in an octet", {16, 17, 18, 19, 20, 21, 22, 23, 40, 0, 1, 2, 3, 4, 5, 6, 7, 90}},
+        {"mass 0 in the first octet", {0, 1, 2, 3, 4, 5, 6, 7, 16, 17, 18, 19, 20, 21, 22, 23, 40, 90}},
+        {"mass 0 alone", {0}},
+        {"mass 0 loose", {16, 17, 18, 19, 20, 21, 22, 23, 40, 0, 90}},
+        {"mass 0 not moving", {16, 17, 18, 19, 20, 21, 22, 23, 40, 90}}};
+    const std::vector<std::pair<std::string, Vec3>> spoils = {
+        {"nothing", Vec3::Zero()}, {"nan", Vec3(nan, 0, 0)}, {"3 bounds", Vec3(0, 3.0 * bound, 0)}, {"half a bound", Vec3(0, 0, 0.5 * bound)}};
+    for (const detail::BlockKernel kernel : {detail::BlockKernel::Scalar, detail::BlockKernel::Avx2, detail::BlockKernel::Avx512}) {
+        if (!detail::blockKernelAvailable(kernel)) continue;
+        const detail::ScopedBlockKernel use(kernel);
+        for (const double modelBound : {bound, inf}) {
+            model->positionBound = modelBound;
+            for (const auto& [regionName, masses] : regions) {
+                const ActiveRegion region = regionOf(*model, masses);
+                for (const Index culprit : {Index(0), Index(5), Index(20), Index(40), Index(90)})
+                    for (const auto& [spoilName, offset] : spoils) {
+                        PartState state = PartState::atRest(*model);
+                        state.forces[20] = Vec3(0.5, -1.0, 0.25);
+                        state.positions[culprit] += offset;
+                        detail::PositionCheck check(model->positionBound);
+                        detail::stepRegion(*model, noRestoration(), region, state, nullptr, &check);
+                        const std::string where = std::string(detail::toString(kernel)) + ", " + regionName + ", mass " +
+                                                  std::to_string(culprit) + " " + spoilName + (std::isinf(modelBound) ? ", no bound" : "");
+                        if (kernel == detail::BlockKernel::Scalar) {
+                            EXPECT_FALSE(check.covered) << where;
+                            continue;
+                        }
+                        ASSERT_TRUE(check.covered) << where;
+                        const Vec3 origin = std::isinf(modelBound) ? Vec3::Zero() : state.positions[0];
+                        std::uint64_t expected = 0;
+                        for (const Index m : region.masses()) expected |= detail::beyondBits(state.positions[m], origin, detail::carryBeyond(modelBound));
+                        EXPECT_EQ(check.bits, expected) << where;
+                    }
+            }
+        }
     }
 }
