@@ -116,7 +116,7 @@ struct StepCounters {
 // Throws DivergenceError (core.hpp: "part", the time at the start of the step, the first mass
 // whose position or velocity is no longer finite, the likely cause) after a step that diverged;
 // with semi-implicit Euler the AVX2 and AVX-512 kernels check each position as their
-// integration pass writes it (a separate pass over the positions cost 9-12 % of the heart's
+// integration pass writes it (a separate pass over the positions cost about 9 % of the heart's
 // step); the scalar kernel, and explicit Euler (which reads the velocities too), check in one
 // vectorised pass after the step.
 void stepFullModel(const PartModel& model, const SimulationSettings& settings,
