@@ -1,6 +1,8 @@
-"""The measuring scripts' own geometry (tools/): checked against what the mesh must keep."""
+"""The measuring scripts' own computations (tools/): geometry checked against what the mesh
+must keep, tables against ratios worked out by hand."""
 
 import csv
+import json
 import math
 import subprocess
 import sys
@@ -75,3 +77,19 @@ def test_step_tails_reads_the_runs_metrics(tmp_path, flexfit_exe, examples):
     metrics = tmp_path / "metrics.csv"
     metrics.write_text("time,contacts,us_world_step\n0.001,0,7.5\n0.002,3,2.0\n0.003,4,9.0\n0.004,0,1.0\n")
     assert step_tails.tails(metrics) == [7.5, 9.0, 2.0, 9.0, 9.0]
+
+
+def test_ab_bench_table_takes_medians_over_rounds_and_the_reference_of_the_same_argument():
+    """tools/ab_bench.py's table from known per-round medians: ratios computed by hand."""
+    import ab_bench
+    report = json.dumps({"benchmarks": [
+        {"aggregate_name": "median", "run_name": "BM_Ours/0", "label": "torus1", "real_time": 5.0, "time_unit": "us"},
+        {"aggregate_name": "mean", "run_name": "BM_Ours/0", "label": "torus1", "real_time": 99.0, "time_unit": "us"},
+        {"aggregate_name": "median", "run_name": "BM_Naive/0", "label": "torus1", "real_time": 12000.0, "time_unit": "ns"}]})
+    assert list(ab_bench.medians(report)) == [("BM_Ours/0", "torus1", 5000.0), ("BM_Naive/0", "torus1", 12000.0)]
+    times = {("before", "BM_Ours/0"): [6000.0, 5000.0, 7000.0], ("after", "BM_Ours/0"): [4000.0, 5000.0, 4500.0],
+             ("before", "BM_Naive/0"): [12000.0, 13000.0, 11000.0], ("after", "BM_Naive/0"): [12000.0, 12500.0, 11500.0]}
+    header, rows = ab_bench.table(times, {"BM_Ours/0": "torus1"}, ["before", "after"], "BM_Naive", 3)
+    assert header[:5] == ["benchmark", "mesh", "before_us", "after_us", "speedup"]
+    assert rows == [["BM_Ours/0", "torus1", "6.000", "4.500", f"{6000 / 4500:.3f}", "12.000", "12.000",
+                     f"{12000 / 6000:.3f}", f"{12000 / 4500:.3f}", 3]]
