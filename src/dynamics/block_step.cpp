@@ -184,8 +184,7 @@ void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartStat
     integrateScalar(model, update, state, integrated);
     if (held != nullptr) holdAtRestFrom(model, held, state, heldDone);
     if (check != nullptr && integrated > 0) {  // the masses after the vector groups, as the kernel checked those
-        const Vec3 origin = check->fromMassZero ? state.positions[0] : Vec3::Zero();
-        check->bits |= beyondBits(std::span<const Vec3>(state.positions).subspan(integrated), origin, check->carry);
+        check->add(state, integrated, model.massCount() - integrated);
         check->covered = true;
     }
 }

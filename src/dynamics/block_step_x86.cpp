@@ -246,25 +246,41 @@ FLEXFIT_AVX512 void regionBlocks512(const SpringBlocks& blocks, std::span<const 
     }
 }
 
-// Groups of 8 masses: group g starts at 8 octets[g], or at 8 g without a list.
 // The divergence check's bits (PositionCheck) of 8 coordinates less their origin's, or-ed into acc.
 FLEXFIT_AVX512 inline __m512i orBeyondBits8(__m512i acc, __m512d x, __m512d origin, __m512i carry) {
     const __m512i exponent = _mm512_and_si512(_mm512_castpd_si512(_mm512_sub_pd(x, origin)), _mm512_set1_epi64(0x7ff0000000000000LL));
     return _mm512_or_si512(acc, _mm512_add_epi64(exponent, carry));
 }
 
-// The origin's coordinates for the 3 vectors of `width` masses' 3 * width doubles.
+// The check's origin coordinates for the 3 vectors of kLanes masses' 3 * kLanes doubles.
 template <std::size_t kLanes>
-std::array<double, 3 * kLanes> originPattern(const PositionCheck& check, const PartState& state) {
-    const Vec3 origin = check.originKnown ? check.origin : check.fromMassZero ? state.positions[0] : Vec3::Zero();
+std::array<double, 3 * kLanes> originPattern(const PositionCheck& check) {
     std::array<double, 3 * kLanes> at{};
-    for (std::size_t k = 0; k < at.size(); ++k) at[k] = origin[int(k % 3)];
+    for (std::size_t k = 0; k < at.size(); ++k) at[k] = check.origin[int(k % 3)];
     return at;
 }
 
-FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate& p, PartState& state,
-                                        const Index* octets, std::size_t groups, const std::uint16_t* held = nullptr,
-                                        PositionCheck* check = nullptr) {
+// A whole model's integration pass with `check`: the first group alone and unchecked, the origin
+// (mass 0's new position) fixed from it, its positions checked, then the other groups checked in
+// the pass. pass(firstGroup, groups, check) integrates groups [firstGroup, groups).
+template <class Pass>
+std::size_t checkedWholePass(std::size_t width, std::size_t groups, PartState& state, PositionCheck* check, Pass pass) {
+    std::size_t first = 0;
+    if (check != nullptr && groups > 0) {
+        pass(0, 1, nullptr);
+        check->fixOrigin(state);
+        check->add(state, 0, width);
+        first = 1;
+    }
+    pass(first, groups, check);
+    return width * groups;
+}
+
+// Groups firstGroup.. of 8 masses: group g starts at 8 octets[g], or at 8 g without a list. A
+// check must have its origin fixed (checkedWholePass).
+FLEXFIT_AVX512 void integrate512(const PartModel& model, const MassUpdate& p, PartState& state, const Index* octets,
+                                  std::size_t firstGroup, std::size_t groups, const std::uint16_t* held = nullptr,
+                                  PositionCheck* check = nullptr) {
     double* x = state.positions.data()->data();
     double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
@@ -274,17 +290,14 @@ FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate
     const __m512d h = _mm512_set1_pd(p.h), invH = _mm512_set1_pd(p.invH), drag = _mm512_set1_pd(p.drag);
     const __m512d anchor = _mm512_set1_pd(p.anchorStiffness), constraint = _mm512_set1_pd(p.constraint);
     const bool anchored = p.anchorStiffness != 0.0, readsRest = p.readsRest();
-    // Without a known origin the check needs mass 0 in group 0: the whole model's pass.
-    check = check != nullptr && groups > 0 && (check->originKnown || octets == nullptr) ? check : nullptr;
-    bool haveOrigin = check != nullptr && check->originKnown;
     __m512d origin[3] = {};
-    if (haveOrigin) {
-        const auto at = originPattern<8>(*check, state);
+    if (check != nullptr) {
+        const auto at = originPattern<8>(*check);
         for (int j = 0; j < 3; ++j) origin[j] = _mm512_loadu_pd(at.data() + 8 * j);
     }
     __m512i beyond = _mm512_setzero_si512();
     const __m512i carry = _mm512_set1_epi64(check != nullptr ? std::int64_t(check->carry) : 0);
-    for (std::size_t g = 0; g < groups; ++g) {
+    for (std::size_t g = firstGroup; g < groups; ++g) {
         const std::size_t i = 8 * (octets != nullptr ? std::size_t(octets[g]) : g);
         const __m512d mass = _mm512_loadu_pd(model.mass.data() + i);
         const __m512d hOverMass = _mm512_mul_pd(h, _mm512_loadu_pd(model.inverseMass.data() + i));
@@ -316,22 +329,13 @@ FLEXFIT_AVX512 std::size_t integrate512(const PartModel& model, const MassUpdate
                 xn = _mm512_mask_loadu_pd(xn, atRest, rest + o);
                 vn = _mm512_mask_mov_pd(vn, atRest, _mm512_setzero_pd());
             }
-            if (haveOrigin) beyond = orBeyondBits8(beyond, xn, origin[j], carry);
+            if (check != nullptr) beyond = orBeyondBits8(beyond, xn, origin[j], carry);
             _mm512_storeu_pd(x + o, xn);
             _mm512_storeu_pd(v + o, vn);
             _mm512_storeu_pd(f + o, _mm512_setzero_pd());
         }
-        if (check != nullptr && !haveOrigin) {  // mass 0 written: the origin, then this group from memory
-            const auto at = originPattern<8>(*check, state);
-            for (int j = 0; j < 3; ++j) {
-                origin[j] = _mm512_loadu_pd(at.data() + 8 * j);
-                beyond = orBeyondBits8(beyond, _mm512_loadu_pd(x + 8 * j), origin[j], carry);
-            }
-            haveOrigin = true;
-        }
     }
     if (check != nullptr) check->bits |= std::uint64_t(_mm512_reduce_or_epi64(beyond));
-    return 8 * groups;
 }
 
 // A mass's x y z as one vector, lane 3 zero: masked, as the last mass has nothing after it.
@@ -674,15 +678,17 @@ FLEXFIT_AVX2 inline __m256d spread4(__m256d values, int j) {
     }
 }
 
-// Groups of 4 masses: group g starts at 4 g, or with an octet list at 8 octets[g / 2] + 4 (g % 2).
-// With `held`, the masses whose count is 0 end at rest (as holdAtRest puts them: a selection).
 FLEXFIT_AVX2 inline __m256i orBeyondBits4(__m256i acc, __m256d x, __m256d origin, __m256i carry) {
     const __m256i exponent = _mm256_and_si256(_mm256_castpd_si256(_mm256_sub_pd(x, origin)), _mm256_set1_epi64x(0x7ff0000000000000LL));
     return _mm256_or_si256(acc, _mm256_add_epi64(exponent, carry));
 }
 
-FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& p, PartState& state, const Index* octets,
-                                      std::size_t groups, const std::uint16_t* held = nullptr, PositionCheck* check = nullptr) {
+// Groups firstGroup.. of 4 masses: group g starts at 4 g, or with an octet list at
+// 8 octets[g / 2] + 4 (g % 2). With `held`, the masses whose count is 0 end at rest (as
+// holdAtRest puts them: a selection). A check must have its origin fixed (checkedWholePass).
+FLEXFIT_AVX2 void integrate256(const PartModel& model, const MassUpdate& p, PartState& state, const Index* octets,
+                                std::size_t firstGroup, std::size_t groups, const std::uint16_t* held = nullptr,
+                                PositionCheck* check = nullptr) {
     double* x = state.positions.data()->data();
     double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
@@ -692,16 +698,14 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
     const __m256d h = _mm256_set1_pd(p.h), invH = _mm256_set1_pd(p.invH), drag = _mm256_set1_pd(p.drag);
     const __m256d anchor = _mm256_set1_pd(p.anchorStiffness), constraint = _mm256_set1_pd(p.constraint);
     const bool anchored = p.anchorStiffness != 0.0, readsRest = p.readsRest();
-    check = check != nullptr && groups > 0 && (check->originKnown || octets == nullptr) ? check : nullptr;  // as integrate512
-    bool haveOrigin = check != nullptr && check->originKnown;
     __m256d origin[3] = {};
-    if (haveOrigin) {
-        const auto at = originPattern<4>(*check, state);
+    if (check != nullptr) {
+        const auto at = originPattern<4>(*check);
         for (int j = 0; j < 3; ++j) origin[j] = _mm256_loadu_pd(at.data() + 4 * j);
     }
     __m256i beyond = _mm256_setzero_si256();
     const __m256i carry = _mm256_set1_epi64x(check != nullptr ? std::int64_t(check->carry) : 0);
-    for (std::size_t g = 0; g < groups; ++g) {
+    for (std::size_t g = firstGroup; g < groups; ++g) {
         const std::size_t i = octets != nullptr ? 8 * std::size_t(octets[g / 2]) + 4 * (g % 2) : 4 * g;
         const __m256d mass = _mm256_loadu_pd(model.mass.data() + i);
         const __m256d hOverMass = _mm256_mul_pd(h, _mm256_loadu_pd(model.inverseMass.data() + i));
@@ -732,18 +736,10 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
                 xn = _mm256_blendv_pd(xn, _mm256_loadu_pd(rest + o), atRest);
                 vn = _mm256_andnot_pd(atRest, vn);
             }
-            if (haveOrigin) beyond = orBeyondBits4(beyond, xn, origin[j], carry);
+            if (check != nullptr) beyond = orBeyondBits4(beyond, xn, origin[j], carry);
             _mm256_storeu_pd(x + o, xn);
             _mm256_storeu_pd(v + o, vn);
             _mm256_storeu_pd(f + o, _mm256_setzero_pd());
-        }
-        if (check != nullptr && !haveOrigin) {  // as integrate512
-            const auto at = originPattern<4>(*check, state);
-            for (int j = 0; j < 3; ++j) {
-                origin[j] = _mm256_loadu_pd(at.data() + 4 * j);
-                beyond = orBeyondBits4(beyond, _mm256_loadu_pd(x + 4 * j), origin[j], carry);
-            }
-            haveOrigin = true;
         }
     }
     if (check != nullptr) {
@@ -751,7 +747,6 @@ FLEXFIT_AVX2 std::size_t integrate256(const PartModel& model, const MassUpdate& 
         _mm256_store_si256(reinterpret_cast<__m256i*>(lanes), beyond);
         check->bits |= lanes[0] | lanes[1] | lanes[2] | lanes[3];
     }
-    return 4 * groups;
 }
 
 }  // namespace
@@ -772,19 +767,23 @@ std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Ind
 }
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held,
                           PositionCheck* check) {
-    return integrate256(model, update, state, nullptr, model.massCount() / 4, held, check);
+    return checkedWholePass(4, model.massCount() / 4, state, check, [&](std::size_t first, std::size_t groups, PositionCheck* c) {
+        integrate256(model, update, state, nullptr, first, groups, held, c);
+    });
 }
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held,
                             PositionCheck* check) {
-    return integrate512(model, update, state, nullptr, model.massCount() / 8, held, check);
+    return checkedWholePass(8, model.massCount() / 8, state, check, [&](std::size_t first, std::size_t groups, PositionCheck* c) {
+        integrate512(model, update, state, nullptr, first, groups, held, c);
+    });
 }
 void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
                          PositionCheck* check) {
-    integrate256(model, update, state, octets.data(), 2 * octets.size(), nullptr, check);
+    integrate256(model, update, state, octets.data(), 0, 2 * octets.size(), nullptr, check);
 }
 void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
                            PositionCheck* check) {
-    integrate512(model, update, state, octets.data(), octets.size(), nullptr, check);
+    integrate512(model, update, state, octets.data(), 0, octets.size(), nullptr, check);
 }
 void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                            const double* x, const double* v, double* f) {

@@ -43,21 +43,26 @@ void blockForces(const SpringBlocks& blocks, const double* x, const double* v, d
 
 // The divergence check over the new positions (checkAllMassesFinite's, divergence.hpp), made
 // by the vector integration as it writes them instead of in a pass of its own (which cost
-// about 9 % of the heart's full step): the beyond-bits of x - origin or-ed into `bits`, the
-// origin being mass 0's new position (read back once the first group is written) when the
-// bound is finite, else zero. `covered` says whether every mass was checked (the scalar kernel
-// checks none: the caller then makes the whole check).
-// A region's step (region_step.hpp) knows the origin before its pass (originKnown): mass 0 is
-// integrated first, or does not move.
+// about 9 % of the heart's full step): the beyond-bits of x - origin or-ed into `bits`. The
+// origin (boundOrigin) is mass 0's new position when the bound is finite, so whoever runs the
+// pass integrates mass 0 first and then fixes it; the vector kernels take a check only with its
+// origin fixed. `covered` says whether every mass was checked (the scalar kernel checks none:
+// the caller then makes the whole check).
 struct PositionCheck {
-    explicit PositionCheck(double positionBound)
-        : carry(carryBeyond(positionBound)), fromMassZero(positionBound < std::numeric_limits<double>::infinity()) {}
+    explicit PositionCheck(double positionBound) : bound(positionBound), carry(carryBeyond(positionBound)) {}
+    double bound;
     std::uint64_t carry;
-    bool fromMassZero;
-    bool originKnown = false;
     Vec3 origin = Vec3::Zero();
     std::uint64_t bits = 0;
     bool covered = false;
+    // Whether the origin is mass 0's position, to be written before the others are checked.
+    bool fromMassZero() const { return bound < std::numeric_limits<double>::infinity(); }
+    // Once mass 0's new position is written (or it does not move).
+    void fixOrigin(const PartState& state) { origin = boundOrigin(state, bound); }
+    // The bits of masses [first, first + count), written already.
+    void add(const PartState& state, std::size_t first, std::size_t count) {
+        bits |= beyondBits(std::span<const Vec3>(state.positions).subspan(first, count), origin, carry);
+    }
     bool passed() const { return covered && noneBeyond(bits); }
 };
 
@@ -93,7 +98,7 @@ void listedSpringForces(const PartModel& model, std::span<const Index> springs, 
 inline constexpr std::size_t kListChunk = 256;
 
 // Integrates the masses of the given octets (masses 8k..8k+7, each once) as integrateScalar
-// would, mass by mass: the same bits in every kernel. With `check` (its origin known), the
+// would, mass by mass: the same bits in every kernel. With `check` (its origin fixed), the
 // vector kernels or the new positions' beyond-bits into it; the scalar kernel does not.
 void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
                      BlockKernel kernel, PositionCheck* check = nullptr);
@@ -109,7 +114,7 @@ std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Ind
                                      const double* x, const double* v, double* f);
 // Integrates masses [0, n) for the largest n that is a multiple of the width (4, 8); returns n.
 // The masses whose `held` count is 0 (when given) end at rest, as holdAtRest leaves them. With
-// `check` (n > 0), or-s the new positions' beyond-bits into it (PositionCheck).
+// `check`, the first group goes first, fixes the origin, and every position is checked.
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held,
                           PositionCheck* check = nullptr);
 std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held,

@@ -26,7 +26,7 @@ void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const 
         for (Index i : region.looseMasses()) detail::integrateMass(model, p, state, i);
         return;
     }
-    const bool massZeroFirst = check->fromMassZero && region.moves(0);
+    const bool massZeroFirst = check->fromMassZero() && region.moves(0);
     const bool octetZero = massZeroFirst && region.fullOctets().contains(0);
     if (octetZero) {  // octet 0 alone, then the octets before and after it in the list
         const std::size_t slot = region.fullOctets().slotOf(0);
@@ -36,18 +36,14 @@ void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const 
     } else if (massZeroFirst) {
         detail::integrateMass(model, p, state, 0);
     }
-    check->origin = check->fromMassZero ? state.positions[0] : Vec3::Zero();
-    check->originKnown = true;
-    if (octetZero)
-        for (Index i = 0; i < 8; ++i) check->bits |= detail::beyondBits(state.positions[i], check->origin, check->carry);
-    else if (massZeroFirst)
-        check->bits |= detail::beyondBits(state.positions[0], check->origin, check->carry);
+    check->fixOrigin(state);
+    if (massZeroFirst) check->add(state, 0, octetZero ? 8 : 1);
     detail::integrateOctets(model, p, octets, state, kernel, check);
     detail::integrateOctets(model, p, octetsAfter, state, kernel, check);
     for (Index i : region.looseMasses()) {
         if (i == 0 && massZeroFirst) continue;
         detail::integrateMass(model, p, state, i);
-        check->bits |= detail::beyondBits(state.positions[i], check->origin, check->carry);
+        check->add(state, i, 1);
     }
     check->covered = true;
 }
