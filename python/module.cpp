@@ -400,18 +400,25 @@ PYBIND11_MODULE(_flexfit, m) {
           "A box with each face divided into divisions x divisions squares.");
     m.def("heart", &makeHeart, py::arg("size") = 20.0, py::arg("segments") = 93, py::arg("rings") = 80, "The thesis's heart.");
     m.def("container_mouth", &makeContainerMouth, "The thesis's container mouth (a torus R = 10, r = 2.5, 64 x 24).");
-    m.def("remesh", [](const TriMesh& mesh, double edge) {
+    m.def("remesh", [](const TriMesh& mesh, double edge, const std::string& thinFeatures) {
         RemeshOptions options;
         options.targetEdge = edge;
+        if (thinFeatures == "keep") options.thinFeatures = ThinFeatures::Keep;
+        else if (thinFeatures == "round") options.thinFeatures = ThinFeatures::Round;
+        else if (thinFeatures != "auto")
+            throw InputError("thin_features", 0, "unknown value '" + thinFeatures + "' (expected 'auto', 'keep' or 'round')");
         RemeshResult r = remeshForSimulation(mesh, options, mesh.name);
         py::dict q;
         q["min_angle_degrees"] = r.after.minAngle;
         q["slivers"] = r.after.slivers;
         q["edge_spread"] = r.after.edgeSpread;
         q["hausdorff_share"] = r.hausdorffShare();
+        q["thin_features_rounded"] = r.rounded;
         return py::make_tuple(std::move(r.mesh), q);
-    }, py::arg("mesh"), py::arg("edge"),
-          "Simulation remeshing (CGAL): near-uniform edges of length `edge`, sharp features kept. Returns (mesh, quality).");
+    }, py::arg("mesh"), py::arg("edge"), py::arg("thin_features") = "auto",
+          "Simulation remeshing (CGAL): near-uniform edges of length `edge`, sharp features kept; sharp edges closer than half "
+          "the edge kept ('keep'), rounded ('round') or rounded where that leaves fewer slivers within `edge` of the input "
+          "('auto'). Returns (mesh, quality).");
 
     // --- Models and parts ---
     py::class_<PartModel, std::shared_ptr<PartModel>>(m, "PartModel", "A part's immutable model: its mesh, masses and springs.")

@@ -14,12 +14,24 @@ void printQuality(const char* label, const MeshQuality& q) {
                label, q.faces, q.minAngle, 100.0 * q.slivers, q.minEdge, q.meanEdge, q.maxEdge, q.edgeSpread);
 }
 
+void printThinFeatures(const RemeshResult& r, const std::string& source) {
+    if (r.releasedEdges == 0) return;
+    const double share = 100.0 * r.roundedHausdorff / r.diagonal;
+    if (r.rounded)
+        fmt::print("  thin features rounded: {} sharp edge pieces no longer kept, where sharp edges are closer than half the target edge\n",
+                   r.releasedEdges);
+    else
+        warn(fmt::format("{}: thin features kept (slivers remain between sharp edges closer than half the target edge): rounding them "
+                         "moved the surface {:.3f} % of the diagonal or left no fewer slivers; --thin-features round rounds them anyway",
+                         source, share));
+}
+
 }  // namespace
 
 void registerRemesh(CLI::App& app) {
     auto* cmd = app.add_subcommand("remesh", "Remesh for simulation: near-uniform edges, sharp features kept (CGAL)");
     struct Options {
-        std::string in, out;
+        std::string in, out, thinFeatures = "auto";
         RemeshOptions remesh;
         MeshOptions mesh;
     };
@@ -30,12 +42,21 @@ void registerRemesh(CLI::App& app) {
     cmd->add_option("--iterations", opt->remesh.iterations, "Remeshing rounds")->capture_default_str()->check(CLI::Range(1, 100));
     cmd->add_option("--feature-angle", opt->remesh.featureAngle, "Edges whose faces meet at more than this many degrees stay sharp")
         ->capture_default_str()->check(CLI::Range(0.0, 180.0));
+    cmd->add_option("--thin-features", opt->thinFeatures,
+                    "Sharp edges closer than half the target edge: keep them (slivers stay between them), round them, or auto (round "
+                    "them when 1 % or more of the triangles are slivers, if that leaves fewer and the surface within the target edge of the input)")
+        ->check(CLI::IsMember({"auto", "keep", "round"}))
+        ->capture_default_str();
     addMeshOptions(cmd, opt->mesh);
     cmd->callback([opt] {
+        opt->remesh.thinFeatures = opt->thinFeatures == "keep"    ? ThinFeatures::Keep
+                                   : opt->thinFeatures == "round" ? ThinFeatures::Round
+                                                                  : ThinFeatures::Auto;
         const MeshReadResult read = loadMesh(opt->in, opt->mesh.read());
         const RemeshResult r = remeshForSimulation(read.mesh, opt->remesh, opt->in);
         writeMesh(r.mesh, opt->out);
         fmt::print("{} -> {}: target edge {:.4g}, {} sharp or border edges kept\n", opt->in, opt->out, opt->remesh.targetEdge, r.featureEdges);
+        printThinFeatures(r, opt->in);
         printQuality("input", r.before);
         printQuality("output", r.after);
         if (r.droppedFaces > 0) warn(fmt::format("{}: {} degenerate output faces dropped (where sharp polylines meet)", opt->in, r.droppedFaces));

@@ -4,19 +4,25 @@
 #include "flexfit/remesh.hpp"
 #include "flexfit/mesh_repair.hpp"
 
+#include <CGAL/AABB_face_graph_triangle_primitive.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/detect_features.h>
 #include <CGAL/Polygon_mesh_processing/distance.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/tangential_relaxation.h>
 #include <CGAL/Surface_mesh.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <vector>
 
@@ -28,6 +34,13 @@ namespace PMP = CGAL::Polygon_mesh_processing;
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using SurfaceMesh = CGAL::Surface_mesh<Point>;
+using VertexIndex = SurfaceMesh::Vertex_index;
+using EdgeIndex = SurfaceMesh::Edge_index;
+using FaceIndex = SurfaceMesh::Face_index;
+using HalfedgeIndex = SurfaceMesh::Halfedge_index;
+using EdgeFlags = SurfaceMesh::Property_map<EdgeIndex, bool>;
+using FacePatches = SurfaceMesh::Property_map<FaceIndex, std::size_t>;
+using FaceTree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, CGAL::AABB_face_graph_triangle_primitive<SurfaceMesh>>>;
 
 // Smallest interior angle of a triangle, degrees (0 for a degenerate one).
 double smallestAngle(const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -72,11 +85,10 @@ TriMesh toTriMesh(const SurfaceMesh& mesh, const std::string& name) {
 }
 
 // Feature and border edges of `mesh`, marked in its "e:constrained" map; returns their number.
-std::size_t markConstrainedEdges(SurfaceMesh& mesh, double featureAngle,
-                                 SurfaceMesh::Property_map<SurfaceMesh::Edge_index, bool>& constrained) {
+std::size_t markConstrainedEdges(SurfaceMesh& mesh, double featureAngle, EdgeFlags& constrained) {
     PMP::detect_sharp_edges(mesh, featureAngle, constrained);
     std::size_t count = 0;
-    for (SurfaceMesh::Edge_index e : mesh.edges()) {
+    for (EdgeIndex e : mesh.edges()) {
         if (mesh.is_border(e)) constrained[e] = true;
         count += constrained[e] ? 1 : 0;
     }
@@ -84,10 +96,205 @@ std::size_t markConstrainedEdges(SurfaceMesh& mesh, double featureAngle,
 }
 
 // Faces removed after remeshing: caps (an angle above kCapAngle degrees) and needles (longest
-// over shortest edge above kNeedleRatio, the short one below kNeedleEdge of the target).
-constexpr double kCapAngle = 160.0;
-constexpr double kNeedleRatio = 4.0;
-constexpr double kNeedleEdge = 0.2;
+// over shortest edge above kNeedleRatio, the short one below kNeedleEdge of the target). A
+// triangle with an angle below 20 degrees is one or the other at these bounds (a cap of two
+// 20-degree angles has a 140-degree one; a needle's sides are 2.9 times its base).
+constexpr double kCapAngle = 120.0;
+constexpr double kNeedleRatio = 2.5;
+constexpr double kNeedleEdge = 0.6;
+
+// Sharp polylines closer than this share of the target edge cannot be meshed between without
+// slivers: a triangle spanning them is at most this high against sides of about the target.
+constexpr double kThinFeature = 0.5;
+// Rounds of releasing thin features and remeshing again: a round's remeshing can leave new thin
+// slivers beside the edges it released (on regr01 the third round still found a few).
+constexpr int kReleaseRounds = 3;
+constexpr double kSliverAngle = 20.0;
+// ThinFeatures::Auto tries rounding when the surface keeping every sharp edge has this share of
+// slivers, and keeps the rounded surface when it has fewer and lies within the target edge of
+// the input (or no farther than the other).
+constexpr double kRoundingShare = 0.01;
+
+// The input surface, split into patches (its faces between sharp edges): every remeshing
+// iteration puts each vertex back on the input faces of its own patch, as CGAL's remesher
+// does, so a vertex beside a sharp edge stays on its side of it. Once thin features are
+// released, a patch of the remeshed surface covers the input patches it merged.
+class PatchProjection {
+public:
+    PatchProjection(const SurfaceMesh& input, const FacePatches& patch, std::size_t patches) : input_(input), faces_(patches), sources_(patches) {
+        for (FaceIndex f : input.faces()) faces_[patch[f]].push_back(f);
+        for (std::size_t p = 0; p < patches; ++p) sources_[p] = {p};
+        buildTrees();
+    }
+
+    // `work`'s patches were relabelled (`before[f]` their old labels, now `patch`): each new
+    // patch covers the input patches of the old ones it holds.
+    void relabel(const SurfaceMesh& work, const std::vector<std::size_t>& before, const FacePatches& patch, std::size_t patches) {
+        std::vector<std::vector<std::size_t>> sources(patches);
+        for (FaceIndex f : work.faces()) {
+            const std::vector<std::size_t>& old = sources_[before[std::size_t(f)]];
+            sources[patch[f]].insert(sources[patch[f]].end(), old.begin(), old.end());
+        }
+        for (std::vector<std::size_t>& s : sources) {
+            std::sort(s.begin(), s.end());
+            s.erase(std::unique(s.begin(), s.end()), s.end());
+        }
+        sources_ = std::move(sources);
+        buildTrees();
+    }
+
+    void project(SurfaceMesh& work, const FacePatches& patch) const {
+        for (VertexIndex v : work.vertices()) {
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(v, work)) {
+                if (work.is_border(h)) continue;
+                work.point(v) = trees_[patch[work.face(h)]]->closest_point(work.point(v));
+                break;
+            }
+        }
+    }
+
+private:
+    void buildTrees() {
+        trees_.clear();
+        for (const std::vector<std::size_t>& source : sources_) {
+            std::vector<FaceIndex> faces;
+            for (std::size_t p : source) faces.insert(faces.end(), faces_[p].begin(), faces_[p].end());
+            trees_.push_back(std::make_unique<FaceTree>(faces.begin(), faces.end(), input_));
+            trees_.back()->accelerate_distance_queries();
+        }
+    }
+
+    const SurfaceMesh& input_;
+    std::vector<std::vector<FaceIndex>> faces_;      // per input patch
+    std::vector<std::vector<std::size_t>> sources_;  // per patch of the remeshed surface: its input patches
+    std::vector<std::unique_ptr<FaceTree>> trees_;   // per patch of the remeshed surface
+};
+
+// The surface being remeshed, with its kept edges (sharp or border: CGAL's constrained edges)
+// and its faces' patch labels, which CGAL carries through splits and flips.
+struct WorkSurface {
+    SurfaceMesh mesh;
+    EdgeFlags kept;
+    FacePatches patch;
+
+    explicit WorkSurface(const SurfaceMesh& from)
+        : mesh(from), kept(mesh.add_property_map<EdgeIndex, bool>("e:constrained", false).first),
+          patch(mesh.add_property_map<FaceIndex, std::size_t>("f:patch", 0).first) {}
+    WorkSurface(const WorkSurface& other) : mesh(other.mesh), kept(propertyMaps().first), patch(propertyMaps().second) {}
+    WorkSurface& operator=(WorkSurface&& other) {
+        mesh = std::move(other.mesh);
+        std::tie(kept, patch) = propertyMaps();
+        return *this;
+    }
+
+private:
+    std::pair<EdgeFlags, FacePatches> propertyMaps() const {
+        return {mesh.property_map<EdgeIndex, bool>("e:constrained").first, mesh.property_map<FaceIndex, std::size_t>("f:patch").first};
+    }
+};
+
+// Labels the faces by patch (connected across edges not kept); returns their number.
+std::size_t labelPatches(WorkSurface& s) {
+    return PMP::connected_components(s.mesh, s.patch, CGAL::parameters::edge_is_constrained_map(s.kept));
+}
+
+// One iteration of isotropic remeshing at a time: CGAL's split, collapse and flip, then our
+// own call of its tangential relaxation and projection. CGAL 5.5.1's relaxation inside
+// isotropic_remeshing reads its constraint map at an invalid edge for a vertex whose faces are
+// all degenerate (a read far past a property array: a segfault on regr01 when a remeshed
+// surface was remeshed again); given a map that answers such an edge, the same relaxation is safe.
+void remeshIterations(WorkSurface& s, const RemeshOptions& options, const PatchProjection& projection) {
+    SurfaceMesh& work = s.mesh;
+    auto notMoved = [&work](VertexIndex v) { return work.point(v); };  // never called: do_project(false)
+    auto keptEdge = [&s](EdgeIndex e) { return std::size_t(e) < s.mesh.num_edges() && (s.kept[e] || s.mesh.is_border(e)); };
+    for (int i = 0; i < options.iterations; ++i) {
+        PMP::isotropic_remeshing(faces(work), options.targetEdge, work,
+                                 CGAL::parameters::number_of_iterations(1)
+                                     .number_of_relaxation_steps(0)
+                                     .do_project(false)
+                                     .projection_functor(notMoved)
+                                     .edge_is_constrained_map(s.kept)
+                                     .face_patch_map(s.patch)
+                                     .relax_constraints(true));
+        PMP::tangential_relaxation(vertices(work), work,
+                                   CGAL::parameters::number_of_iterations(1)
+                                       .edge_is_constrained_map(boost::make_function_property_map<EdgeIndex>(keptEdge))
+                                       .relax_constraints(true));
+        projection.project(work, s.patch);
+    }
+}
+
+// Where sharp polylines meet, needles and caps can remain: collapsed or flipped away (CGAL's
+// cap/needle removal, kept edges kept).
+void removeCapsAndNeedles(WorkSurface& s, double targetEdge) {
+    PMP::experimental::remove_almost_degenerate_faces(s.mesh, std::cos(kCapAngle * M_PI / 180.0), kNeedleRatio, kNeedleEdge * targetEdge,
+                                                      CGAL::parameters::edge_is_constrained_map(s.kept));
+    s.mesh.collect_garbage();
+}
+
+double smallestAngle(const SurfaceMesh& mesh, HalfedgeIndex h) {
+    const Point& a = mesh.point(mesh.source(h));
+    const Point& b = mesh.point(mesh.target(h));
+    const Point& c = mesh.point(mesh.target(mesh.next(h)));
+    return smallestAngle(Vec3(a.x(), a.y(), a.z()), Vec3(b.x(), b.y(), b.z()), Vec3(c.x(), c.y(), c.z()));
+}
+
+// A sliver whose three vertices lie on sharp polylines, lower than kThinFeature of the target
+// edge: two polylines (or one folded back) closer than the triangles can span. The sharp edges
+// at its vertices stop being kept; returns how many.
+std::size_t releaseThinFeatures(WorkSurface& s, double targetEdge) {
+    SurfaceMesh& work = s.mesh;
+    EdgeFlags& constrained = s.kept;
+    std::vector<char> onPolyline(work.num_vertices(), 0);
+    for (EdgeIndex e : work.edges())
+        if (constrained[e]) onPolyline[std::size_t(work.vertex(e, 0))] = onPolyline[std::size_t(work.vertex(e, 1))] = 1;
+    std::vector<VertexIndex> corners;
+    for (FaceIndex f : work.faces()) {
+        const HalfedgeIndex h = work.halfedge(f);
+        if (smallestAngle(work, h) >= kSliverAngle) continue;
+        double longest = 0.0;
+        bool allOnPolylines = true;
+        for (HalfedgeIndex k : CGAL::halfedges_around_face(h, work)) {
+            longest = std::max(longest, std::sqrt(CGAL::squared_distance(work.point(work.source(k)), work.point(work.target(k)))));
+            allOnPolylines = allOnPolylines && onPolyline[std::size_t(work.target(k))];
+        }
+        const Point& a = work.point(work.source(h));
+        const double height = std::sqrt(CGAL::cross_product(work.point(work.target(h)) - a, work.point(work.target(work.next(h))) - a).squared_length()) / longest;
+        if (!allOnPolylines || height >= kThinFeature * targetEdge) continue;
+        for (VertexIndex v : CGAL::vertices_around_face(h, work)) corners.push_back(v);
+    }
+    std::size_t released = 0;
+    for (VertexIndex v : corners)
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(v, work))
+            if (constrained[work.edge(h)] && !work.is_border(work.edge(h))) {
+                constrained[work.edge(h)] = false;
+                ++released;
+            }
+    return released;
+}
+
+// Share of the triangles with an angle below kSliverAngle.
+double sliverShare(const SurfaceMesh& mesh) {
+    std::size_t slivers = 0;
+    for (FaceIndex f : mesh.faces()) slivers += smallestAngle(mesh, mesh.halfedge(f)) < kSliverAngle ? 1 : 0;
+    return mesh.number_of_faces() > 0 ? double(slivers) / double(mesh.number_of_faces()) : 0.0;
+}
+
+// Rounds of releasing thin features and remeshing again; returns the edges released.
+std::size_t roundThinFeatures(WorkSurface& s, const RemeshOptions& options, PatchProjection& projection) {
+    std::size_t total = 0;
+    for (int round = 0; round < kReleaseRounds; ++round) {
+        const std::size_t released = releaseThinFeatures(s, options.targetEdge);
+        if (released == 0) break;
+        total += released;
+        std::vector<std::size_t> before(s.mesh.num_faces());
+        for (FaceIndex f : s.mesh.faces()) before[std::size_t(f)] = s.patch[f];
+        projection.relabel(s.mesh, before, s.patch, labelPatches(s));
+        remeshIterations(s, options, projection);
+    }
+    removeCapsAndNeedles(s, options.targetEdge);
+    return total;
+}
 
 // The Hausdorff distance's samples: vertices, and points on a grid over every edge and face
 // at this share of the target edge (deterministic, unlike random sampling).
@@ -187,25 +394,32 @@ RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, co
         throw InputError(source, 0, "remesh: the feature angle must be between 0 and 180 degrees");
     r.before = measureQuality(mesh);
     const SurfaceMesh input = toSurfaceMesh(mesh, source);
-    SurfaceMesh work = input;
-    auto constrained = work.add_property_map<SurfaceMesh::Edge_index, bool>("e:constrained", false).first;
-    r.featureEdges = markConstrainedEdges(work, options.featureAngle, constrained);
-    PMP::isotropic_remeshing(faces(work), options.targetEdge, work,
-                             CGAL::parameters::number_of_iterations(unsigned(options.iterations))
-                                 .edge_is_constrained_map(constrained)
-                                 .relax_constraints(true));
-    // Where constrained polylines meet, a few needles and caps can remain: collapsed or
-    // flipped away (CGAL's cap/needle removal, features kept).
-    PMP::experimental::remove_almost_degenerate_faces(work, std::cos(kCapAngle * M_PI / 180.0), kNeedleRatio, kNeedleEdge * options.targetEdge,
-                                                      CGAL::parameters::edge_is_constrained_map(constrained));
-    work.collect_garbage();
-    r.mesh = toTriMesh(work, mesh.name);
+    WorkSurface work(input);
+    r.featureEdges = markConstrainedEdges(work.mesh, options.featureAngle, work.kept);
+    const std::size_t patches = labelPatches(work);
+    PatchProjection projection(input, work.patch, patches);  // `work` is still `input`'s copy: its faces, its labels
+    remeshIterations(work, options, projection);
+    removeCapsAndNeedles(work, options.targetEdge);
+    const double spacing = kSampleShare * options.targetEdge;
+    r.hausdorff = sampledHausdorff(input, work.mesh, spacing);
+    const double slivers = sliverShare(work.mesh);
+    const bool round = options.thinFeatures == ThinFeatures::Round;
+    if (round || (options.thinFeatures == ThinFeatures::Auto && slivers >= kRoundingShare)) {
+        WorkSurface rounded(work);
+        r.releasedEdges = roundThinFeatures(rounded, options, projection);
+        r.roundedHausdorff = sampledHausdorff(input, rounded.mesh, spacing);
+        r.rounded = round || (r.roundedHausdorff <= std::max(r.hausdorff, options.targetEdge) && sliverShare(rounded.mesh) < slivers);
+        if (r.rounded) {
+            work = std::move(rounded);
+            r.hausdorff = r.roundedHausdorff;
+        }
+    }
+    r.mesh = toTriMesh(work.mesh, mesh.name);
     // What is still degenerate by validateMesh's test (three vertices of one constrained
     // polyline, nearly collinear) is dropped and counted.
     const MeshRepairs repairs = repairMesh(r.mesh, 0.0, source);
     r.droppedFaces = repairs.degenerateFaces + repairs.duplicateFaces;
     r.after = measureQuality(r.mesh);
-    r.hausdorff = sampledHausdorff(input, work, kSampleShare * options.targetEdge);
     validateMesh(r.mesh, source);
     return r;
 }

@@ -173,7 +173,8 @@ std::vector<const toml::table*> tables(Table& root, const std::string& key) {
     return out;
 }
 
-// `remesh = L` (the target edge) or `remesh = { edge = L, iterations = N, feature_angle = DEG }`.
+// `remesh = L` (the target edge) or
+// `remesh = { edge = L, iterations = N, feature_angle = DEG, thin_features = "auto" | "keep" | "round" }`.
 std::optional<RemeshOptions> readRemesh(Table& t) {
     if (!t.has("remesh")) return std::nullopt;
     const toml::node* n = t.node("remesh");
@@ -182,13 +183,17 @@ std::optional<RemeshOptions> readRemesh(Table& t) {
         r.targetEdge = t.positive("remesh", 1.0);
         return r;
     }
-    if (!n->is_table()) t.fail(*n, "remesh", "expected a target edge length or {edge, iterations, feature_angle}");
+    if (!n->is_table()) t.fail(*n, "remesh", "expected a target edge length or {edge, iterations, feature_angle, thin_features}");
     Table options = t.sub("remesh");
     if (!options.has("edge")) options.fail("needs 'edge' (the target edge length)");
     r.targetEdge = options.positive("edge", 0.0);
     r.iterations = options.integer("iterations", r.iterations, 1, 100);
     r.featureAngle = options.positive("feature_angle", r.featureAngle);
     if (!(r.featureAngle < 180.0)) options.fail(*options.node("feature_angle"), "feature_angle", "must be below 180 degrees");
+    const std::string thin = options.text("thin_features", "auto");
+    if (thin == "keep") r.thinFeatures = ThinFeatures::Keep;
+    else if (thin == "round") r.thinFeatures = ThinFeatures::Round;
+    else if (thin != "auto") options.fail(*options.node("thin_features"), "thin_features", "unknown value '" + thin + "' (expected 'auto', 'keep' or 'round')");
     options.finish();
     return r;
 }

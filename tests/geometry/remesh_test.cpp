@@ -2,7 +2,8 @@
 // comes out without them, every vertex on the box (the analytic distance to its surface), the
 // corners and edges kept; an open square keeps its rim; the reported Hausdorff distance is at
 // least a brute-force lower bound (output vertices against the input's triangles) and within
-// the target edge; bad options are errors.
+// the target edge; a chamfer narrower than half the edge is rounded (the rest kept, every vertex
+// on the input's planes) and ThinFeatures::Auto chooses as its rule says; bad options are errors.
 #include "flexfit/generators.hpp"
 #include "flexfit/remesh.hpp"
 
@@ -199,6 +200,87 @@ TEST(Remesh, EdgesThatWouldMakeMillionsOfTrianglesOrThatTheCoordinatesCannotReso
     } catch (const InputError& e) {
         EXPECT_NE(e.problem().find("cannot resolve"), std::string::npos) << e.problem();
     }
+}
+
+// The box [-1, 1]^3 with its edge at x = y = 1 cut by the plane x + y = 2 - c: a chamfer
+// c sqrt(2) wide between two sharp edges of 45 degrees. Its faces are fans of its polygons.
+struct ChamferedBox {
+    double c;
+    TriMesh mesh() const {
+        TriMesh out;
+        out.name = "chamfered";
+        for (double z : {-1.0, 1.0}) out.vertices.insert(out.vertices.end(), {{-1, -1, z}, {1, -1, z}, {1, 1 - c, z}, {1 - c, 1, z}, {-1, 1, z}});
+        const std::vector<std::vector<Index>> polygons{{0, 4, 3, 2, 1}, {5, 6, 7, 8, 9}, {0, 1, 6, 5}, {1, 2, 7, 6}, {2, 3, 8, 7}, {3, 4, 9, 8}, {4, 0, 5, 9}};
+        for (const std::vector<Index>& p : polygons)
+            for (std::size_t k = 1; k + 1 < p.size(); ++k) out.faces.push_back({p[0], p[k], p[k + 1]});
+        return out;
+    }
+    // Signed distance to the nearest of its planes: 0 on its surface (it is convex).
+    double planeDistance(const Vec3& p) const {
+        return std::max({p.cwiseAbs().maxCoeff() - 1.0, (p.x() + p.y() - (2.0 - c)) / std::sqrt(2.0)});
+    }
+};
+
+bool samePoint(const std::vector<Vec3>& points, const Vec3& p) {
+    return std::any_of(points.begin(), points.end(), [&](const Vec3& v) { return (v - p).norm() < 1e-12; });
+}
+
+// ThinFeatures::Auto against the two outright choices on the same input: it tries rounding when
+// 1 % or more of the kept surface's triangles are slivers, and returns the rounded surface when
+// it has fewer slivers and lies within the target edge of the input (or no farther than the
+// kept one); otherwise the kept surface, bit for bit.
+void expectAutoFollowsItsRule(const TriMesh& input, double edge, const RemeshResult& kept, const RemeshResult& rounded) {
+    const RemeshResult chosen = remeshForSimulation(input, {.targetEdge = edge}, "auto");
+    const bool tried = kept.after.slivers >= 0.01;
+    const bool round = tried && rounded.after.slivers < kept.after.slivers && rounded.hausdorff <= std::max(kept.hausdorff, edge);
+    EXPECT_EQ(chosen.rounded, round);
+    EXPECT_EQ(chosen.releasedEdges, tried ? rounded.releasedEdges : 0u);
+    const RemeshResult& expected = round ? rounded : kept;
+    EXPECT_EQ(chosen.mesh.vertices, expected.mesh.vertices);
+    EXPECT_EQ(chosen.mesh.faces, expected.mesh.faces);
+    EXPECT_EQ(chosen.hausdorff, expected.hausdorff);
+}
+
+TEST(Remesh, AChamferNarrowerThanHalfTheEdgeIsRoundedAndTheRestKept) {
+    const ChamferedBox box{0.02};  // the chamfer 0.028 wide: 0.11 of the edge
+    const double edge = 0.25;
+    const TriMesh input = box.mesh();
+    const RemeshResult kept = remeshForSimulation(input, {.targetEdge = edge, .thinFeatures = ThinFeatures::Keep}, "box");
+    const RemeshResult rounded = remeshForSimulation(input, {.targetEdge = edge, .thinFeatures = ThinFeatures::Round}, "box");
+    // Kept: the surface exact, the chamfer's corners kept, slivers along it.
+    EXPECT_LT(kept.hausdorff, 1e-9);
+    EXPECT_GT(kept.after.slivers, 0.01);
+    EXPECT_EQ(kept.releasedEdges, 0u);
+    for (const Vec3& corner : input.vertices) EXPECT_TRUE(samePoint(kept.mesh.vertices, corner)) << corner.transpose();
+    // Rounded: no sliver; every vertex still on the input's surface (its planes, analytically);
+    // the box's corners away from the chamfer kept; the chamfer cut by less than half the edge.
+    EXPECT_TRUE(rounded.rounded);
+    EXPECT_GT(rounded.releasedEdges, 0u);
+    EXPECT_EQ(rounded.after.slivers, 0.0);
+    EXPECT_GT(rounded.after.minAngle, 25.0);
+    for (const Vec3& v : rounded.mesh.vertices) EXPECT_NEAR(box.planeDistance(v), 0.0, 1e-9) << v.transpose();
+    for (const Vec3& corner : input.vertices) {
+        const bool onTheChamfer = corner.x() + corner.y() > 1.5;
+        EXPECT_TRUE(onTheChamfer || samePoint(rounded.mesh.vertices, corner)) << corner.transpose();
+    }
+    EXPECT_GT(rounded.hausdorff, 0.0);
+    EXPECT_LT(rounded.hausdorff, 0.5 * edge);
+    EXPECT_EQ(rounded.roundedHausdorff, rounded.hausdorff);
+    EXPECT_NO_THROW(validateMesh(rounded.mesh, "rounded"));
+    expectAutoFollowsItsRule(input, edge, kept, rounded);
+}
+
+TEST(Remesh, AutoKeepsTheSharpEdgesWhereRoundingLeavesNoFewerSlivers) {
+    // A bar 0.04 thick remeshed at 0.2: its long sides are slivers however they are cut, and
+    // rounding its edges leaves more of them.
+    const TriMesh bar = makeBox(Vec3(0.02, 0.02, 1.0), 1);
+    const double edge = 0.2;
+    const RemeshResult kept = remeshForSimulation(bar, {.targetEdge = edge, .thinFeatures = ThinFeatures::Keep}, "bar");
+    const RemeshResult rounded = remeshForSimulation(bar, {.targetEdge = edge, .thinFeatures = ThinFeatures::Round}, "bar");
+    EXPECT_GT(kept.after.slivers, 0.5);
+    EXPECT_GE(rounded.after.slivers, kept.after.slivers);
+    EXPECT_GT(rounded.releasedEdges, 0u);
+    expectAutoFollowsItsRule(bar, edge, kept, rounded);
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 // Scene files: every error class names the file, the line and the key, and nothing is built;
 // a valid scene gives exactly the values it states (checked key by key against the text),
 // contact materials, the contact solver's settings and the box and plate generators included.
+#include "flexfit/mesh_io.hpp"
+#include "flexfit/remesh.hpp"
 #include "flexfit/scene_file.hpp"
 #include "temp_dir.hpp"
 
@@ -492,6 +494,27 @@ TEST(SceneFile, RemeshGivesTheModelNearUniformEdges) {
         << error("remesh = 1e-6\n");
     EXPECT_NE(errorOf(withLine("name = \"ball\"", "remesh = 0.5")).find("key 'remesh': applies only to a part read from a 'mesh' file"),
               std::string::npos);
+}
+
+// `thin_features` in the remesh table: the part's model is the surface remeshForSimulation makes
+// with that choice (a chamfer narrower than half the edge: kept, or rounded).
+TEST(SceneFile, RemeshThinFeaturesChoosesTheSurface) {
+    flexfit::testing::TempDir dir;
+    dir.write("chamfered.obj", "v -1 -1 -1\nv 1 -1 -1\nv 1 0.98 -1\nv 0.98 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 0.98 1\nv 0.98 1 1\n"
+                               "v -1 1 1\nf 1 5 4 3 2\nf 6 7 8 9 10\nf 1 2 7 6\nf 2 3 8 7\nf 3 4 9 8\nf 4 5 10 9\nf 5 1 6 10\n");
+    const TriMesh file = readMesh(dir.path() / "chamfered.obj").mesh;
+    const std::string part = "[[part]]\nname = \"box\"\nmesh = \"chamfered.obj\"\n";
+    for (const auto& [key, choice] : {std::pair{"keep", ThinFeatures::Keep}, std::pair{"round", ThinFeatures::Round}, std::pair{"auto", ThinFeatures::Auto}}) {
+        const Scene scene = parseScene(part + "remesh = { edge = 0.25, thin_features = \"" + key + "\" }\n", "scene.toml", dir.path());
+        const TriMesh expected = remeshForSimulation(file, {.targetEdge = 0.25, .thinFeatures = choice}, "chamfered.obj").mesh;
+        EXPECT_EQ(scene.parts[0].model->mesh.faces.size(), expected.faces.size()) << key;
+        EXPECT_EQ(scene.parts[0].model->restLength.size(), scene.parts[0].model->springCount()) << key;
+    }
+    const Scene kept = parseScene(part + "remesh = { edge = 0.25, thin_features = \"keep\" }\n", "scene.toml", dir.path());
+    const Scene rounded = parseScene(part + "remesh = { edge = 0.25, thin_features = \"round\" }\n", "scene.toml", dir.path());
+    EXPECT_NE(kept.parts[0].model->mesh.faces.size(), rounded.parts[0].model->mesh.faces.size());
+    const std::string bad = errorOf(part + "remesh = { edge = 0.25, thin_features = \"never\" }\n", dir.path());
+    EXPECT_NE(bad.find("scene.toml:4: part 1.remesh, key 'thin_features': unknown value 'never' (expected 'auto', 'keep' or 'round')"), std::string::npos) << bad;
 }
 
 TEST(SceneFile, ImplicitIntegratorAndItsSolve) {
