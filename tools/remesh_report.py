@@ -2,7 +2,10 @@
 """Simulation remeshing on third-party meshes: `flexfit remesh` on Debian's assimp test models at
 target edges set as shares of each part's bounding-box diagonal; the quality before and after
 (smallest angle, share of triangles with an angle below 20 degrees, edge-length spread) and the
-Hausdorff distance as a share of the diagonal, one CSV row per mesh and edge.
+Hausdorff distance as a share of the diagonal, one CSV row per mesh and edge. Each is remeshed
+twice: keeping every sharp edge (`--thin-features keep`: its slivers and Hausdorff distance in the
+`*_keep` columns) and as by default (`auto`: rounding thin features where that leaves fewer
+slivers within the target edge of the input; `thin_features` says what it did).
 
   tools/remesh_report.py --flexfit build/release/apps/flexfit/flexfit --csv bench/results/remesh.csv
 """
@@ -28,6 +31,16 @@ def diagonal(flexfit, mesh):
     return sum((b - a) ** 2 for a, b in zip(lo, hi)) ** 0.5
 
 
+def remesh(flexfit, mesh, out, edge, *options):
+    start = time.perf_counter()
+    run = subprocess.run([flexfit, "remesh", mesh, out, "--edge", f"{edge:.6g}", *options], check=True, capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    q = {m.group(1): m.groups()[1:] for m in QUALITY.finditer(run.stdout)}
+    h = HAUSDORFF.search(run.stdout)
+    thin = "rounded" if "thin features rounded" in run.stdout else "kept" if "thin features kept" in run.stderr else "none"
+    return q, h.group(2), thin, seconds
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--flexfit", required=True)
@@ -38,16 +51,13 @@ def main():
         for mesh in MESHES:
             d = diagonal(args.flexfit, mesh)
             for share in SHARES:
-                start = time.perf_counter()
-                out = subprocess.run([args.flexfit, "remesh", mesh, f"{directory}/out.obj", "--edge", f"{share * d:.6g}"], check=True,
-                                     capture_output=True, text=True).stdout
-                seconds = time.perf_counter() - start
-                q = {m.group(1): m.groups()[1:] for m in QUALITY.finditer(out)}
-                h = HAUSDORFF.search(out)
+                kept, hausdorff_kept, _, _ = remesh(args.flexfit, mesh, f"{directory}/out.obj", share * d, "--thin-features", "keep")
+                q, hausdorff, thin, seconds = remesh(args.flexfit, mesh, f"{directory}/out.obj", share * d)
                 rows.append({"mesh": mesh.split("/")[-1], "edge_share": f"{share:g}", "faces_in": q["input"][0], "min_angle_in": q["input"][1],
-                             "slivers_in_pct": q["input"][2], "spread_in": q["input"][3], "faces_out": q["output"][0],
+                             "slivers_in_pct": q["input"][2], "spread_in": q["input"][3], "slivers_keep_pct": kept["output"][2],
+                             "hausdorff_keep_pct": hausdorff_kept, "thin_features": thin, "faces_out": q["output"][0],
                              "min_angle_out": q["output"][1], "slivers_out_pct": q["output"][2], "spread_out": q["output"][3],
-                             "hausdorff_pct": h.group(2), "seconds": f"{seconds:.2f}"})
+                             "hausdorff_pct": hausdorff, "seconds": f"{seconds:.2f}"})
     report(rows, args.csv)
 
 
