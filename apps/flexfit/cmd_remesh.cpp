@@ -22,7 +22,8 @@ void printThinFeatures(const RemeshResult& r, const std::string& source) {
                    r.releasedEdges);
     else
         warn(fmt::format("{}: thin features kept (slivers remain between sharp edges closer than half the target edge): rounding them "
-                         "moved the surface {:.3f} % of the diagonal or left no fewer slivers; --thin-features round rounds them anyway",
+                         "moved the surface {:.3f} % of the diagonal, left no fewer slivers or opened the closed surface; --thin-features round "
+                         "rounds them anyway",
                          source, share));
 }
 

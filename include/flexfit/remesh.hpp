@@ -31,9 +31,10 @@
 // Hausdorff distance from 0.25 % to 0.37 % of the diagonal; on the spider (legs thinner than
 // the edge, every edge of them sharp) from 0.2 % to 0.0 % and from 0.22 % to 1.2 %: its legs
 // shrink. So `ThinFeatures::Auto` (the default) tries it only when 1 % or more of the
-// triangles are slivers, and keeps the rounded surface only when it has fewer slivers and its
-// Hausdorff distance is within the target edge (or no more than the other's); Keep and Round
-// decide it outright.
+// triangles are slivers, and keeps the rounded surface only when it has fewer slivers, its
+// Hausdorff distance is within the target edge (or no more than the other's) and it is closed
+// if the other is (faces of zero area are dropped, which can open it); Keep and Round decide
+// it outright.
 //
 // Each remeshing iteration is CGAL's split, collapse and flip followed by its tangential
 // relaxation and a projection onto the input faces of the vertex's own patch (the faces

@@ -111,8 +111,8 @@ constexpr double kThinFeature = 0.5;
 constexpr int kReleaseRounds = 3;
 constexpr double kSliverAngle = 20.0;
 // ThinFeatures::Auto tries rounding when the surface keeping every sharp edge has this share of
-// slivers, and keeps the rounded surface when it has fewer and lies within the target edge of
-// the input (or no farther than the other).
+// slivers, and keeps the rounded surface when it has fewer, lies within the target edge of the
+// input (or no farther than the other) and is closed if the other is.
 constexpr double kRoundingShare = 0.01;
 
 // The input surface, split into patches (its faces between sharp edges): every remeshing
@@ -181,11 +181,6 @@ struct WorkSurface {
         : mesh(from), kept(mesh.add_property_map<EdgeIndex, bool>("e:constrained", false).first),
           patch(mesh.add_property_map<FaceIndex, std::size_t>("f:patch", 0).first) {}
     WorkSurface(const WorkSurface& other) : mesh(other.mesh), kept(propertyMaps().first), patch(propertyMaps().second) {}
-    WorkSurface& operator=(WorkSurface&& other) {
-        mesh = std::move(other.mesh);
-        std::tie(kept, patch) = propertyMaps();
-        return *this;
-    }
 
 private:
     std::pair<EdgeFlags, FacePatches> propertyMaps() const {
@@ -296,6 +291,22 @@ std::size_t roundThinFeatures(WorkSurface& s, const RemeshOptions& options, Patc
     return total;
 }
 
+// A remeshed surface as returned: what is still of zero area by validateMesh's test (three
+// vertices of one kept polyline, nearly collinear) dropped and counted, which can open it.
+struct FinishedSurface {
+    TriMesh mesh;
+    std::size_t dropped = 0;
+    bool closed = false;
+};
+
+FinishedSurface finish(const WorkSurface& s, const std::string& name, const std::string& source) {
+    FinishedSurface f{toTriMesh(s.mesh, name)};
+    const MeshRepairs repairs = repairMesh(f.mesh, 0.0, source);
+    f.dropped = repairs.degenerateFaces + repairs.duplicateFaces;
+    f.closed = validateMesh(f.mesh, source).closed();
+    return f;
+}
+
 // The Hausdorff distance's samples: vertices, and points on a grid over every edge and face
 // at this share of the target edge (deterministic, unlike random sampling).
 constexpr double kSampleShare = 0.25;
@@ -403,24 +414,23 @@ RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, co
     const double spacing = kSampleShare * options.targetEdge;
     r.hausdorff = sampledHausdorff(input, work.mesh, spacing);
     const double slivers = sliverShare(work.mesh);
+    FinishedSurface result = finish(work, mesh.name, source);
     const bool round = options.thinFeatures == ThinFeatures::Round;
     if (round || (options.thinFeatures == ThinFeatures::Auto && slivers >= kRoundingShare)) {
         WorkSurface rounded(work);
         r.releasedEdges = roundThinFeatures(rounded, options, projection);
         r.roundedHausdorff = sampledHausdorff(input, rounded.mesh, spacing);
-        r.rounded = round || (r.roundedHausdorff <= std::max(r.hausdorff, options.targetEdge) && sliverShare(rounded.mesh) < slivers);
+        FinishedSurface roundedResult = finish(rounded, mesh.name, source);
+        r.rounded = round || (r.roundedHausdorff <= std::max(r.hausdorff, options.targetEdge) && sliverShare(rounded.mesh) < slivers &&
+                              (roundedResult.closed || !result.closed));
         if (r.rounded) {
-            work = std::move(rounded);
+            result = std::move(roundedResult);
             r.hausdorff = r.roundedHausdorff;
         }
     }
-    r.mesh = toTriMesh(work.mesh, mesh.name);
-    // What is still degenerate by validateMesh's test (three vertices of one constrained
-    // polyline, nearly collinear) is dropped and counted.
-    const MeshRepairs repairs = repairMesh(r.mesh, 0.0, source);
-    r.droppedFaces = repairs.degenerateFaces + repairs.duplicateFaces;
+    r.mesh = std::move(result.mesh);
+    r.droppedFaces = result.dropped;
     r.after = measureQuality(r.mesh);
-    validateMesh(r.mesh, source);
     return r;
 }
 

@@ -227,12 +227,13 @@ bool samePoint(const std::vector<Vec3>& points, const Vec3& p) {
 
 // ThinFeatures::Auto against the two outright choices on the same input: it tries rounding when
 // 1 % or more of the kept surface's triangles are slivers, and returns the rounded surface when
-// it has fewer slivers and lies within the target edge of the input (or no farther than the
-// kept one); otherwise the kept surface, bit for bit.
+// it has fewer slivers, lies within the target edge of the input (or no farther than the kept
+// one) and is closed if the kept one is; otherwise the kept surface, bit for bit.
 void expectAutoFollowsItsRule(const TriMesh& input, double edge, const RemeshResult& kept, const RemeshResult& rounded) {
     const RemeshResult chosen = remeshForSimulation(input, {.targetEdge = edge}, "auto");
     const bool tried = kept.after.slivers >= 0.01;
-    const bool round = tried && rounded.after.slivers < kept.after.slivers && rounded.hausdorff <= std::max(kept.hausdorff, edge);
+    const bool staysClosed = validateMesh(rounded.mesh, "rounded").closed() || !validateMesh(kept.mesh, "kept").closed();
+    const bool round = tried && rounded.after.slivers < kept.after.slivers && rounded.hausdorff <= std::max(kept.hausdorff, edge) && staysClosed;
     EXPECT_EQ(chosen.rounded, round);
     EXPECT_EQ(chosen.releasedEdges, tried ? rounded.releasedEdges : 0u);
     const RemeshResult& expected = round ? rounded : kept;
@@ -266,7 +267,8 @@ TEST(Remesh, AChamferNarrowerThanHalfTheEdgeIsRoundedAndTheRestKept) {
     EXPECT_GT(rounded.hausdorff, 0.0);
     EXPECT_LT(rounded.hausdorff, 0.5 * edge);
     EXPECT_EQ(rounded.roundedHausdorff, rounded.hausdorff);
-    EXPECT_NO_THROW(validateMesh(rounded.mesh, "rounded"));
+    EXPECT_TRUE(validateMesh(kept.mesh, "kept").closed());
+    EXPECT_TRUE(validateMesh(rounded.mesh, "rounded").closed());
     expectAutoFollowsItsRule(input, edge, kept, rounded);
 }
 
