@@ -5,7 +5,8 @@ target edges set as shares of each part's bounding-box diagonal; the quality bef
 Hausdorff distance as a share of the diagonal, one CSV row per mesh and edge. Each is remeshed
 twice: keeping every sharp edge (`--thin-features keep`: its slivers and Hausdorff distance in the
 `*_keep` columns) and as by default (`auto`: rounding thin features where that leaves fewer
-slivers within the target edge of the input; `thin_features` says what it did).
+slivers within the target edge of the input; `thin_features` says what it did; `dropped_faces`
+counts the output faces left of zero area and dropped).
 
   tools/remesh_report.py --flexfit build/release/apps/flexfit/flexfit --csv bench/results/remesh.csv
 """
@@ -22,6 +23,7 @@ MESHES = [f"{MODELS}/OFF/Wuson.off", f"{MODELS}/STL/Spider_binary.stl", f"{MODEL
 SHARES = [0.005, 0.01, 0.02]  # target edge / bounding-box diagonal
 
 QUALITY = re.compile(r"(input|output)\s+(\d+) faces, min angle\s+([0-9.]+) deg,\s+([0-9.]+) % of triangles.*spread ([0-9.]+)")
+DROPPED = re.compile(r"(\d+) degenerate output faces dropped")
 HAUSDORFF = re.compile(r"Hausdorff distance (\S+) \(([0-9.]+) % of the bounding-box diagonal ([0-9.e+-]+)\)")
 
 
@@ -38,7 +40,8 @@ def remesh(flexfit, mesh, out, edge, *options):
     q = {m.group(1): m.groups()[1:] for m in QUALITY.finditer(run.stdout)}
     h = HAUSDORFF.search(run.stdout)
     thin = "rounded" if "thin features rounded" in run.stdout else "kept" if "thin features kept" in run.stderr else "none"
-    return q, h.group(2), thin, seconds
+    dropped = DROPPED.search(run.stderr)
+    return q, h.group(2), thin, dropped.group(1) if dropped else "0", seconds
 
 
 def main():
@@ -51,13 +54,13 @@ def main():
         for mesh in MESHES:
             d = diagonal(args.flexfit, mesh)
             for share in SHARES:
-                kept, hausdorff_kept, _, _ = remesh(args.flexfit, mesh, f"{directory}/out.obj", share * d, "--thin-features", "keep")
-                q, hausdorff, thin, seconds = remesh(args.flexfit, mesh, f"{directory}/out.obj", share * d)
+                kept, hausdorff_kept, _, _, _ = remesh(args.flexfit, mesh, f"{directory}/out.obj", share * d, "--thin-features", "keep")
+                q, hausdorff, thin, dropped, seconds = remesh(args.flexfit, mesh, f"{directory}/out.obj", share * d)
                 rows.append({"mesh": mesh.split("/")[-1], "edge_share": f"{share:g}", "faces_in": q["input"][0], "min_angle_in": q["input"][1],
                              "slivers_in_pct": q["input"][2], "spread_in": q["input"][3], "slivers_keep_pct": kept["output"][2],
                              "hausdorff_keep_pct": hausdorff_kept, "thin_features": thin, "faces_out": q["output"][0],
                              "min_angle_out": q["output"][1], "slivers_out_pct": q["output"][2], "spread_out": q["output"][3],
-                             "hausdorff_pct": hausdorff, "seconds": f"{seconds:.2f}"})
+                             "hausdorff_pct": hausdorff, "dropped_faces": dropped, "seconds": f"{seconds:.2f}"})
     report(rows, args.csv)
 
 

@@ -28,7 +28,7 @@
 // and is lower than half the target edge, the sharp edges at its vertices stop being kept and
 // the surface is remeshed again, up to three rounds (counted in releasedEdges). That moves the
 // surface: on regr01 (a CAD part) at 0.5 % of its size slivers go from 2.0 % to 0.2 % and the
-// Hausdorff distance from 0.23 % to 0.37 % of the diagonal; on the spider (legs thinner than
+// Hausdorff distance from 0.23 % to 0.44 % of the diagonal; on the spider (legs thinner than
 // the edge, every edge of them sharp) from 0.2 % to 0.0 % and from 0.22 % to 1.2 %: its legs
 // shrink. So `ThinFeatures::Auto` (the default) tries it only when 1 % or more of the
 // triangles are slivers, and keeps the rounded surface only when it has fewer slivers, its
@@ -53,7 +53,7 @@
 // midpoints to at most 4/3 of the target edge (the same points on every sheet), kept, and their
 // vertices held in place, so the copies weld back and the junction stays joined (remeshed apart
 // they drifted and opened cracks: regr01 at 1 % of its size had 142 boundary edges away from
-// any border of the input, and has none now).
+// any border or junction of the input, and has none now).
 //
 // Known limits: the input must be a manifold surface (edges shared by at most two faces,
 // consistently wound: repairMesh() makes it so where it can; CGAL's polygon-soup orientation

@@ -112,6 +112,7 @@ constexpr double kThinFeature = 0.5;
 // Rounds of releasing thin features and remeshing again: a round's remeshing can leave new thin
 // slivers beside the edges it released (on regr01 the third round still found a few).
 constexpr int kReleaseRounds = 3;
+// A sliver: a triangle with an angle below this many degrees (MeshQuality::slivers).
 constexpr double kSliverAngle = 20.0;
 // ThinFeatures::Auto tries rounding when the surface keeping every sharp edge has this share of
 // slivers, and keeps the rounded surface when it has fewer, lies within the target edge of the
@@ -220,8 +221,12 @@ std::set<Position> sharedPositions(const SurfaceMesh& mesh) {
 std::size_t holdSeams(WorkSurface& s, double targetEdge) {
     const std::set<Position> shared = sharedPositions(s.mesh);
     if (shared.empty()) return 0;
-    std::map<std::pair<Position, Position>, int> joins;
-    auto key = [&s](EdgeIndex e) { return std::minmax(positionOf(s.mesh, s.mesh.vertex(e, 0)), positionOf(s.mesh, s.mesh.vertex(e, 1))); };
+    using Join = std::pair<Position, Position>;
+    std::map<Join, int> joins;
+    auto key = [&s](EdgeIndex e) {
+        const Position a = positionOf(s.mesh, s.mesh.vertex(e, 0)), b = positionOf(s.mesh, s.mesh.vertex(e, 1));
+        return a < b ? Join{a, b} : Join{b, a};  // by value: std::minmax would return references to these
+    };
     for (EdgeIndex e : s.mesh.edges())
         if (shared.count(positionOf(s.mesh, s.mesh.vertex(e, 0))) && shared.count(positionOf(s.mesh, s.mesh.vertex(e, 1)))) ++joins[key(e)];
     std::vector<EdgeIndex> seam;
@@ -389,7 +394,7 @@ MeshQuality measureQuality(const TriMesh& mesh) {
     for (const Face& f : mesh.faces) {
         const double angle = smallestAngle(mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]);
         q.minAngle = std::min(q.minAngle, angle);
-        slivers += angle < 20.0 ? 1 : 0;
+        slivers += angle < kSliverAngle ? 1 : 0;
     }
     q.slivers = mesh.faces.empty() ? 0.0 : double(slivers) / double(mesh.faces.size());
     // Each edge once: the faces' edges, keyed by their vertices.
