@@ -499,22 +499,20 @@ TEST(SceneFile, RemeshGivesTheModelNearUniformEdges) {
 // `thin_features` in the remesh table: the part's model is the surface remeshForSimulation makes
 // with that choice (a chamfer narrower than half the edge: kept, or rounded).
 TEST(SceneFile, RemeshThinFeaturesChoosesTheSurface) {
-    flexfit::testing::TempDir dir;
-    dir.write("chamfered.obj", "v -1 -1 -1\nv 1 -1 -1\nv 1 0.98 -1\nv 0.98 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 0.98 1\nv 0.98 1 1\n"
-                               "v -1 1 1\nf 1 5 4 3 2\nf 6 7 8 9 10\nf 1 2 7 6\nf 2 3 8 7\nf 3 4 9 8\nf 4 5 10 9\nf 5 1 6 10\n");
-    const TriMesh file = readMesh(dir.path() / "chamfered.obj").mesh;
-    const std::string part = "[[part]]\nname = \"box\"\nmesh = \"chamfered.obj\"\n";
+    const std::filesystem::path data = FLEXFIT_TEST_DATA_DIR;  // chamfered_box.obj: the CLI tests' box
+    const TriMesh file = readMesh(data / "chamfered_box.obj").mesh;
+    const std::string part = "[[part]]\nname = \"box\"\nmesh = \"chamfered_box.obj\"\n";
     std::vector<std::size_t> faces;
     for (const auto& [key, choice] : {std::pair{"keep", ThinFeatures::Keep}, std::pair{"round", ThinFeatures::Round}}) {
-        const Scene scene = parseScene(part + "remesh = { edge = 0.25, thin_features = \"" + key + "\" }\n", "scene.toml", dir.path());
-        const TriMesh expected = remeshForSimulation(file, {.targetEdge = 0.25, .thinFeatures = choice}, "chamfered.obj").mesh;
+        const Scene scene = parseScene(part + "remesh = { edge = 0.25, thin_features = \"" + key + "\" }\n", "scene.toml", data);
+        const TriMesh expected = remeshForSimulation(file, {.targetEdge = 0.25, .thinFeatures = choice}, "chamfered_box.obj").mesh;
         // The model renumbers the vertices for locality: the same surface, compared by its counts.
         EXPECT_EQ(scene.parts[0].model->mesh.faces.size(), expected.faces.size()) << key;
         EXPECT_EQ(scene.parts[0].model->mesh.vertices.size(), expected.vertices.size()) << key;
         faces.push_back(expected.faces.size());
     }
     EXPECT_NE(faces[0], faces[1]);  // the two surfaces differ
-    const std::string bad = errorOf(part + "remesh = { edge = 0.25, thin_features = \"never\" }\n", dir.path());
+    const std::string bad = errorOf(part + "remesh = { edge = 0.25, thin_features = \"never\" }\n", data);
     EXPECT_NE(bad.find("scene.toml:4: part 1.remesh, key 'thin_features': unknown value 'never' (expected 'auto', 'keep' or 'round')"), std::string::npos) << bad;
 }
 

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import flexfit
+from conftest import ROOT
 
 
 def ball_on_torus():
@@ -32,12 +33,9 @@ def test_meshes_from_arrays_files_and_generators(tmp_path):
     remeshed, quality = flexfit.remesh(flexfit.torus(10, 2.5, 64, 24), 1.5)
     assert quality["min_angle_degrees"] > 20 and quality["hausdorff_share"] < 0.01
     assert "Mesh" in repr(remeshed)
-    # A box whose edge at x = y = 1 is chamfered 0.028 wide: the chamfer's sharp edges are closer
-    # than half of a 0.25 edge, kept as asked (slivers between them) or rounded.
-    chamfered = flexfit.Mesh(np.array([[-1, -1, -1], [1, -1, -1], [1, 0.98, -1], [0.98, 1, -1], [-1, 1, -1],
-                                       [-1, -1, 1], [1, -1, 1], [1, 0.98, 1], [0.98, 1, 1], [-1, 1, 1.0]]),
-                             np.array([[0, 4, 3], [0, 3, 2], [0, 2, 1], [5, 6, 7], [5, 7, 8], [5, 8, 9], [0, 1, 6], [0, 6, 5], [1, 2, 7],
-                                       [1, 7, 6], [2, 3, 8], [2, 8, 7], [3, 4, 9], [3, 9, 8], [4, 0, 5], [4, 5, 9]]), "chamfered")
+    # A box whose edge at x = y = 1 is chamfered 0.028 wide (the CLI tests' file): the chamfer's
+    # sharp edges are closer than half of a 0.25 edge, kept as asked (slivers between them) or rounded.
+    chamfered, _ = flexfit.read_mesh(ROOT / "tests" / "apps" / "data" / "chamfered_box.obj")
     _, kept = flexfit.remesh(chamfered, 0.25, thin_features="keep")
     _, rounded = flexfit.remesh(chamfered, 0.25, thin_features="round")
     assert kept["slivers"] > 0.01 and not kept["thin_features_rounded"]
