@@ -33,6 +33,10 @@
 #include <thread>
 #include <vector>
 
+#if defined(__linux__)
+#include <sched.h>
+#endif
+
 namespace flexfit {
 namespace {
 
@@ -58,13 +62,23 @@ void buildForQueries(FaceTree& tree) {
     if (!tree.empty()) tree.closest_point(CGAL::ORIGIN);  // the search tree is built at its first search
 }
 
-// Runs body(begin, end) over [0, n) in chunks of `chunk` on the machine's cores. A chunk's
+// The cores this process may run on (its affinity mask on Linux: a container or `taskset`
+// limits it below the machine's count).
+unsigned usableCores() {
+#if defined(__linux__)
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0) return unsigned(std::max(1, CPU_COUNT(&set)));
+#endif
+    return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// Runs body(begin, end) over [0, n) in chunks of `chunk` on the usable cores. A chunk's
 // result must not depend on which thread runs it, so the outcome is the same on any machine.
 // The first exception a chunk throws is rethrown here once every thread has stopped.
 template <class Body>
 void forChunks(std::size_t n, std::size_t chunk, Body body) {
     const std::size_t chunks = (n + chunk - 1) / chunk;
-    const std::size_t threads = std::min<std::size_t>(chunks, std::max(1u, std::thread::hardware_concurrency()));
+    const std::size_t threads = std::min<std::size_t>(chunks, usableCores());
     std::atomic<std::size_t> next{0};
     std::exception_ptr failure;
     std::mutex failureLock;
