@@ -407,7 +407,12 @@ PYBIND11_MODULE(_flexfit, m) {
         else if (thinFeatures == "round") options.thinFeatures = ThinFeatures::Round;
         else if (thinFeatures != "auto")
             throw InputError("thin_features", 0, "unknown value '" + thinFeatures + "' (expected 'auto', 'keep' or 'round')");
-        RemeshResult r = remeshForSimulation(mesh, options, mesh.name);
+        RemeshResult r;
+        {
+            const TriMesh input = mesh;  // a copy: other Python threads may change `mesh` meanwhile
+            py::gil_scoped_release release;
+            r = remeshForSimulation(input, options, input.name);
+        }
         py::dict q;
         q["min_angle_degrees"] = r.after.minAngle;
         q["slivers"] = r.after.slivers;
@@ -418,7 +423,7 @@ PYBIND11_MODULE(_flexfit, m) {
     }, py::arg("mesh"), py::arg("edge"), py::arg("thin_features") = "auto",
           "Simulation remeshing (CGAL): near-uniform edges of length `edge`, sharp features kept; sharp edges closer than half "
           "the edge kept ('keep'), rounded ('round') or rounded where that leaves fewer slivers within `edge` of the input "
-          "('auto'). Returns (mesh, quality).");
+          "('auto'). Returns (mesh, quality); the GIL is released meanwhile.");
 
     // --- Models and parts ---
     py::class_<PartModel, std::shared_ptr<PartModel>>(m, "PartModel", "A part's immutable model: its mesh, masses and springs.")
@@ -613,8 +618,11 @@ PYBIND11_MODULE(_flexfit, m) {
             for (const SceneWarning& w : s.warnings) out.push_back(w.message);
             return out;
         }, "The scene's warnings (old spellings, mesh repairs).");
-    m.def("load_scene", [](const std::filesystem::path& path, bool strict) { return loadScene(path, SceneReadOptions{strict}); }, py::arg("path"),
-          py::arg("strict") = false, "Reads a scene file (TOML). Raises InputError naming the file, line and key.");
+    m.def("load_scene", [](const std::filesystem::path& path, bool strict) {
+        py::gil_scoped_release release;  // a scene's meshes may be remeshed and their fields built: seconds
+        return loadScene(path, SceneReadOptions{strict});
+    }, py::arg("path"), py::arg("strict") = false,
+          "Reads a scene file (TOML), the GIL released meanwhile. Raises InputError naming the file, line and key.");
 
     py::class_<SceneRun>(m, "SceneRun", "A scene's world driven by its scripted actions (what `flexfit run` steps).")
         .def(py::init<const Scene&>(), py::arg("scene"))
@@ -632,7 +640,12 @@ PYBIND11_MODULE(_flexfit, m) {
 
     m.def("run_scene", [](const std::filesystem::path& path, std::optional<std::filesystem::path> out, std::optional<double> duration, std::optional<double> vtkEvery,
                           std::optional<double> glbEvery) {
-        const Scene scene = loadScene(path);
+        std::optional<Scene> loaded;
+        {
+            py::gil_scoped_release release;
+            loaded.emplace(loadScene(path));
+        }
+        const Scene& scene = *loaded;
         cli::RunOptions options;
         options.duration = duration;
         options.out = out.value_or(std::filesystem::path());

@@ -214,6 +214,31 @@ def test_step_releases_the_gil(examples):
     assert runs[1].world.step_count == 150
 
 
+def longest_pause(call):
+    """This thread's longest pause between two loop turns while another thread runs `call`, and
+    the whole time: a call holding the GIL pauses this thread for about all of it."""
+    done = threading.Event()
+    worker = threading.Thread(target=lambda: (call(), done.set()))
+    start = last = time.perf_counter()
+    longest = 0.0
+    worker.start()
+    while not done.is_set():
+        now = time.perf_counter()
+        longest, last = max(longest, now - last), now
+    worker.join()
+    return longest, time.perf_counter() - start
+
+
+def test_remeshing_and_loading_scenes_release_the_gil(examples):
+    torus = flexfit.torus(10, 2.5, 64, 24)
+    # The remeshed-mouth scene remeshes its part while loading, and run_scene loads it too.
+    scene = str(examples / "ball_torus_remeshed.toml")
+    for name, call in [("remesh", lambda: flexfit.remesh(torus, 0.4)), ("load_scene", lambda: flexfit.load_scene(scene)),
+                       ("run_scene", lambda: flexfit.run_scene(scene, duration=0.001))]:
+        longest, whole = longest_pause(call)
+        assert whole > 0.05 and longest < 0.25 * whole, (name, longest, whole)
+
+
 def described(obj):
     """A docstring beyond pybind11's generated signature."""
     doc = getattr(obj, "__doc__", None) or ""
