@@ -384,7 +384,11 @@ PYBIND11_MODULE(_flexfit, m) {
         MeshReadOptions options;
         options.repair = !strict;
         options.weldTolerance = weld;
-        MeshReadResult r = readMesh(path, options);
+        MeshReadResult r;
+        {
+            py::gil_scoped_release release;
+            r = readMesh(path, options);
+        }
         if (!fileVertices) return py::make_tuple(std::move(r.mesh), r.diagnostics.warnings);
         py::object numbering = r.fileVertices.empty() ? py::object(py::none()) : py::cast(std::move(r.fileVertices));
         return py::make_tuple(std::move(r.mesh), r.diagnostics.warnings, numbering);
@@ -435,6 +439,7 @@ PYBIND11_MODULE(_flexfit, m) {
                  if (vertexOrder != "as_given" && vertexOrder != "locality")
                      throw InputError("vertex_order", 0, "unknown value '" + vertexOrder + "' (expected 'as_given' or 'locality')");
                  settings.vertexOrder = vertexOrder == "locality" ? VertexOrder::Locality : VertexOrder::AsGiven;
+                 py::gil_scoped_release release;  // a large mesh's topology, order and spring blocks
                  return std::const_pointer_cast<PartModel>(buildPartModel(std::move(mesh), settings));
              }),
              py::arg("mesh"), py::arg("material") = py::none(), py::arg("springs") = py::none(), py::arg("vertex_mass") = 1.0, py::kw_only(),
@@ -527,7 +532,7 @@ PYBIND11_MODULE(_flexfit, m) {
             for (const Contact& c : w.contacts()) out.append(contactDict(w, c));
             return out;
         }, "The last step's contacts, as dicts (part_a, part_b, point, normal, depth, ...).")
-        .def("prepare", &World::prepare,
+        .def("prepare", &World::prepare, py::call_guard<py::gil_scoped_release>(),
              "Before a real-time loop: does now what the first step would do once (each touching pair's first collision "
              "traversal, the contact scratch), so the first step costs what the next ones do. Changes no result.")
         .def("profile", [](const World& w) { return profileDict(w.profile()); }, "Per-stage times of the last step and in total (s).")
