@@ -512,6 +512,7 @@ PYBIND11_MODULE(_flexfit, m) {
             PartSettings part;
             BodySettings body;
             applyPartKeywords(settings, part, &body);
+            py::gil_scoped_release release;  // the part's hierarchies, and a distance field for the point shell
             return w.add(model, part, body, makePose(position, rotation));
         }, py::arg("model"), py::arg("position") = Vec3::Zero(), py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0),
              "Adds a part at a pose (rotation as a quaternion w, x, y, z); returns its body id. Settings as keywords named as the scene "
@@ -630,7 +631,11 @@ PYBIND11_MODULE(_flexfit, m) {
           "Reads a scene file (TOML), the GIL released meanwhile. Raises InputError naming the file, line and key.");
 
     py::class_<SceneRun>(m, "SceneRun", "A scene's world driven by its scripted actions (what `flexfit run` steps).")
-        .def(py::init<const Scene&>(), py::arg("scene"))
+        .def(py::init([](const Scene& scene) {
+                 py::gil_scoped_release release;  // the world: every part's hierarchies and distance fields
+                 return std::make_unique<SceneRun>(scene);
+             }),
+             py::arg("scene"))
         .def("step", [](SceneRun& r, int steps) {
             py::gil_scoped_release release;
             for (int i = 0; i < steps; ++i) r.step();

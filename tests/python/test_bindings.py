@@ -234,9 +234,11 @@ def test_remeshing_loading_and_building_models_release_the_gil(examples):
     # The remeshed-mouth scene remeshes its part while loading, and run_scene loads it too.
     scene = str(examples / "ball_torus_remeshed.toml")
     large = flexfit.torus(10, 2.5, 400, 200)
+    haptic = flexfit.load_scene(str(examples / "ball_torus_haptic.toml"))  # a world building the ball's distance field
     for name, call in [("remesh", lambda: flexfit.remesh(torus, 0.4)), ("load_scene", lambda: flexfit.load_scene(scene)),
                        ("run_scene", lambda: flexfit.run_scene(scene, duration=0.001)),
-                       ("PartModel", lambda: flexfit.PartModel(large, material="elastic", vertex_order="locality"))]:
+                       ("PartModel", lambda: flexfit.PartModel(large, material="elastic", vertex_order="locality")),
+                       ("SceneRun", lambda: flexfit.SceneRun(haptic))]:
         longest, whole = longest_pause(call)
         assert whole > 0.05 and longest < 0.25 * whole, (name, longest, whole)
 
