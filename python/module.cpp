@@ -407,10 +407,9 @@ PYBIND11_MODULE(_flexfit, m) {
     m.def("remesh", [](const TriMesh& mesh, double edge, const std::string& thinFeatures) {
         RemeshOptions options;
         options.targetEdge = edge;
-        if (thinFeatures == "keep") options.thinFeatures = ThinFeatures::Keep;
-        else if (thinFeatures == "round") options.thinFeatures = ThinFeatures::Round;
-        else if (thinFeatures != "auto")
-            throw InputError("thin_features", 0, "unknown value '" + thinFeatures + "' (expected 'auto', 'keep' or 'round')");
+        const std::optional<ThinFeatures> chosen = parseName<ThinFeatures>(thinFeatures);
+        if (!chosen) throw InputError("thin_features", 0, "unknown value '" + thinFeatures + "' (expected 'auto', 'keep' or 'round')");
+        options.thinFeatures = *chosen;
         RemeshResult r;
         {
             const TriMesh input = mesh;  // a copy: other Python threads may change `mesh` meanwhile

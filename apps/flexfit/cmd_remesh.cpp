@@ -46,13 +46,11 @@ void registerRemesh(CLI::App& app) {
     cmd->add_option("--thin-features", opt->thinFeatures,
                     "Sharp edges closer than half the target edge: keep them (slivers stay between them), round them, or auto (round "
                     "them when 1 % or more of the triangles are slivers, if that leaves fewer and the surface within the target edge of the input)")
-        ->check(CLI::IsMember({"auto", "keep", "round"}))
+        ->check(CLI::IsMember(enumChoices<ThinFeatures>()))
         ->capture_default_str();
     addMeshOptions(cmd, opt->mesh);
     cmd->callback([opt] {
-        opt->remesh.thinFeatures = opt->thinFeatures == "keep"    ? ThinFeatures::Keep
-                                   : opt->thinFeatures == "round" ? ThinFeatures::Round
-                                                                  : ThinFeatures::Auto;
+        opt->remesh.thinFeatures = enumOption<ThinFeatures>(opt->thinFeatures, "option --thin-features");
         const MeshReadResult read = loadMesh(opt->in, opt->mesh.read());
         const RemeshResult r = remeshForSimulation(read.mesh, opt->remesh, opt->in);
         writeMesh(r.mesh, opt->out);

@@ -65,12 +65,20 @@
 #pragma once
 
 #include "flexfit/mesh.hpp"
+#include "flexfit/names.hpp"
 
 namespace flexfit {
 
 // Sharp edges closer than half the target edge (see above): kept (slivers between them stay),
 // rounded, or rounded where that leaves the surface within the target edge of the input.
 enum class ThinFeatures { Auto, Keep, Round };
+// Its names (names.hpp): the scene's `thin_features`, `--thin-features`, Python's thin_features=.
+inline constexpr EnumName<ThinFeatures> kThinFeaturesNames[] = {
+    {ThinFeatures::Auto, "auto", "rounded where that helps"},
+    {ThinFeatures::Keep, "keep", "kept"},
+    {ThinFeatures::Round, "round", "rounded"},
+};
+template <> inline constexpr std::span<const EnumName<ThinFeatures>> kEnumNames<ThinFeatures> = kThinFeaturesNames;
 
 struct RemeshOptions {
     double targetEdge = 0.0;     // > 0, in the mesh's units

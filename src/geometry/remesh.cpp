@@ -99,6 +99,8 @@ void forChunks(std::size_t n, std::size_t chunk, Body body) {
     if (failure) std::rethrow_exception(failure);
 }
 
+Vec3 toVec3(const Point& p) { return {p.x(), p.y(), p.z()}; }
+
 // Smallest interior angle of a triangle, degrees (0 for a degenerate one).
 double smallestAngle(const Vec3& a, const Vec3& b, const Vec3& c) {
     auto angle = [](const Vec3& at, const Vec3& u, const Vec3& v) {
@@ -129,8 +131,7 @@ TriMesh toTriMesh(const SurfaceMesh& mesh, const std::string& name) {
     std::vector<Index> index(mesh.number_of_vertices() + mesh.number_of_removed_vertices(), Index(-1));
     for (SurfaceMesh::Vertex_index v : mesh.vertices()) {
         index[std::size_t(v)] = Index(out.vertices.size());
-        const Point& p = mesh.point(v);
-        out.vertices.emplace_back(p.x(), p.y(), p.z());
+        out.vertices.push_back(toVec3(mesh.point(v)));
     }
     for (SurfaceMesh::Face_index f : mesh.faces()) {
         Face face{};
@@ -348,10 +349,7 @@ void removeCapsAndNeedles(WorkSurface& s, double targetEdge) {
 }
 
 double smallestAngle(const SurfaceMesh& mesh, HalfedgeIndex h) {
-    const Point& a = mesh.point(mesh.source(h));
-    const Point& b = mesh.point(mesh.target(h));
-    const Point& c = mesh.point(mesh.target(mesh.next(h)));
-    return smallestAngle(Vec3(a.x(), a.y(), a.z()), Vec3(b.x(), b.y(), b.z()), Vec3(c.x(), c.y(), c.z()));
+    return smallestAngle(toVec3(mesh.point(mesh.source(h))), toVec3(mesh.point(mesh.target(h))), toVec3(mesh.point(mesh.target(mesh.next(h)))));
 }
 
 // A sliver whose three vertices lie on sharp polylines, lower than kThinFeature of the target
@@ -388,13 +386,6 @@ std::size_t releaseThinFeatures(WorkSurface& s, double targetEdge) {
     return released;
 }
 
-// Share of the triangles with an angle below kSliverAngle.
-double sliverShare(const SurfaceMesh& mesh) {
-    std::size_t slivers = 0;
-    for (FaceIndex f : mesh.faces()) slivers += smallestAngle(mesh, mesh.halfedge(f)) < kSliverAngle ? 1 : 0;
-    return mesh.number_of_faces() > 0 ? double(slivers) / double(mesh.number_of_faces()) : 0.0;
-}
-
 // Rounds of releasing thin features and remeshing again; returns the edges released.
 std::size_t roundThinFeatures(WorkSurface& s, const RemeshOptions& options, PatchProjection& projection) {
     std::size_t total = 0;
@@ -413,14 +404,17 @@ std::size_t roundThinFeatures(WorkSurface& s, const RemeshOptions& options, Patc
 
 // A remeshed surface as returned: what is still of zero area by validateMesh's test (three
 // vertices of one kept polyline, nearly collinear) dropped and counted, which can open it.
+// `slivers` is the remeshed surface's share of slivers before that (what Auto compares).
 struct FinishedSurface {
     TriMesh mesh;
+    double slivers = 0.0;
     std::size_t dropped = 0;
     bool closed = false;
 };
 
 FinishedSurface finish(const WorkSurface& s, const std::string& name, const std::string& source) {
     FinishedSurface f{toTriMesh(s.mesh, name)};
+    f.slivers = measureQuality(f.mesh).slivers;
     const MeshRepairs repairs = repairMesh(f.mesh, 0.0, source);
     f.dropped = repairs.degenerateFaces + repairs.duplicateFaces;
     f.closed = validateMesh(f.mesh, source).closed();
@@ -469,32 +463,48 @@ std::vector<Point> surfaceSamples(const SurfaceMesh& mesh, double spacing) {
     return out;
 }
 
-// Farthest distance from `from`'s samples to `to`, in parallel: each chunk of samples searches
-// from its first sample's closest point on, as CGAL's max_distance_to_triangle_mesh does from
-// the last one (the same distances: a hint only starts the search).
-double farthestSample(const SurfaceMesh& from, const SurfaceMesh& to, double spacing) {
+// A face tree of `mesh`, ready for queries from several threads.
+std::unique_ptr<FaceTree> faceTreeOf(const SurfaceMesh& mesh) {
+    auto tree = std::make_unique<FaceTree>(faces(mesh).first, faces(mesh).second, mesh);
+    buildForQueries(*tree);
+    return tree;
+}
+
+// Farthest distance from `samples` to the tree's faces, in parallel: each chunk of samples
+// searches from its first sample's closest point on, as CGAL's max_distance_to_triangle_mesh
+// does from the last one (the same distances: a hint only starts the search).
+double farthestSample(const std::vector<Point>& samples, const FaceTree& to) {
     constexpr std::size_t kChunk = 4096;
-    const std::vector<Point> samples = surfaceSamples(from, spacing);
     if (samples.empty()) return 0.0;
-    if (to.is_empty()) return std::numeric_limits<double>::infinity();
-    FaceTree tree(faces(to).first, faces(to).second, to);
-    buildForQueries(tree);
+    if (to.empty()) return std::numeric_limits<double>::infinity();
     std::vector<double> farthest((samples.size() + kChunk - 1) / kChunk, 0.0);  // squared, per chunk
     forChunks(samples.size(), kChunk, [&](std::size_t begin, std::size_t end) {
-        Point hint = tree.closest_point(samples[begin]);
+        Point hint = to.closest_point(samples[begin]);
         for (std::size_t i = begin; i < end; ++i) {
-            hint = tree.closest_point(samples[i], hint);
+            hint = to.closest_point(samples[i], hint);
             farthest[begin / kChunk] = std::max(farthest[begin / kChunk], CGAL::squared_distance(hint, samples[i]));
         }
     });
     return std::sqrt(*std::max_element(farthest.begin(), farthest.end()));
 }
 
-// The symmetric Hausdorff distance, from samples `spacing` apart: a lower bound of the true one,
-// short of it by at most about the spacing.
-double sampledHausdorff(const SurfaceMesh& a, const SurfaceMesh& b, double spacing) {
-    return std::max(farthestSample(a, b, spacing), farthestSample(b, a, spacing));
-}
+// The input surface's side of the symmetric Hausdorff distance, from samples `spacing` apart
+// (a lower bound of the true distance, short of it by at most about the spacing): its samples
+// and face tree, made once for every surface measured against it.
+class HausdorffFrom {
+public:
+    HausdorffFrom(const SurfaceMesh& input, double spacing)
+        : spacing_(spacing), samples_(surfaceSamples(input, spacing)), tree_(faceTreeOf(input)) {}
+
+    double to(const SurfaceMesh& other) const {
+        return std::max(farthestSample(samples_, *faceTreeOf(other)), farthestSample(surfaceSamples(other, spacing_), *tree_));
+    }
+
+private:
+    double spacing_;
+    std::vector<Point> samples_;
+    std::unique_ptr<FaceTree> tree_;
+};
 
 }  // namespace
 
@@ -534,7 +544,7 @@ MeshQuality measureQuality(const TriMesh& mesh) {
 
 std::vector<Vec3> detail::hausdorffSamples(const TriMesh& mesh, double spacing) {
     std::vector<Vec3> out;
-    for (const Point& p : surfaceSamples(toSurfaceMesh(mesh, mesh.name), spacing)) out.emplace_back(p.x(), p.y(), p.z());
+    for (const Point& p : surfaceSamples(toSurfaceMesh(mesh, mesh.name), spacing)) out.push_back(toVec3(p));
     return out;
 }
 
@@ -592,17 +602,16 @@ RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, co
     PatchProjection projection(input, work.patch, patches);
     remeshIterations(work, options, projection);
     removeCapsAndNeedles(work, options.targetEdge);
-    const double spacing = kSampleShare * options.targetEdge;
-    r.hausdorff = sampledHausdorff(input, work.mesh, spacing);
-    const double slivers = sliverShare(work.mesh);
+    const HausdorffFrom fromInput(input, kSampleShare * options.targetEdge);
+    r.hausdorff = fromInput.to(work.mesh);
     FinishedSurface result = finish(work, mesh.name, source);
     const bool round = options.thinFeatures == ThinFeatures::Round;
-    if (round || (options.thinFeatures == ThinFeatures::Auto && slivers >= kRoundingShare)) {
+    if (round || (options.thinFeatures == ThinFeatures::Auto && result.slivers >= kRoundingShare)) {
         WorkSurface rounded(work);
         r.releasedEdges = roundThinFeatures(rounded, options, projection);
-        r.roundedHausdorff = sampledHausdorff(input, rounded.mesh, spacing);
+        r.roundedHausdorff = fromInput.to(rounded.mesh);
         FinishedSurface roundedResult = finish(rounded, mesh.name, source);
-        r.rounded = round || (r.roundedHausdorff <= std::max(r.hausdorff, options.targetEdge) && sliverShare(rounded.mesh) < slivers &&
+        r.rounded = round || (r.roundedHausdorff <= std::max(r.hausdorff, options.targetEdge) && roundedResult.slivers < result.slivers &&
                               (roundedResult.closed || !result.closed));
         if (r.rounded) {
             result = std::move(roundedResult);

@@ -190,10 +190,10 @@ std::optional<RemeshOptions> readRemesh(Table& t) {
     r.iterations = options.integer("iterations", r.iterations, 1, 100);
     r.featureAngle = options.positive("feature_angle", r.featureAngle);
     if (!(r.featureAngle < 180.0)) options.fail(*options.node("feature_angle"), "feature_angle", "must be below 180 degrees");
-    const std::string thin = options.text("thin_features", "auto");
-    if (thin == "keep") r.thinFeatures = ThinFeatures::Keep;
-    else if (thin == "round") r.thinFeatures = ThinFeatures::Round;
-    else if (thin != "auto") options.fail(*options.node("thin_features"), "thin_features", "unknown value '" + thin + "' (expected 'auto', 'keep' or 'round')");
+    const std::string thin = options.text("thin_features", nameOf(ThinFeatures::Auto));
+    const std::optional<ThinFeatures> chosen = parseName<ThinFeatures>(thin);
+    if (!chosen) options.fail(*options.node("thin_features"), "thin_features", "unknown value '" + thin + "' (expected 'auto', 'keep' or 'round')");
+    r.thinFeatures = *chosen;
     options.finish();
     return r;
 }

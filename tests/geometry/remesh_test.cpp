@@ -54,26 +54,18 @@ double distanceToBoxSurface(const Vec3& p, const Vec3& h) {
     return outside > 0.0 ? outside : -q.maxCoeff();
 }
 
-Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-    // Brute force over a barycentric grid refined around the best sample: independent of the
-    // library's closest-point code, accurate to ~1e-6 of the triangle.
-    Vec3 best = a;
-    double bestU = 0, bestV = 0, step = 0.1;
-    for (int round = 0; round < 6; ++round) {
-        const double u0 = bestU, v0 = bestV;
-        for (int i = -10; i <= 10; ++i)
-            for (int j = -10; j <= 10; ++j) {
-                const double u = std::clamp(u0 + i * step, 0.0, 1.0), v = std::clamp(v0 + j * step, 0.0, 1.0 - u);
-                const Vec3 x = a + u * (b - a) + v * (c - a);
-                if ((x - p).squaredNorm() < (best - p).squaredNorm()) {
-                    best = x;
-                    bestU = u;
-                    bestV = v;
-                }
-            }
-        step /= 10.0;
-    }
-    return best;
+// Distance from p to triangle abc: to its projection on the plane when that lies inside, else
+// to the nearest of its three sides (independent of the library's closest-point code).
+double distanceBySides(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 normal = (b - a).cross(c - a).normalized();
+    const Vec3 q = p - (p - a).dot(normal) * normal;
+    if ((b - a).cross(q - a).dot(normal) >= 0 && (c - b).cross(q - b).dot(normal) >= 0 && (a - c).cross(q - c).dot(normal) >= 0)
+        return (p - q).norm();
+    auto toSide = [&p](const Vec3& u, const Vec3& v) {
+        const double t = std::clamp((p - u).dot(v - u) / (v - u).squaredNorm(), 0.0, 1.0);
+        return (u + t * (v - u) - p).norm();
+    };
+    return std::min({toSide(a, b), toSide(b, c), toSide(c, a)});
 }
 
 TEST(Remesh, SliversBecomeNearUniformTrianglesOnTheSameBox) {
@@ -109,7 +101,7 @@ TEST(Remesh, HausdorffDistanceIsAtLeastTheFarthestVertexAndWithinTheEdge) {
         const Vec3& p = r.mesh.vertices[i];
         double nearest = std::numeric_limits<double>::infinity();
         for (const Face& f : input.faces)
-            nearest = std::min(nearest, (closestOnTriangle(p, input.vertices[f[0]], input.vertices[f[1]], input.vertices[f[2]]) - p).norm());
+            nearest = std::min(nearest, distanceBySides(p, input.vertices[f[0]], input.vertices[f[1]], input.vertices[f[2]]));
         lower = std::max(lower, nearest);
     }
     EXPECT_GE(r.hausdorff + 1e-9, lower);  // the samples include the output's vertices
@@ -128,21 +120,6 @@ std::vector<Vec3> denseSamples(const TriMesh& mesh, double spacing) {
             for (int j = 0; i + j <= n; ++j) out.push_back(a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a));
     }
     return out;
-}
-
-// Distance from p to triangle abc: to its projection on the plane when that lies inside, else
-// to the nearest of its three sides (a second way to the closest point, cheaper than the grid
-// search above for the many samples below).
-double distanceBySides(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-    const Vec3 normal = (b - a).cross(c - a).normalized();
-    const Vec3 q = p - (p - a).dot(normal) * normal;
-    if ((b - a).cross(q - a).dot(normal) >= 0 && (c - b).cross(q - b).dot(normal) >= 0 && (a - c).cross(q - c).dot(normal) >= 0)
-        return (p - q).norm();
-    auto toSide = [&p](const Vec3& u, const Vec3& v) {
-        const double t = std::clamp((p - u).dot(v - u) / (v - u).squaredNorm(), 0.0, 1.0);
-        return (u + t * (v - u) - p).norm();
-    };
-    return std::min({toSide(a, b), toSide(b, c), toSide(c, a)});
 }
 
 double farthestBruteForce(const TriMesh& from, const TriMesh& to, double spacing) {
