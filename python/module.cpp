@@ -623,11 +623,16 @@ PYBIND11_MODULE(_flexfit, m) {
             for (const SceneWarning& w : s.warnings) out.push_back(w.message);
             return out;
         }, "The scene's warnings (old spellings, mesh repairs).");
-    m.def("load_scene", [](const std::filesystem::path& path, bool strict) {
+    m.def("load_scene", [](const std::filesystem::path& path, bool strict, std::optional<std::filesystem::path> remeshCache) {
         py::gil_scoped_release release;  // a scene's meshes may be remeshed and their fields built: seconds
-        return loadScene(path, SceneReadOptions{strict});
-    }, py::arg("path"), py::arg("strict") = false,
-          "Reads a scene file (TOML), the GIL released meanwhile. Raises InputError naming the file, line and key.");
+        SceneReadOptions options;
+        options.strictMeshes = strict;
+        options.remeshCache = std::move(remeshCache);
+        return loadScene(path, options);
+    }, py::arg("path"), py::arg("strict") = false, py::arg("remesh_cache") = py::none(),
+          "Reads a scene file (TOML), the GIL released meanwhile. Raises InputError naming the file, line and key. "
+          "remesh_cache: the directory keeping remeshed parts' surfaces between loads (None: the default, "
+          "$FLEXFIT_CACHE_DIR/remesh or ~/.cache/flexfit/remesh; \"\": none).");
 
     py::class_<SceneRun>(m, "SceneRun", "A scene's world driven by its scripted actions (what `flexfit run` steps).")
         .def(py::init([](const Scene& scene) {

@@ -19,6 +19,7 @@
 #include "flexfit/mesh_repair.hpp"
 #include "flexfit/surface_embedding.hpp"
 #include "flexfit/remesh.hpp"
+#include "flexfit/remesh_cache.hpp"
 #include "flexfit/names.hpp"
 #include "flexfit/part.hpp"
 #include "flexfit/part_model.hpp"

@@ -11,6 +11,7 @@
 #include "flexfit/scene.hpp"
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -20,6 +21,10 @@ struct SceneReadOptions {
     // Refuse mesh files with geometric defects (mesh_repair.hpp) instead of repairing them, for
     // every part (a part's own `repair = false` does it for that part alone).
     bool strictMeshes = false;
+    // Where remeshed parts' surfaces are kept between loads (remesh_cache.hpp): unset, the
+    // default directory (defaultRemeshCacheDirectory()); an empty path, nowhere. A part's own
+    // `remesh = { ..., cache = false }` skips it for that part.
+    std::optional<std::filesystem::path> remeshCache;
 };
 
 // Throws InputError naming the file, the line and the key for every problem. A part's mesh

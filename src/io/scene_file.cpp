@@ -2,6 +2,7 @@
 // which keys were used, so unknown keys (typos) are reported instead of silently ignored.
 #include "flexfit/scene_file.hpp"
 #include "flexfit/remesh.hpp"
+#include "flexfit/remesh_cache.hpp"
 
 #include "flexfit/generators.hpp"
 #include "flexfit/mesh_io.hpp"
@@ -173,20 +174,28 @@ std::vector<const toml::table*> tables(Table& root, const std::string& key) {
     return out;
 }
 
-// `remesh = L` (the target edge) or
-// `remesh = { edge = L, iterations = N, feature_angle = DEG, thin_features = "auto" | "keep" | "round" }`.
-std::optional<RemeshOptions> readRemesh(Table& t) {
+struct PartRemesh {
+    RemeshOptions options;
+    bool cache = true;  // through SceneReadOptions::remeshCache
+};
+
+// `remesh = L` (the target edge) or `remesh = { edge = L, iterations = N, feature_angle = DEG,
+// thin_features = "auto" | "keep" | "round", cache = true | false }`.
+std::optional<PartRemesh> readRemesh(Table& t) {
     if (!t.has("remesh")) return std::nullopt;
     const toml::node* n = t.node("remesh");
-    RemeshOptions r;
+    PartRemesh part;
+    RemeshOptions& r = part.options;
     if (n->is_number()) {
         r.targetEdge = t.positive("remesh", 1.0);
-        return r;
+        return part;
     }
-    if (!n->is_table()) t.fail(*n, "remesh", "expected a target edge length or {edge, iterations, feature_angle, thin_features}");
+    if (!n->is_table())
+        t.fail(*n, "remesh", "expected a target edge length or {edge, iterations, feature_angle, thin_features, cache}");
     Table options = t.sub("remesh");
     if (!options.has("edge")) options.fail("needs 'edge' (the target edge length)");
     r.targetEdge = options.positive("edge", 0.0);
+    part.cache = options.flag("cache", true);
     r.iterations = options.integer("iterations", r.iterations, 1, 100);
     r.featureAngle = options.positive("feature_angle", r.featureAngle);
     if (!(r.featureAngle < 180.0)) options.fail(*options.node("feature_angle"), "feature_angle", "must be below 180 degrees");
@@ -195,7 +204,19 @@ std::optional<RemeshOptions> readRemesh(Table& t) {
     if (!chosen) options.fail(*options.node("thin_features"), "thin_features", "unknown value '" + thin + "' (expected 'auto', 'keep' or 'round')");
     r.thinFeatures = *chosen;
     options.finish();
-    return r;
+    return part;
+}
+
+// The part's simulation surface, through the remesh cache unless the scene or the part turns
+// it off; a cache that cannot be written becomes a warning at the remesh key's line.
+TriMesh remeshPart(Table& t, const TriMesh& mesh, const PartRemesh& remesh, const std::string& source,
+                   const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
+    const std::filesystem::path directory =
+        remesh.cache ? options.remeshCache.value_or(defaultRemeshCacheDirectory()) : std::filesystem::path();
+    CachedRemesh cached = remeshCached(mesh, remesh.options, source, directory);
+    if (!cached.problem.empty())
+        warnings.push_back({t.line("remesh"), t.what() + ", key 'remesh': " + cached.problem + "; the part is remeshed at every load"});
+    return std::move(cached.result.mesh);
 }
 
 // Mesh input errors stay as they are (they name the mesh file and its line); the scene's
@@ -215,7 +236,7 @@ PartMeshes readPartMesh(Table& t, const std::filesystem::path& base, const Scene
     const std::size_t line = t.line("mesh");
     MeshReadOptions read;
     read.repair = t.flag("repair", true) && !options.strictMeshes;
-    const std::optional<RemeshOptions> remesh = readRemesh(t);
+    const std::optional<PartRemesh> remesh = readRemesh(t);
     MeshReadResult result;
     try {
         result = readMesh(path, read);
@@ -232,7 +253,7 @@ PartMeshes readPartMesh(Table& t, const std::filesystem::path& base, const Scene
         warnings.push_back({t.line("draw"), t.what() + ", key 'draw': has no effect without 'remesh' (the file's mesh is simulated and drawn)"});
     if (!remesh) return {std::move(result.mesh), {}, std::move(result.fileVertices)};
     try {
-        TriMesh simulated = remeshForSimulation(result.mesh, *remesh, path.string()).mesh;
+        TriMesh simulated = remeshPart(t, result.mesh, *remesh, path.string(), options, warnings);
         // Drawn: the file's own vertices, in its order, over the repaired faces.
         return {std::move(simulated), drawOriginal ? inFileOrder(result.mesh, result.fileVertices) : TriMesh{}, {}};
     } catch (const InputError& e) {

@@ -6,6 +6,8 @@
 #include "flexfit/scene_file.hpp"
 #include "temp_dir.hpp"
 
+#include <sys/stat.h>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -441,7 +443,7 @@ TEST(SceneFile, MeshDefectsAreRepairedWithAWarningOrRefused) {
     EXPECT_NE(repaired.warnings[0].message.find("1 duplicate face"), std::string::npos) << repaired.warnings[0].message;
     EXPECT_EQ(repaired.parts[0].model->faceCount(), 4u);
 
-    for (const auto& [text, options] : {std::pair{part + "repair = false\n", SceneReadOptions{}}, std::pair{part, SceneReadOptions{true}}}) {
+    for (const auto& [text, options] : {std::pair{part + "repair = false\n", SceneReadOptions{}}, std::pair{part, SceneReadOptions{true, std::nullopt}}}) {
         try {
             parseScene(text, "scene.toml", dir.path(), options);
             ADD_FAILURE() << "accepted a duplicate face: " << text;
@@ -494,6 +496,47 @@ TEST(SceneFile, RemeshGivesTheModelNearUniformEdges) {
         << error("remesh = 1e-6\n");
     EXPECT_NE(errorOf(withLine("name = \"ball\"", "remesh = 0.5")).find("key 'remesh': applies only to a part read from a 'mesh' file"),
               std::string::npos);
+}
+
+// A remeshed part's surface goes through the remesh cache (remesh_cache.hpp): the second load
+// reads the file the first wrote (the file is not written again: same inode) and builds the
+// same model; `cache = false` and an empty directory write nothing; a directory that cannot be
+// written is a warning at the remesh key's line, and the part is still remeshed.
+TEST(SceneFile, RemeshedPartsGoThroughTheRemeshCache) {
+    flexfit::testing::TempDir dir;
+    dir.write("tet.tri", "tet\n4 4\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 2 1\n0 1 3\n0 3 2\n1 2 3\n");
+    const std::string part = "[[part]]\nname = \"tet\"\nmesh = \"tet.tri\"\n";
+    SceneReadOptions options;
+    options.remeshCache = dir.path() / "cache";
+    const auto cacheFiles = [&] {
+        std::vector<std::filesystem::path> files;
+        if (std::filesystem::exists(*options.remeshCache))
+            for (const auto& entry : std::filesystem::directory_iterator(*options.remeshCache)) files.push_back(entry.path());
+        return files;
+    };
+    const Scene first = parseScene(part + "remesh = 0.2\n", "scene.toml", dir.path(), options);
+    ASSERT_EQ(cacheFiles().size(), 1u);
+    struct stat before {};
+    ASSERT_EQ(::stat(cacheFiles()[0].c_str(), &before), 0);
+    const Scene second = parseScene(part + "remesh = 0.2\n", "scene.toml", dir.path(), options);
+    struct stat after {};
+    ASSERT_EQ(::stat(cacheFiles()[0].c_str(), &after), 0);
+    EXPECT_EQ(before.st_ino, after.st_ino);
+    EXPECT_TRUE(first.warnings.empty() && second.warnings.empty());
+    EXPECT_EQ(second.parts[0].model->mesh.vertices, first.parts[0].model->mesh.vertices);
+    EXPECT_EQ(second.parts[0].model->mesh.faces, first.parts[0].model->mesh.faces);
+    const Scene uncached = parseScene(part + "remesh = { edge = 0.25, cache = false }\n", "scene.toml", dir.path(), options);
+    EXPECT_EQ(cacheFiles().size(), 1u);
+    options.remeshCache = std::filesystem::path();
+    const Scene off = parseScene(part + "remesh = 0.25\n", "scene.toml", dir.path(), options);
+    EXPECT_EQ(off.parts[0].model->mesh.vertices, uncached.parts[0].model->mesh.vertices);
+    options.remeshCache = dir.path() / "tet.tri" / "cache";
+    const Scene unwritable = parseScene(part + "remesh = 0.2\n", "scene.toml", dir.path(), options);
+    ASSERT_EQ(unwritable.warnings.size(), 1u);
+    EXPECT_EQ(unwritable.warnings[0].line, 4u);
+    EXPECT_NE(unwritable.warnings[0].message.find("part 1, key 'remesh': could not create the remesh cache directory"), std::string::npos)
+        << unwritable.warnings[0].message;
+    EXPECT_EQ(unwritable.parts[0].model->mesh.vertices, first.parts[0].model->mesh.vertices);
 }
 
 // `thin_features` in the remesh table: the part's model is the surface remeshForSimulation makes

@@ -8,6 +8,11 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
+# The remesh cache off (as ctest sets it): the suite writes nothing to ~/.cache and every
+# remeshing scene remeshes (the GIL test times a load that remeshes). Tests of the cache name
+# their own directory.
+os.environ["FLEXFIT_CACHE_DIR"] = ""
+
 
 @pytest.fixture
 def examples():

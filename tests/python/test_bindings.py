@@ -252,6 +252,23 @@ def described(obj):
     return len(lines) >= 2 or (len(lines) == 1 and "(" not in lines[0])
 
 
+def test_load_scene_keeps_remeshed_surfaces_in_the_remesh_cache(tmp_path, examples):
+    # The first load remeshes and writes one file; the second reads it (the file is not written
+    # again: same inode) and builds the same world; "" turns the cache off.
+    scene = str(examples / "contact_remeshed.toml")
+    cache = tmp_path / "cache"
+    first = flexfit.load_scene(scene, remesh_cache=str(cache))
+    files = list(cache.iterdir())
+    assert len(files) == 1 and files[0].suffix == ".remesh"
+    inode = files[0].stat().st_ino
+    second = flexfit.load_scene(scene, remesh_cache=cache)
+    assert files[0].stat().st_ino == inode
+    off = flexfit.load_scene(scene, remesh_cache="")
+    hashes = {flexfit.SceneRun(s).world.state_hash() for s in (first, second, off)}
+    assert len(hashes) == 1
+    assert first.warnings == second.warnings == off.warnings == []
+
+
 def test_every_binding_has_a_docstring():
     missing = []
     for name in dir(flexfit._flexfit):

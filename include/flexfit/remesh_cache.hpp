@@ -1,0 +1,50 @@
+// Remeshed surfaces kept on disk, so that a scene loaded again (the next `flexfit run`, a
+// sweep's next variant, a Dask worker's next task) reads its parts' surfaces instead of
+// remeshing them: a CAD part remeshed finely takes seconds to minutes (regr01 at 0.5 % of its
+// size: 34 s), its file reads in milliseconds.
+//
+// One file per (input mesh, options), named by a 64-bit FNV-1a hash of the input's vertices
+// and faces (their bytes), the options, and the remesher's fingerprint: CGAL's version and a
+// hash of Flexfit's remeshing sources taken when the build is configured. A changed mesh,
+// option, CGAL or remesher misses and remeshes. The file repeats the input's counts and the
+// options and is checked against them, so a hash collision (about n^2 / 2^65 for n files)
+// would also need equal counts to be taken. The remesher is deterministic (the same bits on any
+// number of cores, remesh.hpp), so a hit is what remeshing again would give, quality report
+// included.
+//
+// Files are written under a temporary name and renamed into place (atomic on POSIX), so
+// processes sharing the directory never read one half-written. A file that does not read back
+// whole (truncated, another format, a checksum that does not match) is a miss and is written
+// again. The cache never makes a load fail: a directory that cannot be created or written is
+// reported (CachedRemesh::problem, a scene warning) and the surface is remeshed.
+//
+// Known limits: nothing is evicted (a file takes about 24 bytes a vertex and 12 a face; delete
+// the directory to reclaim it); files are in the machine's byte order (another byte order
+// misses, by the format tag); the input's name is not part of the key (the result takes the
+// input's name).
+#pragma once
+
+#include "flexfit/remesh.hpp"
+
+#include <filesystem>
+#include <string>
+
+namespace flexfit {
+
+// FLEXFIT_CACHE_DIR when set (an empty value turns the cache off), else $XDG_CACHE_HOME/flexfit,
+// else $HOME/.cache/flexfit, each with "remesh" appended; empty when none is set.
+std::filesystem::path defaultRemeshCacheDirectory();
+
+struct CachedRemesh {
+    RemeshResult result;
+    bool hit = false;     // read from the cache
+    std::string problem;  // why the cache could not be read or written (empty: it was, or it is off)
+};
+
+// remeshForSimulation(mesh, options, source) through the cache in `directory` (created when
+// missing); an empty directory remeshes without it. Errors in the mesh or the options throw
+// as remeshForSimulation does, and nothing is written for them.
+CachedRemesh remeshCached(const TriMesh& mesh, const RemeshOptions& options, const std::string& source,
+                          const std::filesystem::path& directory);
+
+}  // namespace flexfit

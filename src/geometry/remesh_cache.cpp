@@ -1,0 +1,235 @@
+#include "flexfit/remesh_cache.hpp"
+
+#include "core/fnv1a.hpp"
+#include "geometry/remesh_samples.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <sstream>
+#include <type_traits>
+#include <unistd.h>
+#include <vector>
+
+namespace flexfit {
+namespace {
+
+// The format's tag: its version and this machine's byte order (the 8 bytes of a known integer).
+constexpr char kFormat[8] = {'F', 'F', 'R', 'M', 'S', 'H', '0', '1'};
+constexpr std::uint64_t kByteOrder = 0x0102030405060708ull;
+
+// Everything a cached surface depends on, besides the remesher's fingerprint in `hash`.
+struct CacheKey {
+    std::uint64_t hash = 0;
+    std::uint64_t vertices = 0, faces = 0;
+    double targetEdge = 0.0, featureAngle = 0.0;
+    std::int64_t iterations = 0, thinFeatures = 0;
+};
+
+// Calls io(field) for each key field, then each report field of r, in the file's order: the
+// writer and the reader share this list.
+template <class Io, class Key, class Result>
+void visitFields(Io& io, Key& key, Result& r) {
+    io(key.hash), io(key.vertices), io(key.faces), io(key.targetEdge), io(key.featureAngle), io(key.iterations),
+        io(key.thinFeatures);
+    for (auto* q : {&r.before, &r.after})
+        io(q->faces), io(q->minAngle), io(q->slivers), io(q->minEdge), io(q->meanEdge), io(q->maxEdge), io(q->edgeSpread);
+    io(r.featureEdges), io(r.droppedFaces), io(r.seamVertices), io(r.releasedEdges), io(r.roundedHausdorff), io(r.rounded),
+        io(r.hausdorff), io(r.diagonal);
+}
+
+template <class T>
+void mixValue(detail::Fnv1a& h, const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    h.mix(&value, sizeof value);
+}
+
+CacheKey keyOf(const TriMesh& mesh, const RemeshOptions& options) {
+    CacheKey key;
+    key.vertices = mesh.vertices.size();
+    key.faces = mesh.faces.size();
+    key.targetEdge = options.targetEdge;
+    key.featureAngle = options.featureAngle;
+    key.iterations = options.iterations;
+    key.thinFeatures = std::int64_t(options.thinFeatures);
+    detail::Fnv1a h;
+    const std::string_view fingerprint = detail::remesherFingerprint();
+    h.mix(fingerprint.data(), fingerprint.size());
+    for (const Vec3& p : mesh.vertices) h.mix(p.data(), 3 * sizeof(double));
+    h.mix(mesh.faces.data(), mesh.faces.size() * sizeof(Face));
+    for (auto value : {key.vertices, key.faces}) mixValue(h, value);
+    for (auto value : {key.targetEdge, key.featureAngle}) mixValue(h, value);
+    for (auto value : {key.iterations, key.thinFeatures}) mixValue(h, value);
+    key.hash = h.value();
+    return key;
+}
+
+std::filesystem::path fileOf(const std::filesystem::path& directory, const CacheKey& key) {
+    std::ostringstream name;
+    name << std::hex;
+    name.width(16);
+    name.fill('0');
+    name << key.hash << ".remesh";
+    return directory / name.str();
+}
+
+struct Writer {
+    std::vector<char> bytes;
+    template <class T>
+    void operator()(const T& value) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        const char* p = reinterpret_cast<const char*>(&value);
+        bytes.insert(bytes.end(), p, p + sizeof value);
+    }
+    void raw(const void* data, std::size_t size) {
+        const char* p = static_cast<const char*>(data);
+        bytes.insert(bytes.end(), p, p + size);
+    }
+};
+
+struct Reader {
+    const std::vector<char>& bytes;
+    std::size_t at = 0;
+    bool ok = true;
+    bool raw(void* data, std::size_t size) {
+        ok = ok && size <= bytes.size() - at;
+        if (ok) std::memcpy(data, bytes.data() + at, size), at += size;
+        return ok;
+    }
+    template <class T>
+    void operator()(T& value) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        raw(&value, sizeof value);
+    }
+};
+
+std::uint64_t checksumOf(const char* data, std::size_t size) {
+    detail::Fnv1a h;
+    h.mix(data, size);
+    return h.value();
+}
+
+std::vector<char> serialise(const CacheKey& key, const RemeshResult& r) {
+    Writer w;
+    w.raw(kFormat, sizeof kFormat);
+    w(kByteOrder);
+    visitFields(w, key, r);
+    w(std::uint64_t(r.mesh.vertices.size()));
+    w(std::uint64_t(r.mesh.faces.size()));
+    for (const Vec3& p : r.mesh.vertices) w.raw(p.data(), 3 * sizeof(double));
+    w.raw(r.mesh.faces.data(), r.mesh.faces.size() * sizeof(Face));
+    w(checksumOf(w.bytes.data(), w.bytes.size()));
+    return std::move(w.bytes);
+}
+
+bool sameKey(const CacheKey& a, const CacheKey& b) {
+    return a.hash == b.hash && a.vertices == b.vertices && a.faces == b.faces && a.targetEdge == b.targetEdge &&
+           a.featureAngle == b.featureAngle && a.iterations == b.iterations && a.thinFeatures == b.thinFeatures;
+}
+
+// The surface in `bytes` when they are a whole file of this format for `key`.
+std::optional<RemeshResult> deserialise(const std::vector<char>& bytes, const CacheKey& key) {
+    constexpr std::size_t kChecksum = sizeof(std::uint64_t);
+    if (bytes.size() < sizeof kFormat + kChecksum) return std::nullopt;
+    std::uint64_t stored = 0;
+    std::memcpy(&stored, bytes.data() + bytes.size() - kChecksum, kChecksum);
+    if (stored != checksumOf(bytes.data(), bytes.size() - kChecksum)) return std::nullopt;
+    Reader in{bytes};
+    char format[sizeof kFormat];
+    std::uint64_t byteOrder = 0, vertices = 0, faces = 0;
+    CacheKey found;
+    RemeshResult r;
+    in.raw(format, sizeof format);
+    in(byteOrder);
+    visitFields(in, found, r);
+    in(vertices), in(faces);
+    const std::size_t payload = bytes.size() - kChecksum - std::min(in.at, bytes.size() - kChecksum);
+    if (!in.ok || std::memcmp(format, kFormat, sizeof kFormat) != 0 || byteOrder != kByteOrder || !sameKey(found, key) ||
+        vertices > payload / (3 * sizeof(double)) || faces > payload / sizeof(Face) ||
+        vertices * 3 * sizeof(double) + faces * sizeof(Face) != payload)
+        return std::nullopt;
+    r.mesh.vertices.resize(vertices);
+    r.mesh.faces.resize(faces);
+    for (Vec3& p : r.mesh.vertices) in.raw(p.data(), 3 * sizeof(double));
+    in.raw(r.mesh.faces.data(), faces * sizeof(Face));
+    for (const Vec3& p : r.mesh.vertices)
+        if (!p.allFinite()) return std::nullopt;
+    for (const Face& f : r.mesh.faces)
+        for (Index v : f)
+            if (v >= vertices) return std::nullopt;
+    return r;
+}
+
+std::optional<std::vector<char>> readWhole(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return std::nullopt;
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) return std::nullopt;
+    return bytes;
+}
+
+// Written beside `file` under a name of this process's and renamed over it; the problem, or "".
+std::string writeAtomically(const std::filesystem::path& file, const std::vector<char>& bytes) {
+    static std::atomic<unsigned> counter{0};
+    std::filesystem::path temporary = file;
+    temporary += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        out.write(bytes.data(), std::streamsize(bytes.size()));
+        out.close();
+        if (!out) {
+            std::error_code ignored;
+            std::filesystem::remove(temporary, ignored);
+            return "could not write " + temporary.string();
+        }
+    }
+    std::error_code error;
+    std::filesystem::rename(temporary, file, error);
+    if (!error) return {};
+    std::filesystem::remove(temporary, error);
+    return "could not rename " + temporary.string() + " to " + file.string();
+}
+
+}  // namespace
+
+std::filesystem::path defaultRemeshCacheDirectory() {
+    if (const char* chosen = std::getenv("FLEXFIT_CACHE_DIR"))
+        return *chosen ? std::filesystem::path(chosen) / "remesh" : std::filesystem::path();
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "flexfit" / "remesh";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return std::filesystem::path(home) / ".cache" / "flexfit" / "remesh";
+    return {};
+}
+
+CachedRemesh remeshCached(const TriMesh& mesh, const RemeshOptions& options, const std::string& source,
+                          const std::filesystem::path& directory) {
+    CachedRemesh out;
+    if (directory.empty()) {
+        out.result = remeshForSimulation(mesh, options, source);
+        return out;
+    }
+    const CacheKey key = keyOf(mesh, options);
+    const std::filesystem::path file = fileOf(directory, key);
+    if (const std::optional<std::vector<char>> bytes = readWhole(file))
+        if (std::optional<RemeshResult> cached = deserialise(*bytes, key)) {
+            out.result = std::move(*cached);
+            out.result.mesh.name = mesh.name;
+            out.hit = true;
+            return out;
+        }
+    out.result = remeshForSimulation(mesh, options, source);
+    std::error_code error;
+    std::filesystem::create_directories(directory, error);
+    out.problem = error ? "could not create the remesh cache directory " + directory.string() + " (" + error.message() + ")"
+                        : writeAtomically(file, serialise(key, out.result));
+    return out;
+}
+
+}  // namespace flexfit
