@@ -1,6 +1,7 @@
 // Tests the format dispatch of writeMesh/readMesh and readMesh's weld tolerance on .tri files, against meshes written and counted by hand.
 #include "flexfit/generators.hpp"
 #include "float_precision.hpp"
+#include "mutations.hpp"
 #include "strings.hpp"
 #include "flexfit/mesh_io.hpp"
 
@@ -14,7 +15,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <cstdint>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -370,6 +373,66 @@ TEST(MeshIo, StlIsNumberedByItsWeldedVertices) {
     EXPECT_EQ(r.mesh.vertices.size(), sphere.vertices.size());
     EXPECT_EQ(r.repairs.weldedVertices, 1u);
     EXPECT_EQ(r.fileVertices.count(), sphere.vertices.size() + 1) << "the welded vertices, not the 3F corners";
+}
+
+
+// ---------------------------------------------------------------------------------------------
+// Fuzz: mutations of valid OBJ, OFF and PLY files (ASCII and binary) either read to a valid mesh
+// (validateMesh passes again, every coordinate finite) or throw InputError with a problem;
+// nothing else may escape, and the sanitizer build checks that nothing reads out of bounds.
+
+// A binary little-endian PLY tetrahedron: double coordinates, a colour byte, uint indices.
+std::string binaryPlyTetrahedron() {
+    std::string out = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+                      "property double z\nproperty uchar red\nelement face 4\nproperty list uchar uint vertex_indices\nend_header\n";
+    const double corners[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const std::uint32_t faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    const auto append = [&](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
+    for (const auto& c : corners) append(c, sizeof c), out.push_back('\7');
+    for (const auto& f : faces) out.push_back('\3'), append(f, sizeof f);
+    return out;
+}
+
+// 1 when read, 0 when refused with InputError; a test failure otherwise.
+int readOrReject(const fs::path& file, bool repair, const std::string& label) {
+    return flexfit::testing::readOrRefused([&] {
+        MeshReadOptions options;
+        options.repair = repair;
+        const MeshReadResult r = readMesh(file, options);
+        EXPECT_NO_THROW(validateMesh(r.mesh, "again")) << label;
+        for (const Vec3& p : r.mesh.vertices) EXPECT_TRUE(p.allFinite()) << label;
+        EXPECT_FALSE(r.mesh.faces.empty()) << label;
+    }, label);
+}
+
+TEST(MeshIoFuzz, MutationsOfValidObjOffAndPlyFiles) {
+    const std::string obj = "# tet\no tet\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nvt 0 0\n"
+                            "f 1/1/1 3/1/1 2/1/1\nf 1//1 2//1 4//1\nf -4 -1 -2\nf 2 3 4\n";
+    const std::string quadObj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                                "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+    const std::string off = "OFF\n# tet\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3 255 0 0\n3 0 3 2\n3 1 2 3\n";
+    const std::string ply = "ply\nformat ascii 1.0\ncomment tet\nelement vertex 4\nproperty float x\nproperty float y\n"
+                            "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                            "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    const std::string interesting = "0123456789 -+./\n\r\tenaifvpOF";
+    const struct {
+        std::string name, text;
+    } seeds[] = {{"tet.obj", obj}, {"box.obj", quadObj}, {"tet.off", off}, {"tet.ply", ply}, {"binary.ply", binaryPlyTetrahedron()}};
+    TempDir dir;
+    std::mt19937 rng(20261206u);
+    for (const auto& seed : seeds) {
+        const fs::path file = dir.write(seed.name, seed.text);
+        ASSERT_EQ(readOrReject(file, true, seed.name), 1);
+        int read = 0;
+        for (int i = 0; i < 1500; ++i) {
+            dir.write(seed.name, flexfit::testing::mutated(seed.text, rng, interesting));
+            read += readOrReject(file, i % 2 == 0, seed.name + " mutation " + std::to_string(i));
+            if (::testing::Test::HasFailure()) return;
+        }
+        // Some mutations (comments, whitespace) leave the file valid; most do not.
+        EXPECT_GT(read, 0) << seed.name;
+        EXPECT_LT(read, 1500) << seed.name;
+    }
 }
 
 }  // namespace
