@@ -16,6 +16,8 @@ constexpr double kLinearSlopShare = 0.25;
 constexpr int kBisections = 6;
 // Pieces of one sub-step's move beyond which a body is taken to have diverged.
 constexpr double kMaxPieces = 64.0;
+// Passes over the bodies whose move was cut (settleAll).
+constexpr int kSettlePasses = 8;
 
 // Velocity first (semi-implicit Euler): the loads of the last step and gravity, then the
 // loads are consumed. Returns the speed the loads gave in the step.
@@ -204,6 +206,37 @@ bool settleMove(BodyId id, double dt, double slop, double bound, const StepConte
     return false;
 }
 
+bool samePose(const Pose& a, const Pose& b) {
+    return a.translation == b.translation && a.rotation.coeffs() == b.rotation.coeffs();
+}
+
+// 3 for every mover, then again for those cut short while one of them still gets further: a
+// body is checked against the others' moves as they stand, so a box under a falling one is
+// held back by that one's whole move until it is cut back in turn. Without the passes, a stack
+// stepped in steps longer than its gaps take to close (gravity's travel in a step beyond the
+// slop) never closed them: each box stopped above the one below, the contacts stayed apart
+// and the boxes' velocities grew by g h a step while they stood still. Returns the bodies cut
+// short (the others reached their whole move).
+const std::vector<BodyId>& settleAll(double dt, double slop, double bound, const StepContext& step, Bodies& bodies,
+                                     CollisionWorld& collision, RigidMotionScratch& s, StepProfiler& profiler) {
+    s.cut.clear();
+    for (BodyId id : s.moving)
+        if (!settleMove(id, dt, slop, bound, step, bodies, collision, s, profiler)) s.cut.push_back(id);
+    for (int pass = 1; pass < kSettlePasses && !s.cut.empty(); ++pass) {
+        bool further = false;
+        std::size_t kept = 0;
+        for (BodyId id : s.cut) {
+            const Pose before = bodies.parts[id]->pose();
+            const bool reached = settleMove(id, dt, slop, bound, step, bodies, collision, s, profiler);
+            further = further || !samePose(before, bodies.parts[id]->pose());
+            if (!reached) s.cut[kept++] = id;
+        }
+        s.cut.resize(kept);
+        if (!further) break;
+    }
+    return s.cut;
+}
+
 // 5. A kinematic body's pushes on the deformable parts it meets mid-step.
 void pressDeformableParts(BodyId id, Bodies& bodies, CollisionWorld& collision, ContactResponse& response, StepProfiler& profiler) {
     const Stage outer = profiler.running();
@@ -267,12 +300,9 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
             s.subStart[id] = bodies.parts[id]->pose();
             bodies.parts[id]->setPose(advancedPose(s.subStart[id], dt, bodies.rigid[id]));
         }
-        for (BodyId id : s.moving) {
-            const bool reached = settleMove(id, dt, slop, bound, step, bodies, collision, s, profiler);
-            if (!reached) {
-                s.stopped[id] = 1;
-                ++profile.cutMoves;
-            }
+        for (BodyId id : settleAll(dt, slop, bound, step, bodies, collision, s, profiler)) {
+            s.stopped[id] = 1;
+            ++profile.cutMoves;
         }
         profiler.enter(Stage::ContactSolver);
         refreshLeverArms(bodies, s.solver);

@@ -40,6 +40,7 @@ struct RigidMotionScratch {
     std::vector<Pose> subStart;         // (nbody) pose at the sub-step's start
     std::vector<Pose> stepStart;        // (nbody) pose at the step's start (kinematic bodies)
     std::vector<char> stopped;          // (nbody) a sub-step of this step was cut short
+    std::vector<BodyId> cut;            // this sub-step's movers whose move is cut short so far
     std::vector<Contact> cached;        // contacts of `cachedBody` at its current pose
     std::vector<Contact> unseen;        // a body's contacts not added by a lower id's query
     std::optional<BodyId> cachedBody;
