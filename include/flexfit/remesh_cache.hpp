@@ -21,7 +21,8 @@
 // Known limits: nothing is evicted (a file takes about 24 bytes a vertex and 12 a face; delete
 // the directory to reclaim it); files are in the machine's byte order (another byte order
 // misses, by the format tag); the input's name is not part of the key (the result takes the
-// input's name).
+// input's name); builds of the same sources that round differently (another compiler, other
+// floating-point flags) share files as if they did not.
 #pragma once
 
 #include "flexfit/remesh.hpp"

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <random>
 #include <sstream>
 #include <type_traits>
 #include <unistd.h>
@@ -175,11 +176,14 @@ std::optional<std::vector<char>> readWhole(const std::filesystem::path& file) {
     return bytes;
 }
 
-// Written beside `file` under a name of this process's and renamed over it; the problem, or "".
+// Written beside `file` under a name of this writer's and renamed over it; the problem, or "".
+// The name has the process id and a random number: processes on machines sharing the directory
+// can have the same id.
 std::string writeAtomically(const std::filesystem::path& file, const std::vector<char>& bytes) {
     static std::atomic<unsigned> counter{0};
     std::filesystem::path temporary = file;
-    temporary += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+    temporary += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(std::random_device{}()) + "." +
+                 std::to_string(counter++);
     {
         std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
         out.write(bytes.data(), std::streamsize(bytes.size()));
