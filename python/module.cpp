@@ -160,6 +160,14 @@ TriMesh meshFromArrays(py::array_t<double, py::array::c_style | py::array::force
     return mesh;
 }
 
+// load_scene's and run_scene's keywords: remesh_cache None is the default directory, "" none.
+SceneReadOptions sceneReadOptions(bool strict, std::optional<std::filesystem::path> remeshCache) {
+    SceneReadOptions options;
+    options.strictMeshes = strict;
+    options.remeshCache = std::move(remeshCache);
+    return options;
+}
+
 py::object summaryObject(const Scene& scene, const cli::RunSummary& s) {
     return py::module_::import("json").attr("loads")(cli::summaryJson(scene, s));
 }
@@ -625,10 +633,7 @@ PYBIND11_MODULE(_flexfit, m) {
         }, "The scene's warnings (old spellings, mesh repairs).");
     m.def("load_scene", [](const std::filesystem::path& path, bool strict, std::optional<std::filesystem::path> remeshCache) {
         py::gil_scoped_release release;  // a scene's meshes may be remeshed and their fields built: seconds
-        SceneReadOptions options;
-        options.strictMeshes = strict;
-        options.remeshCache = std::move(remeshCache);
-        return loadScene(path, options);
+        return loadScene(path, sceneReadOptions(strict, std::move(remeshCache)));
     }, py::arg("path"), py::arg("strict") = false, py::arg("remesh_cache") = py::none(),
           "Reads a scene file (TOML), the GIL released meanwhile. Raises InputError naming the file, line and key. "
           "remesh_cache: the directory keeping remeshed parts' surfaces between loads (None: the default, "
@@ -653,11 +658,11 @@ PYBIND11_MODULE(_flexfit, m) {
         }, py::arg("name"), "The body id of a part by its scene name.");
 
     m.def("run_scene", [](const std::filesystem::path& path, std::optional<std::filesystem::path> out, std::optional<double> duration, std::optional<double> vtkEvery,
-                          std::optional<double> glbEvery) {
+                          std::optional<double> glbEvery, std::optional<std::filesystem::path> remeshCache) {
         std::optional<Scene> loaded;
         {
             py::gil_scoped_release release;
-            loaded.emplace(loadScene(path));
+            loaded.emplace(loadScene(path, sceneReadOptions(false, std::move(remeshCache))));
         }
         const Scene& scene = *loaded;
         cli::RunOptions options;
@@ -673,7 +678,9 @@ PYBIND11_MODULE(_flexfit, m) {
         }
         return summaryObject(scene, s);
     }, py::arg("path"), py::arg("out") = py::none(), py::arg("duration") = py::none(), py::arg("vtk_every") = py::none(), py::arg("glb_every") = py::none(),
-          "Runs a scene file as `flexfit run` does; returns its summary (a dict, as summary.json), and with `out` writes the same files.");
+          py::arg("remesh_cache") = py::none(),
+          "Runs a scene file as `flexfit run` does; returns its summary (a dict, as summary.json), and with `out` writes the same files. "
+          "remesh_cache as load_scene's.");
 
     // --- Sweeps ---
     py::class_<Sweep>(m, "Sweep", "A sweep file: a base scene, the parameters to vary, every combination a run.")

@@ -267,6 +267,10 @@ def test_load_scene_keeps_remeshed_surfaces_in_the_remesh_cache(tmp_path, exampl
     hashes = {flexfit.SceneRun(s).world.state_hash() for s in (first, second, off)}
     assert len(hashes) == 1
     assert first.warnings == second.warnings == off.warnings == []
+    # run_scene takes the same keyword.
+    other = tmp_path / "other"
+    flexfit.run_scene(scene, duration=0.01, remesh_cache=str(other))
+    assert [f.name for f in other.iterdir()] == [files[0].name]
 
 
 def test_every_binding_has_a_docstring():
