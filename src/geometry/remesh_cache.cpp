@@ -3,7 +3,6 @@
 #include "core/fnv1a.hpp"
 #include "geometry/remesh_samples.hpp"
 
-#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -14,6 +13,7 @@
 #include <iterator>
 #include <optional>
 #include <random>
+#include <span>
 #include <sstream>
 #include <type_traits>
 #include <unistd.h>
@@ -32,14 +32,21 @@ struct CacheKey {
     std::uint64_t vertices = 0, faces = 0;
     double targetEdge = 0.0, featureAngle = 0.0;
     std::int64_t iterations = 0, thinFeatures = 0;
+    bool operator==(const CacheKey&) const = default;
 };
+
+// Calls io(field) for each key field but the hash: what the hash mixes in after the mesh.
+template <class Io, class Key>
+void visitCounts(Io& io, Key& key) {
+    io(key.vertices), io(key.faces), io(key.targetEdge), io(key.featureAngle), io(key.iterations), io(key.thinFeatures);
+}
 
 // Calls io(field) for each key field, then each report field of r, in the file's order: the
 // writer and the reader share this list.
 template <class Io, class Key, class Result>
 void visitFields(Io& io, Key& key, Result& r) {
-    io(key.hash), io(key.vertices), io(key.faces), io(key.targetEdge), io(key.featureAngle), io(key.iterations),
-        io(key.thinFeatures);
+    io(key.hash);
+    visitCounts(io, key);
     for (auto* q : {&r.before, &r.after})
         io(q->faces), io(q->minAngle), io(q->slivers), io(q->minEdge), io(q->meanEdge), io(q->maxEdge), io(q->edgeSpread);
     io(r.featureEdges), io(r.droppedFaces), io(r.seamVertices), io(r.releasedEdges), io(r.roundedHausdorff), io(r.rounded),
@@ -65,9 +72,8 @@ CacheKey keyOf(const TriMesh& mesh, const RemeshOptions& options) {
     h.mix(fingerprint.data(), fingerprint.size());
     for (const Vec3& p : mesh.vertices) h.mix(p.data(), 3 * sizeof(double));
     h.mix(mesh.faces.data(), mesh.faces.size() * sizeof(Face));
-    for (auto value : {key.vertices, key.faces}) mixValue(h, value);
-    for (auto value : {key.targetEdge, key.featureAngle}) mixValue(h, value);
-    for (auto value : {key.iterations, key.thinFeatures}) mixValue(h, value);
+    auto mix = [&h](const auto& value) { mixValue(h, value); };
+    visitCounts(mix, key);
     key.hash = h.value();
     return key;
 }
@@ -83,20 +89,20 @@ std::filesystem::path fileOf(const std::filesystem::path& directory, const Cache
 
 struct Writer {
     std::vector<char> bytes;
-    template <class T>
-    void operator()(const T& value) {
-        static_assert(std::is_trivially_copyable_v<T>);
-        const char* p = reinterpret_cast<const char*>(&value);
-        bytes.insert(bytes.end(), p, p + sizeof value);
-    }
     void raw(const void* data, std::size_t size) {
         const char* p = static_cast<const char*>(data);
         bytes.insert(bytes.end(), p, p + size);
     }
+    template <class T>
+    void operator()(const T& value) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        raw(&value, sizeof value);
+    }
 };
 
+// Reads `bytes` in order; `ok` turns false at the first read past their end.
 struct Reader {
-    const std::vector<char>& bytes;
+    std::span<const char> bytes;
     std::size_t at = 0;
     bool ok = true;
     bool raw(void* data, std::size_t size) {
@@ -130,11 +136,6 @@ std::vector<char> serialise(const CacheKey& key, const RemeshResult& r) {
     return std::move(w.bytes);
 }
 
-bool sameKey(const CacheKey& a, const CacheKey& b) {
-    return a.hash == b.hash && a.vertices == b.vertices && a.faces == b.faces && a.targetEdge == b.targetEdge &&
-           a.featureAngle == b.featureAngle && a.iterations == b.iterations && a.thinFeatures == b.thinFeatures;
-}
-
 // The surface in `bytes` when they are a whole file of this format for `key`.
 std::optional<RemeshResult> deserialise(const std::vector<char>& bytes, const CacheKey& key) {
     constexpr std::size_t kChecksum = sizeof(std::uint64_t);
@@ -142,7 +143,7 @@ std::optional<RemeshResult> deserialise(const std::vector<char>& bytes, const Ca
     std::uint64_t stored = 0;
     std::memcpy(&stored, bytes.data() + bytes.size() - kChecksum, kChecksum);
     if (stored != checksumOf(bytes.data(), bytes.size() - kChecksum)) return std::nullopt;
-    Reader in{bytes};
+    Reader in{std::span<const char>(bytes).first(bytes.size() - kChecksum)};
     char format[sizeof kFormat];
     std::uint64_t byteOrder = 0, vertices = 0, faces = 0;
     CacheKey found;
@@ -151,8 +152,8 @@ std::optional<RemeshResult> deserialise(const std::vector<char>& bytes, const Ca
     in(byteOrder);
     visitFields(in, found, r);
     in(vertices), in(faces);
-    const std::size_t payload = bytes.size() - kChecksum - std::min(in.at, bytes.size() - kChecksum);
-    if (!in.ok || std::memcmp(format, kFormat, sizeof kFormat) != 0 || byteOrder != kByteOrder || !sameKey(found, key) ||
+    const std::size_t payload = in.bytes.size() - in.at;
+    if (!in.ok || std::memcmp(format, kFormat, sizeof kFormat) != 0 || byteOrder != kByteOrder || !(found == key) ||
         vertices > payload / (3 * sizeof(double)) || faces > payload / sizeof(Face) ||
         vertices * 3 * sizeof(double) + faces * sizeof(Face) != payload)
         return std::nullopt;

@@ -210,29 +210,27 @@ bool samePose(const Pose& a, const Pose& b) {
     return a.translation == b.translation && a.rotation.coeffs() == b.rotation.coeffs();
 }
 
-// 3 for every mover, then again for those cut short while one of them still gets further: a
-// body is checked against the others' moves as they stand, so a box under a falling one is
-// held back by that one's whole move until it is cut back in turn. Without the passes, a stack
-// stepped in steps longer than its gaps take to close (gravity's travel in a step beyond the
-// slop) never closed them: each box stopped above the one below, the contacts stayed apart
-// and the boxes' velocities grew by g h a step while they stood still. Returns the bodies cut
-// short (the others reached their whole move).
+// 3 for every mover, then again for those cut short while a pass changes a pose: a body is
+// checked against the others' moves as they stand, so a box under a falling one is held back
+// by that one's whole move until it is cut back in turn. Without the passes, a stack stepped
+// in steps longer than its gaps take to close (gravity's travel in a step beyond the slop)
+// never closed them: each box stopped above the one below, the contacts stayed apart and the
+// boxes' velocities grew by g h a step while they stood still. Returns the bodies cut short
+// (the others reached their whole move).
 const std::vector<BodyId>& settleAll(double dt, double slop, double bound, const StepContext& step, Bodies& bodies,
                                      CollisionWorld& collision, RigidMotionScratch& s, StepProfiler& profiler) {
-    s.cut.clear();
-    for (BodyId id : s.moving)
-        if (!settleMove(id, dt, slop, bound, step, bodies, collision, s, profiler)) s.cut.push_back(id);
-    for (int pass = 1; pass < kSettlePasses && !s.cut.empty(); ++pass) {
-        bool further = false;
+    s.cut.assign(s.moving.begin(), s.moving.end());
+    for (int pass = 0; pass < kSettlePasses && !s.cut.empty(); ++pass) {
+        bool changed = false;
         std::size_t kept = 0;
         for (BodyId id : s.cut) {
             const Pose before = bodies.parts[id]->pose();
             const bool reached = settleMove(id, dt, slop, bound, step, bodies, collision, s, profiler);
-            further = further || !samePose(before, bodies.parts[id]->pose());
+            changed = changed || !samePose(before, bodies.parts[id]->pose());
             if (!reached) s.cut[kept++] = id;
         }
         s.cut.resize(kept);
-        if (!further) break;
+        if (pass > 0 && !changed) break;  // the first pass is every mover's; the rest repeat while poses change
     }
     return s.cut;
 }
@@ -320,7 +318,7 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
         if (!s.stopped[id]) {
             const Pose& target = *bodies.kinematicTargets[id];
             const Pose& now = bodies.parts[id]->pose();
-            if (target.translation != now.translation || target.rotation.coeffs() != now.rotation.coeffs()) s.cachedBody.reset();
+            if (!samePose(target, now)) s.cachedBody.reset();
             bodies.parts[id]->setPose(target);
         }
         bodies.kinematicTargets[id].reset();
