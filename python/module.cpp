@@ -700,8 +700,12 @@ PYBIND11_MODULE(_flexfit, m) {
         .def("scene_of", [](const Sweep& s, std::size_t run) { return sweepScene(s, run); }, py::arg("run"), py::call_guard<py::gil_scoped_release>(),
              "The scene of one run (the base with its values; the GIL released while it is built).")
         .def("__len__", [](const Sweep& s) { return s.runs.size(); }, "Number of runs.");
-    m.def("load_sweep", &loadSweep, py::arg("path"), py::arg("check_runs") = true, py::call_guard<py::gil_scoped_release>(),
-          "Reads a sweep file; with check_runs, builds and checks every run's scene first (the GIL released meanwhile).");
+    m.def("load_sweep", [](const std::filesystem::path& path, bool checkRuns, bool strict, std::optional<std::filesystem::path> remeshCache) {
+        return loadSweep(path, checkRuns, sceneReadOptions(strict, std::move(remeshCache)));
+    }, py::arg("path"), py::arg("check_runs") = true, py::arg("strict") = false, py::arg("remesh_cache") = py::none(),
+          py::call_guard<py::gil_scoped_release>(),
+          "Reads a sweep file; with check_runs, builds and checks every run's scene first (the GIL released meanwhile). "
+          "strict and remesh_cache as load_scene's, for every run's scene.");
     m.def("missing_sweep_runs", &cli::missingSweepRuns, py::arg("sweep"), py::arg("out"), "Indices of the runs without results under `out`.");
     m.def("run_sweep_run", [](const Sweep& s, std::size_t run, const std::filesystem::path& out) {
         py::gil_scoped_release release;

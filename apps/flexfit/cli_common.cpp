@@ -89,6 +89,20 @@ void addMeshOptions(CLI::App* cmd, MeshOptions& options, bool weld) {
                   "inconsistent windings) instead of repairing them");
 }
 
+SceneReadOptions SceneOptions::read() const {
+    SceneReadOptions options;
+    options.strictMeshes = strict;
+    if (remeshCache) options.remeshCache = std::filesystem::path(*remeshCache);
+    return options;
+}
+
+void addSceneOptions(CLI::App* cmd, SceneOptions& options) {
+    cmd->add_flag("--strict", options.strict, "Refuse mesh files with geometric defects instead of repairing them (every part)");
+    cmd->add_option("--remesh-cache", options.remeshCache,
+                    "Directory keeping remeshed parts' surfaces between runs (default: $FLEXFIT_CACHE_DIR/remesh, else "
+                    "~/.cache/flexfit/remesh; \"\": none)");
+}
+
 MeshReadResult loadMesh(const std::filesystem::path& path, const MeshReadOptions& options) {
     MeshReadResult result = readMesh(path, options);
     for (const std::string& warning : result.diagnostics.warnings) fmt::print(stderr, "warning: {}: {}\n", path.string(), warning);

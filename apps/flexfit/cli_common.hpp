@@ -53,6 +53,15 @@ struct MeshOptions {
 };
 void addMeshOptions(CLI::App* cmd, MeshOptions& options, bool weld = true);
 
+// How a command reads scene files: --strict (every part's mesh file) and --remesh-cache DIR
+// (SceneReadOptions, scene_file.hpp).
+struct SceneOptions {
+    bool strict = false;
+    std::optional<std::string> remeshCache;
+    SceneReadOptions read() const;
+};
+void addSceneOptions(CLI::App* cmd, SceneOptions& options);
+
 // Reads any supported mesh and prints its warnings (repairs first) to stderr.
 MeshReadResult loadMesh(const std::filesystem::path& path, const MeshReadOptions& options = {});
 

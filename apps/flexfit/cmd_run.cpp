@@ -16,8 +16,7 @@ void registerRun(CLI::App& app) {
         std::string scene, out;
         double duration = 0.0;
         bool noProgress = false;
-        bool strict = false;
-        std::optional<std::string> remeshCache;
+        SceneOptions read;
         double objEvery = -1.0, vtkEvery = -1.0, glbEvery = -1.0;
     };
     auto opt = std::make_shared<Options>();
@@ -28,15 +27,9 @@ void registerRun(CLI::App& app) {
     cmd->add_option("--obj-every", opt->objEvery, "Seconds between OBJ frames (default: the scene's [output]; 0: none)")->check(CLI::NonNegativeNumber);
     cmd->add_option("--vtk-every", opt->vtkEvery, "Seconds between VTK frames for ParaView (frame_*.vtp, frames.pvd; 0: none)")->check(CLI::NonNegativeNumber);
     cmd->add_option("--glb-every", opt->glbEvery, "Seconds between glTF binary frames for Blender (frame_*.glb; 0: none)")->check(CLI::NonNegativeNumber);
-    cmd->add_flag("--strict", opt->strict, "Refuse mesh files with geometric defects instead of repairing them (every part)");
-    cmd->add_option("--remesh-cache", opt->remeshCache,
-                    "Directory keeping remeshed parts' surfaces between runs (default: $FLEXFIT_CACHE_DIR/remesh, else "
-                    "~/.cache/flexfit/remesh; \"\": none)");
+    addSceneOptions(cmd, opt->read);
     cmd->callback([opt] {
-        SceneReadOptions read;
-        read.strictMeshes = opt->strict;
-        if (opt->remeshCache) read.remeshCache = std::filesystem::path(*opt->remeshCache);
-        const Scene scene = loadScene(opt->scene, read);
+        const Scene scene = loadScene(opt->scene, opt->read.read());
         printWarnings(scene);
         RunOptions options;
         if (opt->duration > 0.0) options.duration = opt->duration;

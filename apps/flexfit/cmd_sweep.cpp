@@ -16,6 +16,7 @@ void registerSweep(CLI::App& app) {
         std::string sweep, out;
         int jobs = 0;
         bool noProgress = false, list = false;
+        SceneOptions read;
     };
     auto opt = std::make_shared<Options>();
     cmd->add_option("sweep", opt->sweep, "Sweep file (.toml): a base scene and the parameters to vary")->required();
@@ -23,8 +24,9 @@ void registerSweep(CLI::App& app) {
     cmd->add_option("--jobs", opt->jobs, "Runs at once (default: the machine's cores)")->check(CLI::Range(1, 1024));
     cmd->add_flag("--list", opt->list, "Print the runs (id and values) and whether each is done, run nothing");
     cmd->add_flag("--no-progress", opt->noProgress, "No progress bar");
+    addSceneOptions(cmd, opt->read);
     cmd->callback([opt] {
-        const Sweep sweep = loadSweep(opt->sweep);
+        const Sweep sweep = loadSweep(opt->sweep, true, opt->read.read());
         if (opt->list) {
             for (std::size_t r = 0; r < sweep.runs.size(); ++r) {
                 fmt::print("{} {}", sweep.runs[r].id, sweepRunDone(sweep, r, opt->out) ? "done   " : "missing");

@@ -31,6 +31,7 @@
 #pragma once
 
 #include "flexfit/scene.hpp"
+#include "flexfit/scene_file.hpp"
 
 #include <cstddef>
 #include <filesystem>
@@ -64,6 +65,7 @@ struct Sweep {
     std::vector<SweepParameter> parameters;
     std::vector<SweepRun> runs;       // in product order
     std::shared_ptr<const detail::SweepDocument> document;  // the base scene and the values
+    SceneReadOptions read;            // how every run's scene is read (strict meshes, remesh cache)
 
     // The run's label of each parameter, in order.
     std::vector<std::string> labels(std::size_t run) const;
@@ -71,8 +73,9 @@ struct Sweep {
 
 // Throws InputError naming the sweep file (or the base scene), the line and the problem. With
 // checkRuns, every run's scene is built and checked once (meshes and all), so a sweep that loads
-// has no bad run; a worker that runs runs of a sweep checked elsewhere can skip it.
-Sweep loadSweep(const std::filesystem::path& file, bool checkRuns = true);
+// has no bad run; a worker that runs runs of a sweep checked elsewhere can skip it. `read` is
+// kept in the sweep: every run's scene is read with it, as loadScene reads one.
+Sweep loadSweep(const std::filesystem::path& file, bool checkRuns = true, const SceneReadOptions& read = {});
 
 // The scene of one run (its source names the sweep file and the run id).
 Scene sweepScene(const Sweep& sweep, std::size_t run);

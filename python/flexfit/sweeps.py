@@ -19,35 +19,39 @@ import pathlib
 _loaded = {}
 
 
-def _load(path, run, run_id):
-    """The sweep on a worker, loaded once per version of the file (a worker that outlives a
-    sweep, on a long-lived cluster, reloads an edited file); checks the run is the one meant."""
+def _load(path, run, run_id, read):
+    """The sweep on a worker, loaded once per version of the file and read options (a worker
+    that outlives a sweep, on a long-lived cluster, reloads an edited file); checks the run is
+    the one meant."""
     from . import _flexfit
 
     stat = os.stat(path)
-    key = (path, stat.st_mtime_ns, stat.st_size)
+    key = (path, stat.st_mtime_ns, stat.st_size, read)
     if key not in _loaded:
         _loaded.clear()
-        _loaded[key] = _flexfit.load_sweep(path, check_runs=False)  # the client checked them
+        # The client checked the runs.
+        _loaded[key] = _flexfit.load_sweep(path, check_runs=False, strict=read[0], remesh_cache=read[1])
     s = _loaded[key]
     if run >= len(s) or s.run_ids[run] != run_id:
         raise RuntimeError(f"{path} changed while its sweep was running (run {run_id} is no longer run {run})")
     return s
 
 
-def _run_one(path, run, run_id, out):
+def _run_one(path, run, run_id, out, read):
     """One run on a worker; returns (its id, whether it ran now)."""
     from . import _flexfit
 
-    return run_id, _flexfit.run_sweep_run(_load(path, run, run_id), run, out)
+    return run_id, _flexfit.run_sweep_run(_load(path, run, run_id, read), run, out)
 
 
-def sweep(path, out, scheduler=None, workers=2, table=True):
+def sweep(path, out, scheduler=None, workers=2, table=True, strict=False, remesh_cache=None):
     """Runs the sweep file ``path`` into the directory ``out`` on a Dask cluster.
 
     scheduler: None for a LocalCluster of ``workers`` processes (one thread each), or the
         address of a running scheduler (``workers`` is then ignored).
     table: return the results as a pandas DataFrame (python3-pandas), else the CSV's path.
+    strict, remesh_cache: as ``load_scene``'s, for every run's scene (on a remote cluster the
+        cache directory is a path on the workers; None: each worker's default).
 
     The DataFrame's ``attrs["ran"]`` lists the ids run by this call (the others were done).
     Raises flexfit.InputError for a bad sweep file, before anything runs.
@@ -58,7 +62,10 @@ def sweep(path, out, scheduler=None, workers=2, table=True):
 
     path = str(pathlib.Path(path).resolve())
     out = str(pathlib.Path(out).resolve())
-    s = _flexfit.load_sweep(path)
+    # A relative cache directory is the client's, whatever a worker's working directory is.
+    cache = None if remesh_cache is None else str(remesh_cache) and str(pathlib.Path(remesh_cache).resolve())
+    read = (bool(strict), cache)
+    s = _flexfit.load_sweep(path, strict=read[0], remesh_cache=read[1])
     os.makedirs(out, exist_ok=True)
     missing = _flexfit.missing_sweep_runs(s, out)
     ran = []
@@ -73,7 +80,8 @@ def sweep(path, out, scheduler=None, workers=2, table=True):
         client = Client(cluster if cluster is not None else scheduler)
         try:
             ids = [s.run_ids[r] for r in missing]
-            futures = client.map(_run_one, [path] * len(missing), missing, ids, [out] * len(missing), pure=False)
+            n = len(missing)
+            futures = client.map(_run_one, [path] * n, missing, ids, [out] * n, [read] * n, pure=False)
             ran = [run_id for run_id, now in client.gather(futures) if now]
         finally:
             client.close()

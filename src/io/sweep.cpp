@@ -285,7 +285,7 @@ Scene sweepScene(const Sweep& sweep, std::size_t run) {
     const auto inRun = [&](const std::string& problem) { return "run " + sweep.runs[run].id + " (" + values + "): " + problem; };
     Scene scene;
     try {
-        scene = detail::readSceneDocument(document, source, sweep.scene.parent_path(), {});
+        scene = detail::readSceneDocument(document, source, sweep.scene.parent_path(), sweep.read);
     } catch (const InputError& e) {
         // The problem is in a value the sweep set (line 0) or in the base scene (its line).
         if (e.line() == 0) throw InputError(sweep.file.string(), lineOfValue(sweep, e.problem()), inRun(e.problem()));
@@ -298,13 +298,14 @@ Scene sweepScene(const Sweep& sweep, std::size_t run) {
     return scene;
 }
 
-Sweep loadSweep(const std::filesystem::path& file, bool checkRuns) {
+Sweep loadSweep(const std::filesystem::path& file, bool checkRuns, const SceneReadOptions& read) {
     const std::string name = file.string();
     const toml::table root = parseText(readText(file, "sweep file"), file);
     for (const auto& [k, v] : root)
         if (k != "scene" && k != "duration" && k != "set" && k != "parameter") throw InputError(name, lineOf(v), "unknown key '" + std::string(k.str()) + "'");
     Sweep sweep;
     sweep.file = file;
+    sweep.read = read;
     const auto scene = root["scene"].value<std::string>();
     if (!scene) throw InputError(name, 1, "missing 'scene' (the base scene file, relative to the sweep file)");
     sweep.scene = file.parent_path() / *scene;

@@ -227,5 +227,47 @@ TEST(Sweep, NoParametersIsOneRunOfTheBase) {
     EXPECT_EQ(sweepScene(s, 0).parts.size(), 2u);
 }
 
+// loadSweep's read options reach every run's scene, as loadScene's reach one: the remesh cache
+// (one surface for every run and the check) and strict meshes (the file's defect refused).
+TEST(Sweep, ReadOptionsReachEveryRunsScene) {
+    TempDir dir;
+    // A tetrahedron with an unreferenced vertex (a defect repaired with a warning).
+    dir.write("tet.tri", "tet\n5 4\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n5 5 5\n0 2 1\n0 1 3\n0 3 2\n1 2 3\n");
+    const std::string scene = "[world]\ntime_step = 0.001\nduration = 0.01\n[[part]]\nname = \"tet\"\nmesh = \"tet.tri\"\nremesh = 0.2\n";
+    dir.write("scene.toml", scene);
+    const auto sweepFile = dir.write("sweep.toml", "scene = \"scene.toml\"\n[[parameter]]\nname = \"dt\"\nkey = \"world.time_step\"\nvalues = [0.001, 0.002]\n");
+    const std::filesystem::path cache = dir.path() / "cache";
+    SceneReadOptions read;
+    read.remeshCache = cache;
+    const Sweep s = loadSweep(sweepFile, true, read);
+    ASSERT_EQ(s.runs.size(), 2u);
+    const auto cacheFiles = [&] {
+        std::size_t n = 0;
+        for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(cache)) ++n;
+        return n;
+    };
+    EXPECT_EQ(cacheFiles(), 1u);
+    const Scene alone = loadScene(dir.path() / "scene.toml", read);
+    for (std::size_t run = 0; run < 2; ++run) {
+        const Scene runScene = sweepScene(s, run);
+        EXPECT_EQ(runScene.parts[0].model->mesh.vertices, alone.parts[0].model->mesh.vertices);
+        ASSERT_EQ(runScene.warnings.size(), alone.warnings.size());
+    }
+    EXPECT_EQ(cacheFiles(), 1u);
+    read.strictMeshes = true;
+    try {
+        loadSweep(sweepFile, true, read);
+        FAIL() << "strict meshes: the defect is refused";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("scene.toml:6: part 1, key 'mesh'"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("tet.tri"), std::string::npos) << e.what();
+    }
+    read = {};
+    read.remeshCache = std::filesystem::path();
+    const Sweep uncached = loadSweep(sweepFile, true, read);
+    EXPECT_EQ(sweepScene(uncached, 1).parts[0].model->mesh.vertices, alone.parts[0].model->mesh.vertices);
+    EXPECT_EQ(cacheFiles(), 1u);
+}
+
 }  // namespace
 }  // namespace flexfit

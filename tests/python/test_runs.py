@@ -163,3 +163,28 @@ values = ["static", "dynamic"]
     again = flexfit.sweep(sweep, tmp_path / "out", workers=1)
     assert len(again.attrs["ran"]) == 2 and set(again["run"]).isdisjoint(table["run"])
     assert (again["simulated_seconds"] == 0.2).all()
+
+
+def test_a_sweeps_runs_read_their_scenes_with_the_options_given(tmp_path, examples, flexfit_exe, monkeypatch):
+    # Two runs of a scene with a remeshed part: the Dask sweep and the command keep one surface
+    # in the remesh cache named (a relative directory is the client's), the file load_scene
+    # writes; strict meshes refuse a file's defect in every run.
+    sweep = tmp_path / "remeshed.toml"
+    sweep.write_text(f'scene = "{examples / "contact_remeshed.toml"}"\nduration = 0.01\n'
+                     '[[parameter]]\nname = "damping"\nkey = "part.blue.global_damping"\nvalues = [0.5, 0.6]\n')
+    monkeypatch.chdir(tmp_path)
+    table = flexfit.sweep(sweep, tmp_path / "out", workers=1, remesh_cache="cache")
+    assert (table["status"] == "ok").all() and len(table) == 2
+    names = [f.name for f in (tmp_path / "cache").iterdir()]
+    flexfit.load_scene(str(examples / "contact_remeshed.toml"), remesh_cache=str(tmp_path / "alone"))
+    assert names == [f.name for f in (tmp_path / "alone").iterdir()] and len(names) == 1
+    subprocess.run([flexfit_exe, "sweep", str(sweep), "--out", str(tmp_path / "cmd"), "--no-progress", "--remesh-cache", "cmd_cache"],
+                   check=True, capture_output=True)
+    assert [f.name for f in (tmp_path / "cmd_cache").iterdir()] == names
+    assert (tmp_path / "cmd" / "results.csv").read_bytes() == (tmp_path / "out" / "results.csv").read_bytes()
+    defects = pathlib.Path(__file__).resolve().parents[1] / "apps" / "data" / "defects_sweep.toml"
+    assert len(flexfit.load_sweep(str(defects), remesh_cache="")) == 2
+    with pytest.raises(flexfit.InputError, match=r"defects.tri:13: face 4"):
+        flexfit.load_sweep(str(defects), strict=True)
+    with pytest.raises(flexfit.InputError, match=r"defects.tri:13: face 4"):
+        flexfit.sweep(defects, tmp_path / "strict", workers=1, strict=True)
