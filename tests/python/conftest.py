@@ -19,12 +19,22 @@ def examples():
     return ROOT / "examples"
 
 
+def built_program(variable, how):
+    """The path ctest gives in `variable` (a program of the build), or the test is skipped."""
+    exe = os.environ.get(variable)
+    if not exe:
+        pytest.skip(f"{variable} not set (run through ctest{how})")
+    return exe
+
+
 @pytest.fixture
 def flexfit_exe():
-    exe = os.environ.get("FLEXFIT_EXE")
-    if not exe:
-        pytest.skip("FLEXFIT_EXE not set (run through ctest)")
-    return exe
+    return built_program("FLEXFIT_EXE", "")
+
+
+@pytest.fixture
+def haptic_loop_exe():
+    return built_program("FLEXFIT_HAPTIC_LOOP", ", with FLEXFIT_BUILD_EXAMPLES")
 
 
 def pytest_configure(config):
