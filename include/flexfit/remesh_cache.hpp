@@ -18,8 +18,11 @@
 // again. The cache never makes a load fail: a directory that cannot be created or written is
 // reported (CachedRemesh::problem, a scene warning) and the surface is remeshed.
 //
-// Known limits: nothing is evicted (a file takes about 24 bytes a vertex and 12 a face; delete
-// the directory to reclaim it); files are in the machine's byte order (another byte order
+// The cache holds at most FLEXFIT_CACHE_MAX bytes of surfaces (2 GiB by default; a file takes
+// about 24 bytes a vertex and 12 a face): after each write the least recently used files go
+// (by modification time, which a hit renews), never the one just written.
+//
+// Known limits: files are in the machine's byte order (another byte order
 // misses, by the format tag); the input's name is not part of the key (the result takes the
 // input's name); builds of the same sources that round differently (another compiler, other
 // floating-point flags) share files as if they did not.
@@ -27,6 +30,7 @@
 
 #include "flexfit/remesh.hpp"
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -36,6 +40,21 @@ namespace flexfit {
 // else $HOME/.cache/flexfit, each with "remesh" appended; empty when none is set.
 std::filesystem::path defaultRemeshCacheDirectory();
 
+// The most bytes of surfaces a cache directory keeps: FLEXFIT_CACHE_MAX when set (bytes, or
+// with a K, M or G suffix for powers of 1024; 0: no limit), else 2 GiB. A value that is not a
+// size is named in `problem` and the default is used.
+struct RemeshCacheLimit {
+    std::uintmax_t bytes = 0;  // 0: no limit
+    std::string problem;
+};
+RemeshCacheLimit defaultRemeshCacheLimit();
+
+// Removes the least recently used surfaces (*.remesh files, oldest modification time first)
+// from `directory` until those left take at most maxBytes; `keep` is never removed, even alone
+// above the limit. Other files are left alone, and a file another process removed first is
+// skipped. Returns how many it removed.
+std::size_t trimRemeshCache(const std::filesystem::path& directory, std::uintmax_t maxBytes, const std::filesystem::path& keep = {});
+
 struct CachedRemesh {
     RemeshResult result;
     bool hit = false;     // read from the cache
@@ -43,7 +62,8 @@ struct CachedRemesh {
 };
 
 // remeshForSimulation(mesh, options, source) through the cache in `directory` (created when
-// missing); an empty directory remeshes without it. Errors in the mesh or the options throw
+// missing, trimmed to defaultRemeshCacheLimit() after a write); an empty directory remeshes
+// without it. Errors in the mesh or the options throw
 // as remeshForSimulation does, and nothing is written for them.
 CachedRemesh remeshCached(const TriMesh& mesh, const RemeshOptions& options, const std::string& source,
                           const std::filesystem::path& directory);

@@ -3,8 +3,10 @@
 #include "core/fnv1a.hpp"
 #include "geometry/remesh_samples.hpp"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -15,6 +17,7 @@
 #include <random>
 #include <span>
 #include <sstream>
+#include <string_view>
 #include <type_traits>
 #include <unistd.h>
 #include <vector>
@@ -202,7 +205,62 @@ std::string writeAtomically(const std::filesystem::path& file, const std::vector
     return "could not rename " + temporary.string() + " to " + file.string();
 }
 
+// "123", "64K", "100M", "2G" (powers of 1024), or nullopt.
+std::optional<std::uintmax_t> parseSize(std::string_view text) {
+    std::size_t digits = 0;
+    while (digits < text.size() && text[digits] >= '0' && text[digits] <= '9') ++digits;
+    if (digits == 0 || digits > 15 || text.size() > digits + 1) return std::nullopt;
+    std::uintmax_t value = std::stoull(std::string(text.substr(0, digits)));
+    if (digits == text.size()) return value;
+    const char suffix = char(std::toupper(static_cast<unsigned char>(text[digits])));
+    const int shift = suffix == 'K' ? 10 : suffix == 'M' ? 20 : suffix == 'G' ? 30 : -1;
+    if (shift < 0) return std::nullopt;
+    return value << shift;
+}
+
+void markUsed(const std::filesystem::path& file) {
+    std::error_code ignored;  // a read-only directory still serves hits
+    std::filesystem::last_write_time(file, std::filesystem::file_time_type::clock::now(), ignored);
+}
+
 }  // namespace
+
+RemeshCacheLimit defaultRemeshCacheLimit() {
+    constexpr std::uintmax_t kDefault = std::uintmax_t(2) << 30;
+    const char* text = std::getenv("FLEXFIT_CACHE_MAX");
+    if (text == nullptr) return {kDefault, {}};
+    if (const std::optional<std::uintmax_t> bytes = parseSize(text)) return {*bytes, {}};
+    return {kDefault, std::string("FLEXFIT_CACHE_MAX: '") + text + "' is not a size (bytes, or a number with K, M or G); the cache keeps 2G"};
+}
+
+std::size_t trimRemeshCache(const std::filesystem::path& directory, std::uintmax_t maxBytes, const std::filesystem::path& keep) {
+    struct Entry {
+        std::filesystem::file_time_type used;
+        std::uintmax_t bytes;
+        std::filesystem::path path;
+    };
+    std::vector<Entry> entries;
+    std::uintmax_t total = 0;
+    std::error_code error;
+    for (std::filesystem::directory_iterator it(directory, error), end; !error && it != end; it.increment(error)) {
+        if (it->path().extension() != ".remesh") continue;
+        std::error_code statError;
+        const std::uintmax_t bytes = it->file_size(statError);
+        const auto used = it->last_write_time(statError);
+        if (statError) continue;  // removed meanwhile
+        total += bytes;
+        if (it->path() != keep) entries.push_back({used, bytes, it->path()});
+    }
+    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.used < b.used || (a.used == b.used && a.path < b.path); });
+    std::size_t removed = 0;
+    for (const Entry& e : entries) {
+        if (total <= maxBytes) break;
+        total -= e.bytes;
+        std::error_code removeError;
+        removed += std::filesystem::remove(e.path, removeError) ? 1 : 0;
+    }
+    return removed;
+}
 
 std::filesystem::path defaultRemeshCacheDirectory() {
     if (const char* chosen = std::getenv("FLEXFIT_CACHE_DIR"))
@@ -227,6 +285,7 @@ CachedRemesh remeshCached(const TriMesh& mesh, const RemeshOptions& options, con
             out.result = std::move(*cached);
             out.result.mesh.name = mesh.name;
             out.hit = true;
+            markUsed(file);
             return out;
         }
     out.result = remeshForSimulation(mesh, options, source);
@@ -234,6 +293,10 @@ CachedRemesh remeshCached(const TriMesh& mesh, const RemeshOptions& options, con
     std::filesystem::create_directories(directory, error);
     out.problem = error ? "could not create the remesh cache directory " + directory.string() + " (" + error.message() + ")"
                         : writeAtomically(file, serialise(key, out.result));
+    if (!out.problem.empty()) return out;
+    const RemeshCacheLimit limit = defaultRemeshCacheLimit();
+    out.problem = limit.problem;
+    if (limit.bytes > 0) trimRemeshCache(directory, limit.bytes, file);
     return out;
 }
 

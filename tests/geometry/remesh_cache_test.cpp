@@ -2,7 +2,8 @@
 // a hit gives the same surface and report bit for bit; a changed vertex or option misses; a
 // damaged file is remeshed and written again; a directory that cannot be written is reported
 // and the surface still made; concurrent writers leave one whole file; bad options throw and
-// write nothing; the default directory follows the environment.
+// write nothing; the default directory follows the environment. Trimming, against ages and
+// sizes set by hand: the least recently used surfaces go first, others' files stay.
 #include "flexfit/generators.hpp"
 #include "flexfit/core.hpp"
 #include "flexfit/remesh_cache.hpp"
@@ -10,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -222,6 +224,83 @@ TEST(RemeshCache, DefaultDirectoryFollowsTheEnvironment) {
     EXPECT_EQ(defaultRemeshCacheDirectory(), std::filesystem::path("/home/user/.cache/flexfit/remesh"));
     ScopedVariable noHome("HOME", nullptr);
     EXPECT_EQ(defaultRemeshCacheDirectory(), std::filesystem::path());
+}
+
+// Files of given sizes and ages (seconds before now) in `dir`.
+void writeAged(const std::filesystem::path& file, std::size_t bytes, int secondsOld) {
+    overwrite(file, std::string(bytes, 'x'));
+    std::filesystem::last_write_time(file, std::filesystem::file_time_type::clock::now() - std::chrono::seconds(secondsOld));
+}
+
+TEST(RemeshCache, TrimmingRemovesTheLeastRecentlyUsedSurfacesFirst) {
+    TempDir dir;
+    const std::filesystem::path a = dir.path() / "a.remesh", b = dir.path() / "b.remesh", c = dir.path() / "c.remesh";
+    writeAged(a, 100, 300);
+    writeAged(b, 100, 200);
+    writeAged(c, 100, 100);
+    writeAged(dir.path() / "notes.txt", 1000, 400);                    // not a surface
+    writeAged(dir.path() / "d.remesh.tmp.12.34.0", 1000, 400);         // another writer's, unfinished
+    // 300 bytes of surfaces: at most 250 removes the oldest only.
+    EXPECT_EQ(trimRemeshCache(dir.path(), 250), 1u);
+    EXPECT_FALSE(std::filesystem::exists(a));
+    EXPECT_TRUE(std::filesystem::exists(b) && std::filesystem::exists(c));
+    EXPECT_EQ(trimRemeshCache(dir.path(), 200), 0u);  // within the limit: nothing
+    // Below one file: all but the kept one go, oldest first, and the kept one stays above it.
+    EXPECT_EQ(trimRemeshCache(dir.path(), 50, b), 1u);
+    EXPECT_TRUE(std::filesystem::exists(b));
+    EXPECT_FALSE(std::filesystem::exists(c));
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / "notes.txt") && std::filesystem::exists(dir.path() / "d.remesh.tmp.12.34.0"));
+    EXPECT_EQ(trimRemeshCache(dir.path() / "absent", 0), 0u);
+}
+
+TEST(RemeshCache, AHitRenewsItsFileAndAWriteTrimsTheOthersToTheLimit) {
+    TempDir dir;
+    const std::filesystem::path cache = dir.path() / "cache";
+    ScopedVariable unlimited("FLEXFIT_CACHE_MAX", "0");
+    ASSERT_TRUE(remeshCached(cacheInput(), cacheOptions(), "box", cache).problem.empty());
+    const std::vector<std::filesystem::path> first = filesIn(cache);
+    ASSERT_EQ(first.size(), 1u);
+    const auto old = std::filesystem::file_time_type::clock::now() - std::chrono::hours(24);
+    std::filesystem::last_write_time(first[0], old);
+    ASSERT_TRUE(remeshCached(cacheInput(), cacheOptions(), "box", cache).hit);
+    EXPECT_GT(std::filesystem::last_write_time(first[0]), old);
+    // Another surface under a one-byte limit: the first goes, the new one stays.
+    ScopedVariable tiny("FLEXFIT_CACHE_MAX", "1");
+    RemeshOptions other = cacheOptions();
+    other.targetEdge = 0.35;
+    const CachedRemesh second = remeshCached(cacheInput(), other, "box", cache);
+    EXPECT_FALSE(second.hit);
+    EXPECT_TRUE(second.problem.empty()) << second.problem;
+    const std::vector<std::filesystem::path> left = filesIn(cache);
+    ASSERT_EQ(left.size(), 1u);
+    EXPECT_NE(left[0], first[0]);
+    EXPECT_TRUE(remeshCached(cacheInput(), other, "box", cache).hit);
+}
+
+TEST(RemeshCache, TheLimitFollowsTheEnvironment) {
+    {
+        ScopedVariable unset("FLEXFIT_CACHE_MAX", nullptr);
+        EXPECT_EQ(defaultRemeshCacheLimit().bytes, std::uintmax_t(2) << 30);
+    }
+    for (const auto& [text, bytes] : {std::pair{"12345", std::uintmax_t(12345)}, std::pair{"64k", std::uintmax_t(65536)},
+                                      std::pair{"100M", std::uintmax_t(100) << 20}, std::pair{"3G", std::uintmax_t(3) << 30},
+                                      std::pair{"0", std::uintmax_t(0)}}) {
+        ScopedVariable limit("FLEXFIT_CACHE_MAX", text);
+        EXPECT_EQ(defaultRemeshCacheLimit().bytes, bytes) << text;
+        EXPECT_TRUE(defaultRemeshCacheLimit().problem.empty()) << text;
+    }
+    for (const char* bad : {"", "12x", "1.5G", "-1", "G", "10 M", "99999999999999999999"}) {
+        ScopedVariable limit("FLEXFIT_CACHE_MAX", bad);
+        const RemeshCacheLimit read = defaultRemeshCacheLimit();
+        EXPECT_EQ(read.bytes, std::uintmax_t(2) << 30) << bad;
+        EXPECT_EQ(read.problem, std::string("FLEXFIT_CACHE_MAX: '") + bad + "' is not a size (bytes, or a number with K, M or G); the cache keeps 2G");
+    }
+    // A write under a bad limit says so (a scene shows it as a warning) and still caches.
+    TempDir dir;
+    ScopedVariable limit("FLEXFIT_CACHE_MAX", "lots");
+    const CachedRemesh written = remeshCached(cacheInput(), cacheOptions(), "box", dir.path());
+    EXPECT_NE(written.problem.find("FLEXFIT_CACHE_MAX: 'lots' is not a size"), std::string::npos) << written.problem;
+    EXPECT_EQ(filesIn(dir.path()).size(), 1u);
 }
 
 }  // namespace
