@@ -62,8 +62,8 @@ def sweep(path, out, scheduler=None, workers=2, table=True, strict=False, remesh
 
     path = str(pathlib.Path(path).resolve())
     out = str(pathlib.Path(out).resolve())
-    # A relative cache directory is the client's, whatever a worker's working directory is.
-    cache = None if remesh_cache is None else str(remesh_cache) and str(pathlib.Path(remesh_cache).resolve())
+    # A relative cache directory is the client's, whatever a worker's working directory is ("" is off).
+    cache = remesh_cache if remesh_cache in (None, "") else str(pathlib.Path(remesh_cache).resolve())
     read = (bool(strict), cache)
     s = _flexfit.load_sweep(path, strict=read[0], remesh_cache=read[1])
     os.makedirs(out, exist_ok=True)

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <optional>
 #include <random>
 #include <span>
@@ -214,7 +215,7 @@ std::optional<std::uintmax_t> parseSize(std::string_view text) {
     if (digits == text.size()) return value;
     const char suffix = char(std::toupper(static_cast<unsigned char>(text[digits])));
     const int shift = suffix == 'K' ? 10 : suffix == 'M' ? 20 : suffix == 'G' ? 30 : -1;
-    if (shift < 0) return std::nullopt;
+    if (shift < 0 || value > (std::numeric_limits<std::uintmax_t>::max() >> shift)) return std::nullopt;
     return value << shift;
 }
 

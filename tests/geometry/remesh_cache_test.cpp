@@ -284,12 +284,12 @@ TEST(RemeshCache, TheLimitFollowsTheEnvironment) {
     }
     for (const auto& [text, bytes] : {std::pair{"12345", std::uintmax_t(12345)}, std::pair{"64k", std::uintmax_t(65536)},
                                       std::pair{"100M", std::uintmax_t(100) << 20}, std::pair{"3G", std::uintmax_t(3) << 30},
-                                      std::pair{"0", std::uintmax_t(0)}}) {
+                                      std::pair{"0", std::uintmax_t(0)}, std::pair{"999999999999999", std::uintmax_t(999999999999999)}}) {
         ScopedVariable limit("FLEXFIT_CACHE_MAX", text);
         EXPECT_EQ(defaultRemeshCacheLimit().bytes, bytes) << text;
         EXPECT_TRUE(defaultRemeshCacheLimit().problem.empty()) << text;
     }
-    for (const char* bad : {"", "12x", "1.5G", "-1", "G", "10 M", "99999999999999999999"}) {
+    for (const char* bad : {"", "12x", "1.5G", "-1", "G", "10 M", "9999999999999999", "999999999999999G"}) {
         ScopedVariable limit("FLEXFIT_CACHE_MAX", bad);
         const RemeshCacheLimit read = defaultRemeshCacheLimit();
         EXPECT_EQ(read.bytes, std::uintmax_t(2) << 30) << bad;
