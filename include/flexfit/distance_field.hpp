@@ -21,7 +21,8 @@
 // the ball-torus haptic scene filled 17,800 nodes while in contact, 2 to 3 us each, the worst
 // of its step times; with six, 2,900, for 47,000 more at build; 568 on 2026-12-04, about
 // 1.4 us each, at most 18 in one step); nodes further away the first time they are read
-// (deterministic: a value depends only on the node's position).
+// (deterministic: a value depends only on the node's position, so the band is computed on
+// every usable core, core/parallel.hpp, and is the same grid on any number of them).
 //
 // clearOf(centre, radius): node values are 1-Lipschitz, so each partial derivative of the
 // interpolant is at most 1 and its gradient at most sqrt(3): no point of the ball has a
@@ -44,6 +45,7 @@
 #include "flexfit/topology.hpp"
 
 #include <array>
+#include <cstdint>
 #include <span>
 #include <utility>
 #include <vector>
@@ -98,6 +100,11 @@ public:
         return reach > 0.0 ? reach * reach : -1.0;
     }
     double cellSize() const { return fine_.cell; }
+    // Nodes of the fine grid computed so far (the band at build, more as samples reach them).
+    std::size_t computedNodes() const;
+    // 64-bit FNV-1a of both grids' node values, bit for bit (a node not computed yet is NaN):
+    // equal hashes, the same field so far.
+    std::uint64_t gridHash() const;
 
 private:
     // Node (i, j, k) at box.min + cell (i, j, k); values NaN until computed.
@@ -114,6 +121,7 @@ private:
     void setUpGrid(Grid& grid, double cell, std::size_t maxNodes) const;
     void fill(Grid& grid, int i, int j, int k) const;
     void fillBand(Grid& grid, int cells) const;
+    void fillNodes(Grid& grid, std::span<const std::size_t> nodes) const;
     Interpolated sample(Grid& grid, const Vec3& p) const;
     // p clamped into the grid's box, and how far p is from it.
     static std::pair<Vec3, double> clampedInto(const Grid& grid, const Vec3& p);

@@ -3,6 +3,7 @@
 // stay in this file and do not reach the step kernels.
 #include "flexfit/remesh.hpp"
 #include "flexfit/mesh_repair.hpp"
+#include "core/parallel.hpp"
 #include "geometry/remesh_samples.hpp"
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
@@ -21,24 +22,18 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <set>
 #include <sstream>
-#include <thread>
 #include <vector>
-
-#if defined(__linux__)
-#include <sched.h>
-#endif
 
 namespace flexfit {
 namespace {
+
+using detail::forChunks;
 
 namespace PMP = CGAL::Polygon_mesh_processing;
 
@@ -60,43 +55,6 @@ void buildForQueries(FaceTree& tree) {
     tree.build();
     tree.accelerate_distance_queries();
     if (!tree.empty()) tree.closest_point(CGAL::ORIGIN);  // the search tree is built at its first search
-}
-
-// The cores this process may run on (its affinity mask on Linux: a container or `taskset`
-// limits it below the machine's count).
-unsigned usableCores() {
-#if defined(__linux__)
-    cpu_set_t set;
-    if (sched_getaffinity(0, sizeof set, &set) == 0) return unsigned(std::max(1, CPU_COUNT(&set)));
-#endif
-    return std::max(1u, std::thread::hardware_concurrency());
-}
-
-// Runs body(begin, end) over [0, n) in chunks of `chunk` on the usable cores. A chunk's
-// result must not depend on which thread runs it, so the outcome is the same on any machine.
-// The first exception a chunk throws is rethrown here once every thread has stopped.
-template <class Body>
-void forChunks(std::size_t n, std::size_t chunk, Body body) {
-    const std::size_t chunks = (n + chunk - 1) / chunk;
-    const std::size_t threads = std::min<std::size_t>(chunks, usableCores());
-    std::atomic<std::size_t> next{0};
-    std::exception_ptr failure;
-    std::mutex failureLock;
-    auto work = [&] {
-        try {
-            for (std::size_t c; (c = next.fetch_add(1)) < chunks;) body(c * chunk, std::min(n, (c + 1) * chunk));
-        } catch (...) {
-            next = chunks;  // the others stop after their chunk
-            const std::lock_guard lock(failureLock);
-            if (!failure) failure = std::current_exception();
-        }
-    };
-    {
-        std::vector<std::jthread> helpers;
-        for (std::size_t t = 1; t < threads; ++t) helpers.emplace_back(work);
-        work();
-    }
-    if (failure) std::rethrow_exception(failure);
 }
 
 Vec3 toVec3(const Point& p) { return {p.x(), p.y(), p.z()}; }

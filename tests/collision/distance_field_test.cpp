@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "one_core.hpp"
 #include "unit_cube.hpp"
 
 #include <bit>
@@ -259,3 +260,22 @@ TEST(SignedDistanceField, SampleManyScalarPathEqualsSample) {
     ASSERT_FALSE(detail::vectorSamplingEnabled());
     expectSampleManyEqualsSample();
 }
+
+#if defined(__linux__)
+// The band and the coarse grid are computed on every usable core, in fixed chunks: pinned to
+// one core, the same grids bit for bit, the band computed when the field is built.
+TEST(SignedDistanceField, OneCoreBuildsTheSameFieldAsAll) {
+    const TriMesh mesh = makeIcoSphere(8.5, 3);
+    const SignedDistanceField all = fieldOf(mesh, 0.4);
+    const SignedDistanceField single = flexfit::testing::onOneCore([&] { return fieldOf(mesh, 0.4); });
+    EXPECT_GT(all.computedNodes(), std::size_t(4 * 4096));  // several chunks
+    EXPECT_EQ(single.computedNodes(), all.computedNodes());
+    EXPECT_EQ(single.gridHash(), all.gridHash());
+    // A sample away from the band computes its corners, which changes the hash.
+    const std::uint64_t built = all.gridHash();
+    (void)all.sample(Vec3(0.0, 0.0, 0.0));
+    EXPECT_GT(all.computedNodes(), single.computedNodes());
+    EXPECT_NE(all.gridHash(), built);
+}
+#endif
+

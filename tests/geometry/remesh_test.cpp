@@ -17,9 +17,7 @@
 #include <map>
 #include <vector>
 
-#if defined(__linux__)
-#include <sched.h>
-#endif
+#include "one_core.hpp"
 
 namespace flexfit {
 namespace {
@@ -191,17 +189,7 @@ TEST(Remesh, OneCoreMakesTheSameSurfaceAsAll) {
     const TriMesh input = sliverBox(Vec3(1.0, 0.7, 0.5), 8);
     const RemeshOptions options{.targetEdge = 0.1};
     const RemeshResult all = remeshForSimulation(input, options, "box");
-    cpu_set_t before, one;
-    ASSERT_EQ(sched_getaffinity(0, sizeof before, &before), 0);
-    CPU_ZERO(&one);
-    for (int c = 0; c < CPU_SETSIZE; ++c)
-        if (CPU_ISSET(c, &before)) {
-            CPU_SET(c, &one);
-            break;
-        }
-    ASSERT_EQ(sched_setaffinity(0, sizeof one, &one), 0);
-    const RemeshResult single = remeshForSimulation(input, options, "box");
-    ASSERT_EQ(sched_setaffinity(0, sizeof before, &before), 0);
+    const RemeshResult single = flexfit::testing::onOneCore([&] { return remeshForSimulation(input, options, "box"); });
     EXPECT_GT(all.mesh.vertices.size(), 1024u);  // more than one chunk of vertices, and of samples
     EXPECT_EQ(single.mesh.vertices, all.mesh.vertices);
     EXPECT_EQ(single.mesh.faces, all.mesh.faces);
