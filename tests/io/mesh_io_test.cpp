@@ -377,7 +377,8 @@ TEST(MeshIo, StlIsNumberedByItsWeldedVertices) {
 
 
 // ---------------------------------------------------------------------------------------------
-// Fuzz: mutations of valid OBJ, OFF and PLY files (ASCII and binary) either read to a valid mesh
+// Fuzz: mutations of valid OBJ, OFF, PLY and STL files (ASCII and binary; STL through assimp)
+// either read to a valid mesh
 // (validateMesh passes again, every coordinate finite) or throw InputError with a problem;
 // nothing else may escape, and the sanitizer build checks that nothing reads out of bounds.
 
@@ -393,6 +394,32 @@ std::string binaryPlyTetrahedron() {
     return out;
 }
 
+// The same tetrahedron as an ASCII STL (one vertex per face corner) and a binary one (float
+// corners, a zero normal and attribute count per face), which assimp reads and readMesh welds.
+std::string asciiStlTetrahedron() {
+    return "solid tet\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\n"
+           "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
+           "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 1\nvertex 0 1 0\nendloop\nendfacet\n"
+           "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 0 1\nendloop\nendfacet\nendsolid tet\n";
+}
+
+std::string binaryStlTetrahedron() {
+    std::string out(80, ' ');
+    const auto append = [&](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
+    const std::uint32_t count = 4;
+    append(&count, sizeof count);
+    const float corners[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const int faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    const float normal[3] = {0, 0, 0};
+    const std::uint16_t attributes = 0;
+    for (const auto& f : faces) {
+        append(normal, sizeof normal);
+        for (int v : f) append(corners[v], sizeof corners[v]);
+        append(&attributes, sizeof attributes);
+    }
+    return out;
+}
+
 // 1 when read, 0 when refused with InputError; a test failure otherwise.
 int readOrReject(const fs::path& file, bool repair, const std::string& label) {
     return flexfit::testing::readOrRefused([&] {
@@ -405,7 +432,7 @@ int readOrReject(const fs::path& file, bool repair, const std::string& label) {
     }, label);
 }
 
-TEST(MeshIoFuzz, MutationsOfValidObjOffAndPlyFiles) {
+TEST(MeshIoFuzz, MutationsOfValidObjOffPlyAndStlFiles) {
     const std::string obj = "# tet\no tet\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nvt 0 0\n"
                             "f 1/1/1 3/1/1 2/1/1\nf 1//1 2//1 4//1\nf -4 -1 -2\nf 2 3 4\n";
     const std::string quadObj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
@@ -414,10 +441,11 @@ TEST(MeshIoFuzz, MutationsOfValidObjOffAndPlyFiles) {
     const std::string ply = "ply\nformat ascii 1.0\ncomment tet\nelement vertex 4\nproperty float x\nproperty float y\n"
                             "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
                             "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
-    const std::string interesting = "0123456789 -+./\n\r\tenaifvpOF";
+    const std::string interesting = "0123456789 -+./\n\r\tenaifvpOFsoldtcrx";
     const struct {
         std::string name, text;
-    } seeds[] = {{"tet.obj", obj}, {"box.obj", quadObj}, {"tet.off", off}, {"tet.ply", ply}, {"binary.ply", binaryPlyTetrahedron()}};
+    } seeds[] = {{"tet.obj", obj},      {"box.obj", quadObj}, {"tet.off", off}, {"tet.ply", ply}, {"binary.ply", binaryPlyTetrahedron()},
+                 {"tet.stl", asciiStlTetrahedron()}, {"binary.stl", binaryStlTetrahedron()}};
     TempDir dir;
     std::mt19937 rng(20261206u);
     for (const auto& seed : seeds) {
