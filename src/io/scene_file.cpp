@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -629,6 +630,30 @@ AssemblyRule detail::readAssemblyTable(const toml::table& table, const std::stri
     return readAssembly(t, scene);
 }
 
+// The restoration constraint's default fraction (1e-3) is per step and was chosen for 1 ms
+// steps: at another step a deforming part restores 1 ms / h times as fast and resists loads
+// about (1 ms / h)^2 times as stiffly (k ~ c m / h^2, simulation.hpp), which a user moving a
+// scene to a haptic rate does not expect. Said where the fraction is the default; a fraction
+// or a rate the scene gives is its choice.
+void warnOfPerStepRestoration(const Table& t, const ScenePart& p, Scene& scene) {
+    const RestorationSettings& r = p.part.simulation.restoration;
+    const double h = scene.world.timeStep, ratio = 1e-3 / h;
+    if (p.part.mode == PartMode::Rigid || r.method != RestorationMethod::Constraint || t.has("constraint_fraction") ||
+        t.has("constraint_rate") || std::abs(ratio - 1.0) < 1e-9)
+        return;
+    const auto shortly = [](double x) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.3g", x);
+        return std::string(text);
+    };
+    scene.warnings.push_back(
+        {t.line("restoration"),
+         t.what() + ": the restoration constraint's default fraction 0.001 is per step, chosen for 1 ms steps: at time_step = " +
+             shortly(h) + " the part restores " + shortly(ratio) + " times as fast and resists loads about " + shortly(ratio * ratio) +
+             " times as stiffly; constraint_rate = 0.5 (1/s) keeps the 1 ms restoration time, restoration = \"anchors\" a stiffness "
+             "independent of the step"});
+}
+
 Scene detail::readSceneDocument(const toml::table& document, const std::string& source, const std::filesystem::path& baseDirectory,
                                 const SceneReadOptions& options) {
     Scene scene;
@@ -639,6 +664,7 @@ Scene detail::readSceneDocument(const toml::table& document, const std::string& 
         Table part(*t, "part " + std::to_string(scene.parts.size() + 1), scene.source, scene.warnings);
         ScenePart p = readPart(part, baseDirectory, options, scene.warnings);
         if (scene.find(p.name)) part.fail(*t->get("name"), "name", "duplicate part name '" + p.name + "'");
+        warnOfPerStepRestoration(part, p, scene);
         scene.parts.push_back(std::move(p));
     }
     if (scene.parts.empty()) root.fail("no [[part]]: a scene needs at least one part");

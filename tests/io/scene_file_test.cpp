@@ -237,6 +237,33 @@ TEST(SceneFile, OldSpellingsAreReadWithAWarningNamingTheNewOne) {
     EXPECT_TRUE(parseScene(kBall, "scene.toml", ".").warnings.empty());
 }
 
+// The restoration constraint's default fraction is per step (chosen for 1 ms): a deforming
+// part that takes it at another time step is warned of, at its restoration line or its table,
+// with the factors (1 ms / h and its square); a fraction or rate the scene gives, anchors, a
+// rigid part or a 1 ms step are not.
+TEST(SceneFile, TheDefaultPerStepRestorationAtAnotherTimeStepIsWarnedOf) {
+    const auto scene = [](const std::string& world, const std::string& part) {
+        return parseScene("[world]\n" + world + "\n[[part]]\nname = \"torus\"\n"
+                          "generator = { type = \"torus\", major = 10, minor = 2.5, u = 12, v = 8 }\n" + part,
+                          "scene.toml", ".");
+    };
+    const Scene fast = scene("time_step = 0.0002", "");
+    ASSERT_EQ(fast.warnings.size(), 1u);
+    EXPECT_EQ(fast.warnings[0].line, 3u);
+    EXPECT_EQ(fast.warnings[0].message,
+              "part 1: the restoration constraint's default fraction 0.001 is per step, chosen for 1 ms steps: at time_step = 0.0002 "
+              "the part restores 5 times as fast and resists loads about 25 times as stiffly; constraint_rate = 0.5 (1/s) keeps the "
+              "1 ms restoration time, restoration = \"anchors\" a stiffness independent of the step");
+    const Scene slow = scene("time_step = 0.002", "mode = \"full-deformable\"\nrestoration = \"constraint\"\n");
+    ASSERT_EQ(slow.warnings.size(), 1u);
+    EXPECT_EQ(slow.warnings[0].line, 7u);
+    EXPECT_NE(slow.warnings[0].message.find("restores 0.5 times as fast and resists loads about 0.25 times"), std::string::npos);
+    for (const std::string& chosen : {std::string("constraint_fraction = 0.001\n"), std::string("constraint_rate = 0.5\n"),
+                                      std::string("restoration = \"anchors\"\n"), std::string("mode = \"rigid\"\n")})
+        EXPECT_TRUE(scene("time_step = 0.0002", chosen).warnings.empty()) << chosen;
+    EXPECT_TRUE(scene("time_step = 0.001", "").warnings.empty());
+}
+
 // --- Contact materials, the contact solver's settings and the box and plate generators. ---
 
 namespace {

@@ -235,7 +235,7 @@ TEST(Sweep, ReadOptionsReachEveryRunsScene) {
     dir.write("tet.tri", "tet\n5 4\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n5 5 5\n0 2 1\n0 1 3\n0 3 2\n1 2 3\n");
     const std::string scene = "[world]\ntime_step = 0.001\nduration = 0.01\n[[part]]\nname = \"tet\"\nmesh = \"tet.tri\"\nremesh = 0.2\n";
     dir.write("scene.toml", scene);
-    const auto sweepFile = dir.write("sweep.toml", "scene = \"scene.toml\"\n[[parameter]]\nname = \"dt\"\nkey = \"world.time_step\"\nvalues = [0.001, 0.002]\n");
+    const auto sweepFile = dir.write("sweep.toml", "scene = \"scene.toml\"\n[[parameter]]\nname = \"damping\"\nkey = \"part.tet.global_damping\"\nvalues = [0.0, 0.1]\n");
     const std::filesystem::path cache = dir.path() / "cache";
     SceneReadOptions read;
     read.remeshCache = cache;
