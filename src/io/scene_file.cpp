@@ -630,14 +630,17 @@ AssemblyRule detail::readAssemblyTable(const toml::table& table, const std::stri
     return readAssembly(t, scene);
 }
 
-// The restoration constraint's default fraction (1e-3) is per step and was chosen for 1 ms
-// steps: at another step a deforming part restores 1 ms / h times as fast and resists loads
-// about (1 ms / h)^2 times as stiffly (k ~ c m / h^2, simulation.hpp), which a user moving a
-// scene to a haptic rate does not expect. Said where the fraction is the default; a fraction
-// or a rate the scene gives is its choice.
+namespace {
+
+// The restoration constraint's default fraction is per step and was chosen for the default
+// 1 ms step: at another step h a deforming part restores (1 ms / h) times as fast and resists
+// loads about (1 ms / h)^2 times as stiffly (k ~ c m / h^2, simulation.hpp), which a user
+// moving a scene to a haptic rate does not expect. Said where the fraction is the default; a
+// fraction or a rate the scene gives is its choice.
 void warnOfPerStepRestoration(const Table& t, const ScenePart& p, Scene& scene) {
     const RestorationSettings& r = p.part.simulation.restoration;
-    const double h = scene.world.timeStep, ratio = 1e-3 / h;
+    const double chosenFor = WorldSettings{}.timeStep, fraction = RestorationSettings{}.constraintFraction;
+    const double h = scene.world.timeStep, ratio = chosenFor / h;
     if (p.part.mode == PartMode::Rigid || r.method != RestorationMethod::Constraint || t.has("constraint_fraction") ||
         t.has("constraint_rate") || std::abs(ratio - 1.0) < 1e-9)
         return;
@@ -646,13 +649,15 @@ void warnOfPerStepRestoration(const Table& t, const ScenePart& p, Scene& scene) 
         std::snprintf(text, sizeof text, "%.3g", x);
         return std::string(text);
     };
-    scene.warnings.push_back(
-        {t.line("restoration"),
-         t.what() + ": the restoration constraint's default fraction 0.001 is per step, chosen for 1 ms steps: at time_step = " +
-             shortly(h) + " the part restores " + shortly(ratio) + " times as fast and resists loads about " + shortly(ratio * ratio) +
-             " times as stiffly; constraint_rate = 0.5 (1/s) keeps the 1 ms restoration time, restoration = \"anchors\" a stiffness "
-             "independent of the step"});
+    const double rate = -std::log1p(-fraction) / (2.0 * chosenFor);  // the same restoration time at any step
+    scene.warnings.push_back({t.line("restoration"), t.what() + ": the restoration constraint's default fraction " + shortly(fraction) +
+                                                         " is per step, chosen for " + shortly(1e3 * chosenFor) + " ms steps: at time_step = " +
+                                                         shortly(h) + " the part restores " + shortly(ratio) + " times as fast and resists loads about " +
+                                                         shortly(ratio * ratio) + " times as stiffly; constraint_rate = " + shortly(rate) +
+                                                         " (1/s) keeps the restoration time, restoration = \"anchors\" a stiffness independent of the step"});
 }
+
+}  // namespace
 
 Scene detail::readSceneDocument(const toml::table& document, const std::string& source, const std::filesystem::path& baseDirectory,
                                 const SceneReadOptions& options) {

@@ -253,7 +253,7 @@ TEST(SceneFile, TheDefaultPerStepRestorationAtAnotherTimeStepIsWarnedOf) {
     EXPECT_EQ(fast.warnings[0].message,
               "part 1: the restoration constraint's default fraction 0.001 is per step, chosen for 1 ms steps: at time_step = 0.0002 "
               "the part restores 5 times as fast and resists loads about 25 times as stiffly; constraint_rate = 0.5 (1/s) keeps the "
-              "1 ms restoration time, restoration = \"anchors\" a stiffness independent of the step");
+              "restoration time, restoration = \"anchors\" a stiffness independent of the step");
     const Scene slow = scene("time_step = 0.002", "mode = \"full-deformable\"\nrestoration = \"constraint\"\n");
     ASSERT_EQ(slow.warnings.size(), 1u);
     EXPECT_EQ(slow.warnings[0].line, 7u);
