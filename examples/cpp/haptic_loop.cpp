@@ -75,17 +75,19 @@ double percentile(std::vector<double> values, double q) {
     return values[std::min(values.size() - 1, std::size_t(q * double(values.size())))];
 }
 
-}  // namespace
+// The device's world: the container mouth and the ball, the ball in the operator's hand.
+struct DeviceWorld {
+    flexfit::World world;
+    flexfit::BodyId mouth = 0, ball = 0;
+};
 
-int main(int argc, char** argv) {
+DeviceWorld buildWorld(double rate) {
     using namespace flexfit;
-    const Options options = parse(argc, argv);
-
-    // The world: no gravity (the hand carries the ball), one step per device tick.
+    // No gravity (the hand carries the ball), one step per device tick.
     WorldSettings settings;
-    settings.timeStep = 1.0 / options.rate;
+    settings.timeStep = 1.0 / rate;
     settings.gravity = Vec3::Zero();
-    World world(settings);
+    DeviceWorld d{World(settings)};
 
     // The container mouth: static, rigid until the ball presses it, then deformed in zones
     // around the contacts (3 rings of neighbours), restored once released by anchor springs
@@ -100,9 +102,9 @@ int main(int argc, char** argv) {
     rim.simulation.restoration.anchorDamping = 63.0;
     BodySettings fixed;
     fixed.motion = MotionType::Static;
-    const BodyId mouth = world.add(buildPartModel(makeContainerMouth()), rim, fixed, Pose{});
+    d.mouth = d.world.add(buildPartModel(makeContainerMouth()), rim, fixed, Pose{});
 
-    // The ball: rigid, dynamic, 8 in radius (wider than the opening's 7.5: it must deform it).
+    // The ball: rigid, dynamic, radius 8 (wider than the opening's 7.5: it must deform it).
     PartSettings solid;
     solid.mode = PartMode::Rigid;
     BodySettings dynamic;
@@ -110,47 +112,66 @@ int main(int argc, char** argv) {
     dynamic.density = 0.01;
     Pose start;
     start.translation = Vec3(0.0, handHeight(0.0), 0.0);
-    const BodyId ball = world.add(buildPartModel(makeIcoSphere(8.0, 2)), solid, dynamic, start);
+    d.ball = d.world.add(buildPartModel(makeIcoSphere(8.0, 2)), solid, dynamic, start);
 
     GrabSettings hand;
     hand.frequency = 10.0;  // the coupling's spring-damper, critically damped at 10 Hz
-    world.grab(ball, hand);
-    world.prepare();
+    d.world.grab(d.ball, hand);
+    d.world.prepare();  // the first step then costs what the next ones do
+    return d;
+}
 
+// What the loop saw.
+struct LoopRecord {
+    std::vector<double> stepMicros;
+    long misses = 0;
+    double largestForce = 0.0, lowestBall = 0.0, wallSeconds = 0.0;
+};
+
+// One world step per tick for options.seconds, printing a line every quarter second.
+LoopRecord runLoop(DeviceWorld& d, const Options& options) {
+    using namespace flexfit;
     const long steps = std::lround(options.seconds * options.rate);
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / options.rate));
-    std::vector<double> stepMicros;
-    stepMicros.reserve(std::size_t(steps));
-    long misses = 0;
-    double largestForce = 0.0, lowestBall = start.translation.y();
+    LoopRecord r;
+    r.stepMicros.reserve(std::size_t(steps));
+    r.lowestBall = d.world.centreOfMass(d.ball).y();
     std::printf("%8s %9s %9s %13s %14s %9s\n", "t (s)", "hand y", "ball y", "device fy (N)", "moving masses", "step us");
     const Clock::time_point loopStart = Clock::now();
     for (long k = 0; k < steps; ++k) {
-        const double t = double(k) / options.rate;  // at this tick's start
         Pose target;
-        target.translation = Vec3(0.0, handHeight(t), 0.0);
-        world.setGrabTarget(target);  // where the device's hand is at this tick
+        target.translation = Vec3(0.0, handHeight(double(k) / options.rate), 0.0);
+        d.world.setGrabTarget(target);  // where the device's hand is at this tick's start
         const Clock::time_point before = Clock::now();
-        world.step();
+        d.world.step();
         const Clock::time_point after = Clock::now();
-        const Vec3 deviceForce = -world.coupling().force;  // what the operator feels
-        stepMicros.push_back(std::chrono::duration<double, std::micro>(after - before).count());
-        largestForce = std::max(largestForce, deviceForce.norm());
-        lowestBall = std::min(lowestBall, world.centreOfMass(ball).y());
+        const Vec3 deviceForce = -d.world.coupling().force;  // what the operator feels
+        r.stepMicros.push_back(std::chrono::duration<double, std::micro>(after - before).count());
+        r.largestForce = std::max(r.largestForce, deviceForce.norm());
+        r.lowestBall = std::min(r.lowestBall, d.world.centreOfMass(d.ball).y());
         if ((k + 1) % std::max(1L, std::lround(options.rate / 4.0)) == 0)
-            std::printf("%8.3f %9.3f %9.3f %13.1f %14zu %9.1f\n", world.time(), target.translation.y(), world.centreOfMass(ball).y(),
-                        deviceForce.y(), world.part(mouth).movingMasses().size(), stepMicros.back());
+            std::printf("%8.3f %9.3f %9.3f %13.1f %14zu %9.1f\n", d.world.time(), target.translation.y(), d.world.centreOfMass(d.ball).y(),
+                        deviceForce.y(), d.world.part(d.mouth).movingMasses().size(), r.stepMicros.back());
         if (options.freeRunning) continue;
         const Clock::time_point deadline = loopStart + (k + 1) * period;
-        if (after > deadline) ++misses;
+        if (after > deadline) ++r.misses;
         else waitUntil(deadline);
     }
-    const double wall = std::chrono::duration<double>(Clock::now() - loopStart).count();
-    std::printf("%ld steps at %.0f Hz in %.3f s wall%s; step p50 %.1f us, p99 %.1f us, max %.1f us; deadline misses %ld\n",
-                steps, options.rate, wall, options.freeRunning ? " (free running)" : "", percentile(stepMicros, 0.5),
-                percentile(stepMicros, 0.99), percentile(stepMicros, 1.0), options.freeRunning ? 0L : misses);
+    r.wallSeconds = std::chrono::duration<double>(Clock::now() - loopStart).count();
+    return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Options options = parse(argc, argv);
+    DeviceWorld d = buildWorld(options.rate);
+    const LoopRecord r = runLoop(d, options);
+    std::printf("%zu steps at %.0f Hz in %.3f s wall%s; step p50 %.1f us, p99 %.1f us, max %.1f us; deadline misses %ld\n",
+                r.stepMicros.size(), options.rate, r.wallSeconds, options.freeRunning ? " (free running)" : "",
+                percentile(r.stepMicros, 0.5), percentile(r.stepMicros, 0.99), percentile(r.stepMicros, 1.0), r.misses);
     std::printf("largest device force %.3f N; ball lowest at y = %.6f, now %.6f; rim moving masses %zu; state hash %016llx\n",
-                largestForce, lowestBall, world.centreOfMass(ball).y(), world.part(mouth).movingMasses().size(),
-                static_cast<unsigned long long>(world.stateHash()));
+                r.largestForce, r.lowestBall, d.world.centreOfMass(d.ball).y(), d.world.part(d.mouth).movingMasses().size(),
+                static_cast<unsigned long long>(d.world.stateHash()));
     return 0;
 }
