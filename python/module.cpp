@@ -160,6 +160,13 @@ TriMesh meshFromArrays(py::array_t<double, py::array::c_style | py::array::force
     return mesh;
 }
 
+// Scene warnings as Python sees them: their messages (a scene's file and lines are its own).
+std::vector<std::string> messagesOf(const std::vector<SceneWarning>& warnings) {
+    std::vector<std::string> out;
+    for (const SceneWarning& w : warnings) out.push_back(w.message);
+    return out;
+}
+
 // load_scene's and run_scene's keywords: remesh_cache None is the default directory, "" none.
 SceneReadOptions sceneReadOptions(bool strict, std::optional<std::filesystem::path> remeshCache) {
     SceneReadOptions options;
@@ -626,11 +633,7 @@ PYBIND11_MODULE(_flexfit, m) {
             return names;
         }, "Part names in body-id order.")
         .def_property_readonly("time_step", [](const Scene& s) { return s.world.timeStep; }, "The world's time step (s).")
-        .def_property_readonly("warnings", [](const Scene& s) {
-            std::vector<std::string> out;
-            for (const SceneWarning& w : s.warnings) out.push_back(w.message);
-            return out;
-        }, "The scene's warnings (old spellings, mesh repairs).");
+        .def_property_readonly("warnings", [](const Scene& s) { return messagesOf(s.warnings); }, "The scene's warnings (old spellings, mesh repairs).");
     m.def("load_scene", [](const std::filesystem::path& path, bool strict, std::optional<std::filesystem::path> remeshCache) {
         py::gil_scoped_release release;  // a scene's meshes may be remeshed and their fields built: seconds
         return loadScene(path, sceneReadOptions(strict, std::move(remeshCache)));
@@ -697,6 +700,7 @@ PYBIND11_MODULE(_flexfit, m) {
             return ids;
         }, "Every run's id, in the sweep's order.")
         .def("labels", &Sweep::labels, py::arg("run"), "The run's value label for each parameter.")
+        .def_property_readonly("warnings", [](const Sweep& s) { return messagesOf(s.warnings); }, "The runs' scene warnings (mesh repairs, old spellings), each once; empty when loaded with check_runs=False.")
         .def("scene_of", [](const Sweep& s, std::size_t run) { return sweepScene(s, run); }, py::arg("run"), py::call_guard<py::gil_scoped_release>(),
              "The scene of one run (the base with its values; the GIL released while it is built).")
         .def("__len__", [](const Sweep& s) { return s.runs.size(); }, "Number of runs.");

@@ -13,8 +13,10 @@ namespace flexfit::cli {
 
 void warn(const std::string& text) { fmt::print(stderr, "warning: {}\n", text); }
 
-void printWarnings(const Scene& scene) {
-    for (const SceneWarning& w : scene.warnings) warn(fmt::format("{}:{}: {}", scene.source, w.line, w.message));
+void printWarnings(const Scene& scene) { printWarnings(scene.linesFile.empty() ? scene.source : scene.linesFile, scene.warnings); }
+
+void printWarnings(const std::string& file, std::span<const SceneWarning> warnings) {
+    for (const SceneWarning& w : warnings) warn(fmt::format("{}:{}: {}", file, w.line, w.message));
 }
 namespace {
 

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -24,8 +25,10 @@ ZoneRequest parseZone(const std::string& text, const std::string& option);
 
 // "warning: <text>" on stderr.
 void warn(const std::string& text);
-// Prints a scene's warnings (old spellings) on stderr, with the file and line.
+// Prints a scene's warnings (old spellings, mesh repairs) on stderr, with the file and line
+// (a sweep run's: the base scene's file).
 void printWarnings(const Scene& scene);
+void printWarnings(const std::string& file, std::span<const SceneWarning> warnings);
 
 // The value of an option that names an enum (names.hpp). Old spellings are accepted with a
 // warning on stderr that names the new one; anything else throws InputError naming `option`.

@@ -27,6 +27,7 @@ void registerSweep(CLI::App& app) {
     addSceneOptions(cmd, opt->read);
     cmd->callback([opt] {
         const Sweep sweep = loadSweep(opt->sweep, true, opt->read.read());
+        printWarnings(sweep.scene.string(), sweep.warnings);
         if (opt->list) {
             for (std::size_t r = 0; r < sweep.runs.size(); ++r) {
                 fmt::print("{} {}", sweep.runs[r].id, sweepRunDone(sweep, r, opt->out) ? "done   " : "missing");

@@ -66,6 +66,9 @@ struct Sweep {
     std::vector<SweepRun> runs;       // in product order
     std::shared_ptr<const detail::SweepDocument> document;  // the base scene and the values
     SceneReadOptions read;            // how every run's scene is read (strict meshes, remesh cache)
+    // The runs' scene warnings (mesh repairs, old spellings; lines of the base scene), each
+    // once, in the order the check met them; empty when loaded without checking the runs.
+    std::vector<SceneWarning> warnings;
 
     // The run's label of each parameter, in order.
     std::vector<std::string> labels(std::size_t run) const;

@@ -353,6 +353,10 @@ Sweep loadSweep(const std::filesystem::path& file, bool checkRuns, const SceneRe
     std::vector<std::string> parts;
     for (std::size_t r = 0; r < sweep.runs.size(); ++r) {
         const Scene runScene = sweepScene(sweep, r);
+        for (const SceneWarning& w : runScene.warnings)
+            if (std::none_of(sweep.warnings.begin(), sweep.warnings.end(),
+                             [&](const SceneWarning& seen) { return seen.line == w.line && seen.message == w.message; }))
+                sweep.warnings.push_back(w);
         std::vector<std::string> names;
         for (const ScenePart& p : runScene.parts) names.push_back(p.name);
         if (r == 0) parts = names;

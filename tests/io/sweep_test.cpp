@@ -269,5 +269,27 @@ TEST(Sweep, ReadOptionsReachEveryRunsScene) {
     EXPECT_EQ(cacheFiles(), 1u);
 }
 
+// The runs' scene warnings are kept once each, in the base scene's lines: a mesh repair every
+// run meets once, a warning only some runs meet (the per-step restoration at other time steps)
+// once per distinct message; none without the check.
+TEST(Sweep, TheRunsWarningsAreKeptOnceEach) {
+    TempDir dir;
+    dir.write("tet.tri", "tet\n5 4\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n5 5 5\n0 2 1\n0 1 3\n0 3 2\n1 2 3\n");
+    dir.write("scene.toml", "[world]\ntime_step = 0.001\nduration = 0.01\n[[part]]\nname = \"tet\"\nmesh = \"tet.tri\"\n");
+    const auto file = dir.write("sweep.toml", "scene = \"scene.toml\"\n[[parameter]]\nname = \"dt\"\nkey = \"world.time_step\"\n"
+                                              "values = [0.001, 0.002, 0.0005]\n[[parameter]]\nname = \"damping\"\n"
+                                              "key = \"part.tet.global_damping\"\nvalues = [0.0, 0.1]\n");
+    const Scene alone = loadScene(dir.path() / "scene.toml");
+    ASSERT_EQ(alone.warnings.size(), 1u);  // the repair
+    const Sweep s = loadSweep(file);
+    ASSERT_EQ(s.runs.size(), 6u);
+    ASSERT_EQ(s.warnings.size(), 3u);
+    EXPECT_EQ(s.warnings[0].line, alone.warnings[0].line);
+    EXPECT_EQ(s.warnings[0].message, alone.warnings[0].message);
+    EXPECT_NE(s.warnings[1].message.find("at time_step = 0.002 the part restores 0.5 times"), std::string::npos) << s.warnings[1].message;
+    EXPECT_NE(s.warnings[2].message.find("at time_step = 0.0005 the part restores 2 times"), std::string::npos) << s.warnings[2].message;
+    EXPECT_TRUE(loadSweep(file, false).warnings.empty());
+}
+
 }  // namespace
 }  // namespace flexfit

@@ -183,7 +183,10 @@ def test_a_sweeps_runs_read_their_scenes_with_the_options_given(tmp_path, exampl
     assert [f.name for f in (tmp_path / "cmd_cache").iterdir()] == names
     assert (tmp_path / "cmd" / "results.csv").read_bytes() == (tmp_path / "out" / "results.csv").read_bytes()
     defects = pathlib.Path(__file__).resolve().parents[1] / "apps" / "data" / "defects_sweep.toml"
-    assert len(flexfit.load_sweep(str(defects), remesh_cache="")) == 2
+    repaired = flexfit.load_sweep(str(defects), remesh_cache="")
+    # Each repair once (the runs share the base scene's part), as loading the scene alone says them.
+    assert len(repaired) == 2 and repaired.warnings == flexfit.load_scene(str(defects.parent / "defects_scene.toml")).warnings
+    assert any("1 duplicate face" in w for w in repaired.warnings)
     with pytest.raises(flexfit.InputError, match=r"defects.tri:13: face 4"):
         flexfit.load_sweep(str(defects), strict=True)
     with pytest.raises(flexfit.InputError, match=r"defects.tri:13: face 4"):
