@@ -75,45 +75,97 @@ std::size_t lineOfNonFiniteToken(const std::filesystem::path& path) {
     return 0;
 }
 
-// An ASCII STL cut short still imports (assimp reads the facets it finds): a file that starts
-// with "solid" and is not a binary STL by its size (84 + 50 n bytes, n at offset 80) must end
-// with an "endsolid" line (indented or not; blanks, NULs and a DOS end-of-file byte after it
-// are ignored). Reads the first 84 bytes and the last 4 KiB; the whole file only to name the
-// line of a refusal.
-void requireWholeAsciiStl(const std::filesystem::path& path) {
+// Whether the file is an ASCII STL: it starts with "solid" and is not a binary STL by its size
+// (84 + 50 n bytes, n at offset 80; some exporters start a binary header with "solid" too).
+bool isAsciiStl(const std::filesystem::path& path) {
     std::error_code ec;
-    if (lowerExtension(path) != ".stl" || !std::filesystem::is_regular_file(path, ec)) return;  // assimp names what else is wrong
+    if (lowerExtension(path) != ".stl" || !std::filesystem::is_regular_file(path, ec)) return false;  // assimp names what else is wrong
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec) return;
+    if (ec) return false;
     std::ifstream in(path, std::ios::binary);
     std::string head(std::size_t(std::min<std::uintmax_t>(size, 84)), '\0');
     in.read(head.data(), std::streamsize(head.size()));
     const std::size_t first = head.find_first_not_of(" \t\r\n");
-    if (first == std::string::npos || head.compare(first, 5, "solid") != 0) return;  // binary, or not an STL assimp reads as text
+    if (first == std::string::npos || head.compare(first, 5, "solid") != 0) return false;
     if (head.size() == 84) {
         std::uint32_t facets = 0;
         std::memcpy(&facets, head.data() + 80, 4);
-        if (size == 84 + 50 * std::uint64_t(facets)) return;  // binary, whatever its header says
+        if (size == 84 + 50 * std::uint64_t(facets)) return false;  // binary, whatever its header says
     }
-    const std::uintmax_t tailStart = size > 4096 ? size - 4096 : 0;
-    std::string tail(std::size_t(size - tailStart), '\0');
-    in.seekg(std::streamoff(tailStart));
-    in.read(tail.data(), std::streamsize(tail.size()));
-    constexpr std::string_view kTrailing(" \t\r\n\v\f\x1a\0", 8);
-    const std::size_t last = tail.find_last_not_of(kTrailing);
-    if (last != std::string::npos) {
-        const std::size_t lineStart = tail.find_last_of("\r\n", last);
-        const std::size_t start = tail.find_first_not_of(" \t", lineStart == std::string::npos ? 0 : lineStart + 1);
-        if (tail.compare(start, 8, "endsolid") == 0) return;
-    }
-    std::ifstream whole(path, std::ios::binary);
-    const std::string text((std::istreambuf_iterator<char>(whole)), std::istreambuf_iterator<char>());
-    // The last line with something on it, counted as the text readers count lines.
-    detail::LineCursor cursor(std::string_view(text).substr(0, text.find_last_not_of(kTrailing) + 1));
+    return true;
+}
+
+// Whether a token is a whole number (a leading '+' allowed), finite or not.
+bool isNumber(std::string_view token) {
+    double value = 0.0;
+    const char* begin = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
+    const auto [end, ec] = std::from_chars(begin, token.data() + token.size(), value);
+    return end == token.data() + token.size() && (ec == std::errc() || ec == std::errc::result_out_of_range);
+}
+
+// An ASCII STL's structure, checked line by line before assimp reads it: solid, then facets of
+// `facet normal x y z`, `outer loop`, three `vertex x y z`, `endloop`, `endfacet`, then
+// `endsolid` (more solids may follow; NULs and a DOS end-of-file byte after the last are
+// ignored). Assimp 5.2.5 reads a file cut short as a smaller, open mesh, and leaks its buffers
+// when a loop has other than three vertices or facets and vertices disagree (upstream issue
+// 5946); here each is refused at its line, and assimp only ever sees well-formed files.
+void checkAsciiStl(const std::filesystem::path& path) {
+    if (!isAsciiStl(path)) return;
+    std::ifstream in(path, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string file = path.string();
+    enum class At { Start, Solid, Facet, Loop, LoopEnd, AfterSolid } at = At::Start;
+    int vertices = 0;
+    detail::LineCursor cursor(text);
     detail::TextLine line;
     std::size_t lastLine = 0;
-    while (cursor.next(line)) lastLine = line.number;
-    throw InputError(path.string(), lastLine, "the ASCII STL ends without an 'endsolid' line: the file is cut short");
+    const auto fail = [&](const std::string& problem) { throw InputError(file, line.number, problem); };
+    const auto expectNumbers = [&](std::size_t from, const char* what) {
+        if (line.tokens.size() != from + 3) fail(std::string("'") + what + "' needs three numbers");
+        for (std::size_t i = from; i < from + 3; ++i)
+            if (!isNumber(line.tokens[i])) fail(std::string("'") + what + "': '" + std::string(line.tokens[i]) + "' is not a number");
+    };
+    while (cursor.next(line)) {
+        lastLine = line.number;
+        const std::string_view key = line.tokens[0];
+        switch (at) {
+        case At::Start:
+        case At::AfterSolid:
+            if (key == "solid") at = At::Solid;
+            else if (at == At::AfterSolid && key.find_first_not_of(std::string_view("\0\x1a", 2)) == std::string_view::npos) continue;
+            else fail(at == At::Start ? "expected 'solid'" : "'" + std::string(key) + "' after 'endsolid'");
+            break;
+        case At::Solid:
+            if (key == "endsolid") at = At::AfterSolid;
+            else if (key == "facet") {
+                if (line.tokens.size() < 2 || line.tokens[1] != "normal") fail("expected 'facet normal x y z'");
+                expectNumbers(2, "facet normal");
+                at = At::Facet;
+            } else fail("expected 'facet' or 'endsolid', found '" + std::string(key) + "'");
+            break;
+        case At::Facet:
+            if (key != "outer" || line.tokens.size() != 2 || line.tokens[1] != "loop") fail("expected 'outer loop'");
+            at = At::Loop;
+            vertices = 0;
+            break;
+        case At::Loop:
+            if (key == "vertex") {
+                if (++vertices > 3) fail("a facet with more than three vertices: STL facets are triangles");
+                expectNumbers(1, "vertex");
+                for (std::size_t i = 1; i < 4; ++i)
+                    if (isNonFiniteToken(line.tokens[i])) fail("a vertex has a NaN or infinite coordinate");
+            } else if (key == "endloop") {
+                if (vertices != 3) fail("a facet with " + std::to_string(vertices) + " vertices: STL facets are triangles");
+                at = At::LoopEnd;
+            } else fail("expected 'vertex' or 'endloop', found '" + std::string(key) + "'");
+            break;
+        case At::LoopEnd:
+            if (key != "endfacet") fail("expected 'endfacet', found '" + std::string(key) + "'");
+            at = At::Solid;
+            break;
+        }
+    }
+    if (at != At::AfterSolid) throw InputError(file, lastLine, "the ASCII STL ends without an 'endsolid' line: the file is cut short");
 }
 
 }  // namespace
@@ -121,7 +173,7 @@ void requireWholeAsciiStl(const std::filesystem::path& path) {
 MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadOptions& options) {
     const std::string file = path.string();
     if (!std::filesystem::exists(path)) throw InputError(file, 0, "cannot open the file for reading: it does not exist");
-    requireWholeAsciiStl(path);
+    checkAsciiStl(path);
     Assimp::Importer importer;
     const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
     if (scene == nullptr) throw InputError(file, 0, std::string("cannot import: ") + importer.GetErrorString());

@@ -461,6 +461,44 @@ TEST(AssimpIo, TruncatedAsciiStlIsRejected) {
     EXPECT_THROW(readMesh(dir.write("long_cut.stl", longer.substr(0, longer.rfind("endsolid")))), InputError);
 }
 
+// An ASCII STL's structure is checked before assimp reads it: each defect is refused at its line
+// with what was expected (assimp 5.2.5 leaked its buffers on a loop of other than three vertices
+// and on facets and vertices that disagree); several solids in one file are read.
+TEST(AssimpIo, MalformedAsciiStlIsRefusedAtTheLine) {
+    TempDir dir;
+    const std::string whole = stlTetrahedron();  // lines: 1 solid, 2 facet, 3 outer loop, 4-6 vertices, 7 endloop, 8 endfacet
+    const auto refusal = [&](const std::string& text) {
+        const InputError e = expectReadError(dir.write("bad.stl", text));
+        return std::to_string(e.line()) + ": " + e.problem();
+    };
+    const auto edited = [&](const std::string& from, const std::string& to) {
+        std::string text = whole;
+        text.replace(text.find(from), from.size(), to);
+        return text;
+    };
+    EXPECT_EQ(refusal(edited("      vertex 1 0 0\n", "")), "6: a facet with 2 vertices: STL facets are triangles");
+    EXPECT_EQ(refusal(edited("      vertex 1 0 0\n", "      vertex 1 0 0\n      vertex 1 1 1\n")),
+              "7: a facet with more than three vertices: STL facets are triangles");
+    EXPECT_EQ(refusal(edited("  endfacet\n", "")), "8: expected 'endfacet', found 'facet'");
+    EXPECT_EQ(refusal(edited("facet normal 0 0 0", "facet normal 0 0")), "2: 'facet normal' needs three numbers");
+    EXPECT_EQ(refusal(edited("vertex 1 0 0", "vertex 1 a 0")), "6: 'vertex': 'a' is not a number");
+    EXPECT_EQ(refusal(edited("    outer loop\n", "")), "3: expected 'outer loop'");
+    EXPECT_EQ(refusal(whole + "trailing words\n"), "31: 'trailing' after 'endsolid'");
+    EXPECT_EQ(refusal(edited("    endloop\n", "    endloop\n    endloop\n")), "8: expected 'endfacet', found 'endloop'");
+    // Two solids: both read (the tetrahedron and a copy 5 along x).
+    std::string moved = "solid moved\n";
+    for (const auto& face : kTetFaces) {
+        moved += "facet normal 0 0 0\nouter loop\n";
+        for (int corner : face)
+            moved += "vertex " + std::to_string(kTetVertices[corner][0] + 5.0) + " " + std::to_string(kTetVertices[corner][1]) + " " +
+                     std::to_string(kTetVertices[corner][2]) + "\n";
+        moved += "endloop\nendfacet\n";
+    }
+    const MeshReadResult two = readMesh(dir.write("two.stl", whole + moved + "endsolid moved\n"));
+    EXPECT_EQ(two.mesh.faces.size(), 8u);
+    EXPECT_EQ(two.mesh.vertices.size(), 8u);
+}
+
 TEST(AssimpIo, DegenerateAndDuplicateFacesAreRepairedOrRefused) {
     TempDir dir;
     const MeshReadOptions strict{.weldTolerance = std::nullopt, .repair = false};
