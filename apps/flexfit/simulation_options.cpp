@@ -40,9 +40,9 @@ void SimulationOptions::addTo(CLI::App& cmd) {
         ->check(CLI::NonNegativeNumber);
     cmd.add_option("--anchor-damping", anchorDamping, "Anchor spring b_a (default: the material's b; a physical material's mean spring b)")
         ->check(CLI::NonNegativeNumber);
-    cmd.add_option("--constraint-fraction", constraintFraction, "Share of the separation restored per step (0, 1]")
-        ->capture_default_str();
-    cmd.add_option("--constraint-rate", constraintRate,
+    fractionOption = cmd.add_option("--constraint-fraction", constraintFraction, "Share of the separation restored per step (0, 1]")
+                         ->capture_default_str();
+    rateOption = cmd.add_option("--constraint-rate", constraintRate,
                    "Restoration as a rate (1/s), the same restoration time at any --dt; replaces --constraint-fraction")
         ->check(CLI::NonNegativeNumber);
     cmd.add_option("--integrator", integrator, "Time integrator: " + nameList<Integrator>())
@@ -107,6 +107,14 @@ SimulationSettings SimulationOptions::simulationSettings(const PartModel& model)
     if (stability.certainlyUnstable && !allowUnstable)
         throw InputError("option --dt", 0, stability.message + " (or pass --allow-unstable)");
     if (!stability.message.empty()) fmt::print(stderr, "warning: {}\n", stability.message);
+    const bool defaultFraction = fractionOption == nullptr || fractionOption->count() == 0;
+    const bool rateGiven = rateOption != nullptr && rateOption->count() > 0;
+    if (s.restoration.method == RestorationMethod::Constraint && defaultFraction && !rateGiven)
+        if (const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(timeStep))
+            warn(fmt::format("option --dt: the restoration constraint's default fraction {:.3g} is per step, chosen for {:.3g} ms steps: "
+                             "at --dt {:.3g} the part restores {:.3g} times as fast and resists loads about {:.3g} times as stiffly; "
+                             "--constraint-rate {:.3g} keeps the restoration time, --restore anchors a stiffness independent of the step",
+                             d->fraction, 1e3 * d->chosenFor, d->timeStep, d->faster, d->stiffer, d->keepingTime));
     return s;
 }
 

@@ -26,12 +26,15 @@ struct SimulationOptions {
     std::string gravity = "0,0,0";
     double globalDamping = 0.0;
     bool allowUnstable = false;
+    CLI::Option* fractionOption = nullptr;  // --constraint-fraction and --constraint-rate: given or not
+    CLI::Option* rateOption = nullptr;
 
     void addTo(CLI::App& cmd);
     Material resolvedMaterial() const;
     PartModelSettings modelSettings() const;
     // Validated settings; prints a stability warning or throws InputError when the step is
-    // certain to diverge (unless allowUnstable).
+    // certain to diverge (unless allowUnstable), and a warning when the restoration constraint
+    // takes its default fraction (per step, chosen for 1 ms) at another --dt.
     SimulationSettings simulationSettings(const PartModel& model) const;
 };
 

@@ -36,6 +36,7 @@
 #include "flexfit/active_region.hpp"
 #include "flexfit/part_state.hpp"
 
+#include <optional>
 #include <span>
 #include <string>
 
@@ -61,6 +62,17 @@ struct RestorationSettings {
 
 // The constraint's fraction per step of `timeStep` (the rate converted, or the fraction).
 double constraintFractionFor(const RestorationSettings& restoration, double timeStep);
+
+// The default fraction (RestorationSettings{}) is per step and was chosen for the default 1 ms
+// step (SimulationSettings{}). At another step h a part that takes it restores `faster` times
+// as fast (1 ms / h) and resists loads about `stiffer` times as stiffly ((1 ms / h)^2, k ~
+// c m / h^2); `keepingTime` is the constraintRate (1/s) that restores in the 1 ms time at any
+// step. Nullopt at 1 ms. Readers that know the fraction was not given warn with it.
+struct DefaultFractionElsewhere {
+    double timeStep = 0.0, fraction = 0.0, chosenFor = 0.0;
+    double faster = 1.0, stiffer = 1.0, keepingTime = 0.0;
+};
+std::optional<DefaultFractionElsewhere> defaultFractionAt(double timeStep);
 
 // The implicit step's linear solve (conjugate gradient, Jacobi preconditioner). It stops at
 // `maxIterations` or when the residual falls to `tolerance` times the right-hand side's norm;

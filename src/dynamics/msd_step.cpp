@@ -34,6 +34,18 @@ double constraintFractionFor(const RestorationSettings& r, double timeStep) {
     return r.constraintRate > 0.0 ? -std::expm1(-2.0 * r.constraintRate * timeStep) : r.constraintFraction;
 }
 
+std::optional<DefaultFractionElsewhere> defaultFractionAt(double timeStep) {
+    DefaultFractionElsewhere d;
+    d.timeStep = timeStep;
+    d.fraction = RestorationSettings{}.constraintFraction;
+    d.chosenFor = SimulationSettings{}.timeStep;
+    d.faster = d.chosenFor / timeStep;
+    if (std::abs(d.faster - 1.0) < 1e-9) return std::nullopt;
+    d.stiffer = d.faster * d.faster;
+    d.keepingTime = -std::log1p(-d.fraction) / (2.0 * d.chosenFor);  // constraintFractionFor's inverse at 1 ms
+    return d;
+}
+
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
                    PartState& state, StepCounters* counters) {
     detail::stepAllMasses(model, settings, loads, nullptr, state, counters);

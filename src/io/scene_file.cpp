@@ -639,21 +639,20 @@ namespace {
 // fraction or a rate the scene gives is its choice.
 void warnOfPerStepRestoration(const Table& t, const ScenePart& p, Scene& scene) {
     const RestorationSettings& r = p.part.simulation.restoration;
-    const double chosenFor = WorldSettings{}.timeStep, fraction = RestorationSettings{}.constraintFraction;
-    const double h = scene.world.timeStep, ratio = chosenFor / h;
-    if (p.part.mode == PartMode::Rigid || r.method != RestorationMethod::Constraint || t.has("constraint_fraction") ||
-        t.has("constraint_rate") || std::abs(ratio - 1.0) < 1e-9)
+    if (p.part.mode == PartMode::Rigid || r.method != RestorationMethod::Constraint || t.has("constraint_fraction") || t.has("constraint_rate"))
         return;
+    const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(scene.world.timeStep);
+    if (!d) return;
     const auto shortly = [](double x) {
         char text[32];
         std::snprintf(text, sizeof text, "%.3g", x);
         return std::string(text);
     };
-    const double rate = -std::log1p(-fraction) / (2.0 * chosenFor);  // the same restoration time at any step
-    scene.warnings.push_back({t.line("restoration"), t.what() + ": the restoration constraint's default fraction " + shortly(fraction) +
-                                                         " is per step, chosen for " + shortly(1e3 * chosenFor) + " ms steps: at time_step = " +
-                                                         shortly(h) + " the part restores " + shortly(ratio) + " times as fast and resists loads about " +
-                                                         shortly(ratio * ratio) + " times as stiffly; constraint_rate = " + shortly(rate) +
+    scene.warnings.push_back({t.line("restoration"), t.what() + ": the restoration constraint's default fraction " + shortly(d->fraction) +
+                                                         " is per step, chosen for " + shortly(1e3 * d->chosenFor) + " ms steps: at time_step = " +
+                                                         shortly(d->timeStep) + " the part restores " + shortly(d->faster) +
+                                                         " times as fast and resists loads about " + shortly(d->stiffer) +
+                                                         " times as stiffly; constraint_rate = " + shortly(d->keepingTime) +
                                                          " (1/s) keeps the restoration time, restoration = \"anchors\" a stiffness independent of the step"});
 }
 
