@@ -14,6 +14,7 @@
 #include "scene_runner.hpp"
 #include "sweep_runner.hpp"
 
+#include <fmt/core.h>
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -221,6 +222,22 @@ void applyPartKeywords(const py::kwargs& keywords, PartSettings& part, BodySetti
         }
     }
     if (body) body->kineticFriction = kinetic.value_or(body->staticFriction);  // as in scene files
+}
+
+// A Python UserWarning when a deforming part takes the restoration constraint's default fraction
+// (per step, chosen for 1 ms) at another time step, as scene files warn (defaultFractionAt).
+void warnOfDefaultFraction(const py::kwargs& keywords, const PartSettings& part, double timeStep) {
+    if (part.mode == PartMode::Rigid || part.simulation.restoration.method != RestorationMethod::Constraint ||
+        keywords.contains("constraint_fraction") || keywords.contains("constraint_rate"))
+        return;
+    const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(timeStep);
+    if (!d) return;
+    const std::string message = fmt::format(
+        "the restoration constraint's default fraction {:.3g} is per step, chosen for {:.3g} ms steps: at time_step {:.3g} the part "
+        "restores {:.3g} times as fast and resists loads about {:.3g} times as stiffly; constraint_rate={:.3g} keeps the restoration "
+        "time, restoration='anchors' a stiffness independent of the step",
+        d->fraction, 1e3 * d->chosenFor, d->timeStep, d->faster, d->stiffer, d->keepingTime);
+    if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
 }
 
 // A Python value as a TOML node: bool, int, float, str, a dict (table), a sequence (array),
@@ -492,6 +509,7 @@ PYBIND11_MODULE(_flexfit, m) {
     partClass.def(py::init([](std::shared_ptr<PartModel> model, const py::kwargs& settings) {
                  PartSettings s;
                  applyPartKeywords(settings, s, nullptr);
+                 warnOfDefaultFraction(settings, s, s.simulation.timeStep);
                  return Part(model, s);
              }),
              py::arg("model"),
@@ -526,6 +544,7 @@ PYBIND11_MODULE(_flexfit, m) {
             PartSettings part;
             BodySettings body;
             applyPartKeywords(settings, part, &body);
+            warnOfDefaultFraction(settings, part, w.settings().timeStep);
             py::gil_scoped_release release;  // the part's hierarchies, and a distance field for the point shell
             return w.add(model, part, body, makePose(position, rotation));
         }, py::arg("model"), py::arg("position") = Vec3::Zero(), py::arg("rotation") = Eigen::Vector4d(1, 0, 0, 0),

@@ -636,3 +636,24 @@ def test_a_model_built_with_the_files_vertices_speaks_the_files_indices(tmp_path
     assert a.zone_depths[3] == -1 and a.zone_depths[7 + 1] == 0
     with pytest.raises(flexfit.InputError, match="removed by the repair"):
         a.apply_force(3, [1, 0, 0])
+
+
+def test_the_default_per_step_restoration_at_another_time_step_is_a_warning():
+    # As scene files and `flexfit simulate --dt` say it: the default fraction was chosen for 1 ms.
+    import warnings
+
+    model = flexfit.PartModel(flexfit.torus(10, 2.5, 12, 8))
+    with pytest.warns(UserWarning, match=r"default fraction 0.001 is per step, chosen for 1 ms steps: at time_step 0.0002 the part "
+                                         r"restores 5 times as fast and resists loads about 25 times as stiffly; constraint_rate=0.5"):
+        flexfit.World(time_step=2e-4).add(model, mode="rigid-deformable")
+    with pytest.warns(UserWarning, match=r"at time_step 0.002 the part restores 0.5 times as fast"):
+        flexfit.Part(model, time_step=2e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        world = flexfit.World(time_step=2e-4)
+        world.add(model, constraint_rate=0.5)
+        world.add(model, constraint_fraction=0.001)
+        world.add(model, restoration="anchors")
+        world.add(model, mode="rigid")
+        flexfit.World().add(model)
+        flexfit.Part(model)
