@@ -67,7 +67,8 @@ double constraintFractionFor(const RestorationSettings& restoration, double time
 // step (SimulationSettings{}). At another step h a part that takes it restores `faster` times
 // as fast (1 ms / h) and resists loads about `stiffer` times as stiffly ((1 ms / h)^2, k ~
 // c m / h^2); `keepingTime` is the constraintRate (1/s) that restores in the 1 ms time at any
-// step. Nullopt at 1 ms. Readers that know the fraction was not given warn with it.
+// step. Nullopt at 1 ms, and for a time step that is not finite and positive (an error where
+// settings are checked). Readers that know the fraction was not given warn with it.
 struct DefaultFractionElsewhere {
     double timeStep = 0.0, fraction = 0.0, chosenFor = 0.0;
     double faster = 1.0, stiffer = 1.0, keepingTime = 0.0;

@@ -35,6 +35,7 @@ double constraintFractionFor(const RestorationSettings& r, double timeStep) {
 }
 
 std::optional<DefaultFractionElsewhere> defaultFractionAt(double timeStep) {
+    if (!(timeStep > 0.0 && std::isfinite(timeStep))) return std::nullopt;  // refused where settings are checked
     DefaultFractionElsewhere d;
     d.timeStep = timeStep;
     d.fraction = RestorationSettings{}.constraintFraction;

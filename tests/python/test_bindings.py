@@ -657,3 +657,5 @@ def test_the_default_per_step_restoration_at_another_time_step_is_a_warning():
         world.add(model, mode="rigid")
         flexfit.World().add(model)
         flexfit.Part(model)
+        with pytest.raises(flexfit.InputError):
+            flexfit.Part(model, time_step=0.0)  # refused, with no warning first
