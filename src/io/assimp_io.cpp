@@ -17,7 +17,6 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <limits>
 
 namespace flexfit {
@@ -65,8 +64,7 @@ bool isNonFiniteToken(std::string_view token) {
 // First line of a text file holding a NaN/Inf token; 0 when none (binary files, or none found).
 // Lines as the text readers count them (text_lines.hpp).
 std::size_t lineOfNonFiniteToken(const std::filesystem::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    const std::string text = detail::readTextFile(path);
     detail::LineCursor cursor(text);
     detail::TextLine line;
     while (cursor.next(line))
@@ -111,8 +109,7 @@ bool isNumber(std::string_view token) {
 // 5946); here each is refused at its line, and assimp only ever sees well-formed files.
 void checkAsciiStl(const std::filesystem::path& path) {
     if (!isAsciiStl(path)) return;
-    std::ifstream in(path, std::ios::binary);
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string text = detail::readTextFile(path);
     const std::string file = path.string();
     enum class At { Start, Solid, Facet, Loop, LoopEnd, AfterSolid } at = At::Start;
     int vertices = 0;
