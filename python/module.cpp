@@ -14,7 +14,6 @@
 #include "scene_runner.hpp"
 #include "sweep_runner.hpp"
 
-#include <fmt/core.h>
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -227,17 +226,11 @@ void applyPartKeywords(const py::kwargs& keywords, PartSettings& part, BodySetti
 // A Python UserWarning when a deforming part takes the restoration constraint's default fraction
 // (per step, chosen for 1 ms) at another time step, as scene files warn (defaultFractionAt).
 void warnOfDefaultFraction(const py::kwargs& keywords, const PartSettings& part, double timeStep) {
-    if (part.mode == PartMode::Rigid || part.simulation.restoration.method != RestorationMethod::Constraint ||
-        keywords.contains("constraint_fraction") || keywords.contains("constraint_rate"))
-        return;
-    const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(timeStep);
-    if (!d) return;
-    const std::string message = fmt::format(
-        "the restoration constraint's default fraction {:.3g} is per step, chosen for {:.3g} ms steps: at time_step {:.3g} the part "
-        "restores {:.3g} times as fast and resists loads about {:.3g} times as stiffly; constraint_rate={:.3g} keeps the restoration "
-        "time, restoration='anchors' a stiffness independent of the step",
-        d->fraction, 1e3 * d->chosenFor, d->timeStep, d->faster, d->stiffer, d->keepingTime);
-    if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+    if (keywords.contains("constraint_fraction") || keywords.contains("constraint_rate")) return;
+    if (const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(part, timeStep)) {
+        const std::string message = describe(*d, {"time_step ", "constraint_rate=", "", "restoration='anchors'"});
+        if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+    }
 }
 
 // A Python value as a TOML node: bool, int, float, str, a dict (table), a sequence (array),

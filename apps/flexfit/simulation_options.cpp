@@ -111,10 +111,7 @@ SimulationSettings SimulationOptions::simulationSettings(const PartModel& model)
     const bool rateGiven = rateOption != nullptr && rateOption->count() > 0;
     if (s.restoration.method == RestorationMethod::Constraint && defaultFraction && !rateGiven)
         if (const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(timeStep))
-            warn(fmt::format("option --dt: the restoration constraint's default fraction {:.3g} is per step, chosen for {:.3g} ms steps: "
-                             "at --dt {:.3g} the part restores {:.3g} times as fast and resists loads about {:.3g} times as stiffly; "
-                             "--constraint-rate {:.3g} keeps the restoration time, --restore anchors a stiffness independent of the step",
-                             d->fraction, 1e3 * d->chosenFor, d->timeStep, d->faster, d->stiffer, d->keepingTime));
+            warn("option --dt: " + describe(*d, {"--dt ", "--constraint-rate ", "", "--restore anchors"}));
     return s;
 }
 

@@ -76,6 +76,10 @@ struct PartSettings {
     ZoneSettings zones;
 };
 
+// defaultFractionAt (simulation.hpp) for a part: nullopt too for a rigid part or another
+// restoration method.
+std::optional<DefaultFractionElsewhere> defaultFractionAt(const PartSettings& part, double timeStep);
+
 struct ZoneSeed {
     enum class Kind { Mass, Triangle } kind = Kind::Mass;
     Index index = 0;

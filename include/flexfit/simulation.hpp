@@ -75,6 +75,19 @@ struct DefaultFractionElsewhere {
 };
 std::optional<DefaultFractionElsewhere> defaultFractionAt(double timeStep);
 
+// How a reader spells its keys in the warning: "time_step = " then the step; "constraint_rate = "
+// then the rate then " (1/s)"; "restoration = \"anchors\"" (a scene file's spelling).
+struct FractionKeys {
+    const char* timeStep;
+    const char* ratePrefix;
+    const char* rateSuffix;
+    const char* anchors;
+};
+// "the restoration constraint's default fraction 0.001 is per step, chosen for 1 ms steps: at
+// <step> the part restores ... times as fast and resists loads about ... times as stiffly;
+// <rate> keeps the restoration time, <anchors> a stiffness independent of the step".
+std::string describe(const DefaultFractionElsewhere& d, const FractionKeys& keys);
+
 // The implicit step's linear solve (conjugate gradient, Jacobi preconditioner). It stops at
 // `maxIterations` or when the residual falls to `tolerance` times the right-hand side's norm;
 // tolerance 0 runs maxIterations every step (fewer only once the residual reaches rounding

@@ -135,8 +135,7 @@ void SignedDistanceField::fillNodes(Grid& grid, std::span<const std::size_t> nod
     detail::forChunks(nodes.size(), 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t n = begin; n < end; ++n) {
             const std::size_t node = nodes[n];
-            const int i = int(node % dx), j = int(node % dxy / dx), k = int(node / dxy);
-            grid.values[node] = float(query(grid.box.min + grid.cell * Vec3(i, j, k)).distance);
+            fill(grid, int(node % dx), int(node % dxy / dx), int(node / dxy));
         }
     });
 }

@@ -7,6 +7,8 @@
 #include "implicit_step.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 namespace flexfit {
 
@@ -45,6 +47,19 @@ std::optional<DefaultFractionElsewhere> defaultFractionAt(double timeStep) {
     d.stiffer = d.faster * d.faster;
     d.keepingTime = -std::log1p(-d.fraction) / (2.0 * d.chosenFor);  // constraintFractionFor's inverse at 1 ms
     return d;
+}
+
+std::string describe(const DefaultFractionElsewhere& d, const FractionKeys& keys) {
+    const auto shortly = [](double x) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.3g", x);
+        return std::string(text);
+    };
+    return "the restoration constraint's default fraction " + shortly(d.fraction) + " is per step, chosen for " +
+           shortly(1e3 * d.chosenFor) + " ms steps: at " + keys.timeStep + shortly(d.timeStep) + " the part restores " +
+           shortly(d.faster) + " times as fast and resists loads about " + shortly(d.stiffer) + " times as stiffly; " +
+           keys.ratePrefix + shortly(d.keepingTime) + keys.rateSuffix + " keeps the restoration time, " + keys.anchors +
+           " a stiffness independent of the step";
 }
 
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,

@@ -38,6 +38,11 @@ struct Part::Zone {
     std::vector<RingMember> members;
 };
 
+std::optional<DefaultFractionElsewhere> defaultFractionAt(const PartSettings& part, double timeStep) {
+    if (part.mode == PartMode::Rigid || part.simulation.restoration.method != RestorationMethod::Constraint) return std::nullopt;
+    return defaultFractionAt(timeStep);
+}
+
 Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
     : model_(std::move(model)),
       settings_(settings),

@@ -18,6 +18,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 namespace flexfit {
 namespace {
@@ -50,15 +51,26 @@ void appendNode(const aiScene& scene, const aiNode& node, const Eigen::Matrix4d&
     for (unsigned i = 0; i < node.mNumChildren; ++i) appendNode(scene, *node.mChildren[i], world, file, out);
 }
 
+// A token read whole as a number (a leading '+' allowed): its value, or out of a double's
+// range; nullopt for anything else (a word, a number with more after it).
+struct WholeNumber {
+    double value = 0.0;
+    bool outOfRange = false;
+};
+std::optional<WholeNumber> wholeNumber(std::string_view token) {
+    WholeNumber n;
+    const char* begin = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
+    const auto [end, ec] = std::from_chars(begin, token.data() + token.size(), n.value);
+    if (end != token.data() + token.size() || (ec != std::errc() && ec != std::errc::result_out_of_range)) return std::nullopt;
+    n.outOfRange = ec == std::errc::result_out_of_range;
+    return n;
+}
+
 // A whole token that is a number assimp cannot hold: NaN, infinity, or beyond float range
 // (assimp stores coordinates as 32-bit floats). Words that merely start with "inf" do not count.
 bool isNonFiniteToken(std::string_view token) {
-    double value = 0.0;
-    const char* begin = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
-    const auto [end, ec] = std::from_chars(begin, token.data() + token.size(), value);
-    if (end != token.data() + token.size()) return false;
-    if (ec == std::errc::result_out_of_range) return true;
-    return ec == std::errc() && !(std::abs(value) <= double(std::numeric_limits<float>::max()));
+    const std::optional<WholeNumber> n = wholeNumber(token);
+    return n && (n->outOfRange || !(std::abs(n->value) <= double(std::numeric_limits<float>::max())));
 }
 
 // First line of a text file holding a NaN/Inf token; 0 when none (binary files, or none found).
@@ -93,14 +105,6 @@ bool isAsciiStl(const std::filesystem::path& path) {
     return true;
 }
 
-// Whether a token is a whole number (a leading '+' allowed), finite or not.
-bool isNumber(std::string_view token) {
-    double value = 0.0;
-    const char* begin = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
-    const auto [end, ec] = std::from_chars(begin, token.data() + token.size(), value);
-    return end == token.data() + token.size() && (ec == std::errc() || ec == std::errc::result_out_of_range);
-}
-
 // An ASCII STL's structure, checked line by line before assimp reads it: solid, then facets of
 // `facet normal x y z`, `outer loop`, three `vertex x y z`, `endloop`, `endfacet`, then
 // `endsolid` (more solids may follow; NULs and a DOS end-of-file byte after the last are
@@ -120,7 +124,7 @@ void checkAsciiStl(const std::filesystem::path& path) {
     const auto expectNumbers = [&](std::size_t from, const char* what) {
         if (line.tokens.size() != from + 3) fail(std::string("'") + what + "' needs three numbers");
         for (std::size_t i = from; i < from + 3; ++i)
-            if (!isNumber(line.tokens[i])) fail(std::string("'") + what + "': '" + std::string(line.tokens[i]) + "' is not a number");
+            if (!wholeNumber(line.tokens[i])) fail(std::string("'") + what + "': '" + std::string(line.tokens[i]) + "' is not a number");
     };
     while (cursor.next(line)) {
         lastLine = line.number;

@@ -13,7 +13,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -638,22 +637,10 @@ namespace {
 // moving a scene to a haptic rate does not expect. Said where the fraction is the default; a
 // fraction or a rate the scene gives is its choice.
 void warnOfPerStepRestoration(const Table& t, const ScenePart& p, Scene& scene) {
-    const RestorationSettings& r = p.part.simulation.restoration;
-    if (p.part.mode == PartMode::Rigid || r.method != RestorationMethod::Constraint || t.has("constraint_fraction") || t.has("constraint_rate"))
-        return;
-    const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(scene.world.timeStep);
-    if (!d) return;
-    const auto shortly = [](double x) {
-        char text[32];
-        std::snprintf(text, sizeof text, "%.3g", x);
-        return std::string(text);
-    };
-    scene.warnings.push_back({t.line("restoration"), t.what() + ": the restoration constraint's default fraction " + shortly(d->fraction) +
-                                                         " is per step, chosen for " + shortly(1e3 * d->chosenFor) + " ms steps: at time_step = " +
-                                                         shortly(d->timeStep) + " the part restores " + shortly(d->faster) +
-                                                         " times as fast and resists loads about " + shortly(d->stiffer) +
-                                                         " times as stiffly; constraint_rate = " + shortly(d->keepingTime) +
-                                                         " (1/s) keeps the restoration time, restoration = \"anchors\" a stiffness independent of the step"});
+    if (t.has("constraint_fraction") || t.has("constraint_rate")) return;
+    if (const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(p.part, scene.world.timeStep))
+        scene.warnings.push_back({t.line("restoration"),
+                                  t.what() + ": " + describe(*d, {"time_step = ", "constraint_rate = ", " (1/s)", "restoration = \"anchors\""})});
 }
 
 }  // namespace
