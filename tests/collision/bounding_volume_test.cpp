@@ -133,7 +133,7 @@ TEST(BoundingVolume, EachSubtreeIsTheNodeRangeItsLeavesAreIn) {
             std::size_t below = 0;
             for (std::int32_t l = 0; l < std::int32_t(nodes.size()); ++l) {
                 bool inSubtree = false;
-                for (std::int32_t m = l; m >= 0 && !inSubtree; m = nodes[std::size_t(m)].parent) inSubtree = m == n;
+                for (std::int32_t m = l; m >= 0 && !inSubtree; m = tree.parent(std::size_t(m))) inSubtree = m == n;
                 EXPECT_EQ(inSubtree, l >= n && l < tree.subtreeEnd(n)) << "node " << n << ", node " << l;
                 below += inSubtree && nodes[std::size_t(l)].isLeaf();
             }
