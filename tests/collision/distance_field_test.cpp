@@ -217,10 +217,10 @@ TEST(SignedDistanceField, OpenFlippedOrInsideOutMeshIsRefused) {
     EXPECT_NO_THROW(fieldOf(unitCube()));
 }
 
-// The batch sampler (four points a vector where the CPU has AVX2) against sample() on a
+// The batch sampler (eight points a vector with AVX-512, four with AVX2) against sample() on a
 // second field of the same mesh, bit for bit: points near the surface (corners computed when
 // built) and far from it (corners computed on first reading, by whichever field reads first),
-// in batches of every length, so whole vectors and the scalar tail both run.
+// in batches of every length, so whole vectors of 8 and of 4 and the scalar tail all run.
 namespace {
 
 void expectSampleManyEqualsSample() {
@@ -252,6 +252,13 @@ void expectSampleManyEqualsSample() {
 
 TEST(SignedDistanceField, SampleManyEqualsSampleBitForBit) {
     if (!detail::vectorSamplingEnabled()) GTEST_SKIP() << "no AVX2 on this CPU: sampleMany is sample() point by point";
+    expectSampleManyEqualsSample();
+}
+
+TEST(SignedDistanceField, SampleManyFourLanePathEqualsSample) {
+    const detail::ScopedFourLaneSampling four;
+    if (!detail::vectorSamplingEnabled()) GTEST_SKIP() << "no AVX2 on this CPU: sampleMany is sample() point by point";
+    ASSERT_FALSE(detail::eightLaneSamplingEnabled());
     expectSampleManyEqualsSample();
 }
 
