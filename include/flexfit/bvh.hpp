@@ -3,7 +3,12 @@
 //
 // Built top-down as the thesis does (4.3): the root encloses every item; a node splits its
 // items at the centre of their centres' bounding box along its longest axis (at the median
-// when that leaves a side empty), down to one item per leaf. Nodes live in one array, children
+// when that leaves a side empty), down to one item per leaf. Split::SurfaceArea splits by the
+// binned surface-area heuristic instead (16 bins per axis): the face hierarchies use it, which
+// took 8-11 % off a tool's narrow phase in a deforming part (tools/tool_press.py, Wuson x1 /
+// x4) for twice the build time; the contacts are the same, only the tree's shape differs. The
+// other trees (broad phase, rest points, distance fields' faces) keep the centre split: their
+// walks' orders reach results (contact order, grid bits). Nodes live in one array, children
 // after their parent; parent links for refits in an array of their own.
 //
 // refit() updates the leaves of the items that changed and then only their ancestors, bottom-up
@@ -15,6 +20,8 @@
 #include "flexfit/index_set.hpp"
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <cstdint>
 #include <functional>
 #include <numeric>
@@ -42,8 +49,13 @@ public:
         bool isLeaf() const { return left < 0; }
     };
 
+    // How a node's items are split: at the centre of their centres' bounds along its longest
+    // axis (the thesis's), or by the binned surface-area heuristic.
+    enum class Split { Centre, SurfaceArea };
+
     // Builds over items 0..n-1 with the given leaf volumes.
-    void build(std::span<const BV> leafVolumes) {
+    void build(std::span<const BV> leafVolumes, Split how = Split::Centre) {
+        split_ = how;
         nodes_.clear();
         parents_.clear();
         leafOf_.assign(leafVolumes.size(), 0);
@@ -126,7 +138,7 @@ private:
             return index;
         }
         nodes_[std::size_t(index)].volume = encloseAll(leaves, range);
-        const std::size_t middle = split(leaves, items, begin, end);
+        const std::size_t middle = split_ == Split::SurfaceArea ? splitBySurfaceArea(leaves, items, begin, end) : split(leaves, items, begin, end);
         const std::int32_t left = buildNode(leaves, items, begin, middle, index, std::uint16_t(depth + 1));
         const std::int32_t right = buildNode(leaves, items, middle, end, index, std::uint16_t(depth + 1));
         nodes_[std::size_t(index)].left = left;
@@ -152,6 +164,74 @@ private:
         return std::size_t(middle - items.begin());
     }
 
+    static Eigen::AlignedBox3d boxOf(const Aabb& b) { return {b.min, b.max}; }
+    static Eigen::AlignedBox3d boxOf(const Sphere& s) { return {s.centre.array() - s.radius, s.centre.array() + s.radius}; }
+    static double halfArea(const Eigen::AlignedBox3d& b) {
+        if (b.isEmpty()) return 0.0;
+        const Vec3 d = b.sizes();
+        return d.x() * d.y() + d.y() * d.z() + d.z() * d.x();
+    }
+
+    // A surface-area split: the items whose centres fall in bins [0, bin) of `axis` go left.
+    struct BinCut {
+        int axis = -1, bin = 0;
+        double cost = std::numeric_limits<double>::infinity();
+    };
+    static constexpr int kBins = 16;
+
+    // Which of kBins equal bins of the centres' bounds along `axis` the item's centre is in.
+    static int binOf(std::span<const BV> leaves, Index item, const Eigen::AlignedBox3d& centres, int axis) {
+        const double t = (centreOf(leaves[item])[axis] - centres.min()[axis]) / centres.sizes()[axis] * kBins;
+        return std::clamp(int(t), 0, kBins - 1);
+    }
+
+    // The cut along `axis` whose sides' half areas times their item counts sum least, if
+    // better than `best`.
+    static BinCut cheapestCut(std::span<const BV> leaves, std::span<const Index> items, const Eigen::AlignedBox3d& centres, int axis,
+                              BinCut best) {
+        std::array<Eigen::AlignedBox3d, kBins> boxes;  // empty to start with
+        std::array<std::size_t, kBins> counts{};
+        for (Index item : items) {
+            const auto b = std::size_t(binOf(leaves, item, centres, axis));
+            boxes[b].extend(boxOf(leaves[item]));
+            ++counts[b];
+        }
+        std::array<double, kBins> rightCost{};  // of bins [b, kBins)
+        Eigen::AlignedBox3d side;
+        std::size_t count = 0;
+        for (std::size_t b = kBins; b-- > 1;) {
+            side.extend(boxes[b]);
+            count += counts[b];
+            rightCost[b] = halfArea(side) * double(count);
+        }
+        side.setEmpty();
+        count = 0;
+        for (std::size_t b = 1; b < kBins; ++b) {
+            side.extend(boxes[b - 1]);
+            count += counts[b - 1];
+            const double cost = halfArea(side) * double(count) + rightCost[b];
+            if (count > 0 && count < items.size() && cost < best.cost) best = {axis, int(b), cost};
+        }
+        return best;
+    }
+
+    // Binned surface-area heuristic (Wald 2007): the cheapest cut over the three axes; the
+    // centre split for two items, for coincident centres, or when no cut leaves both sides
+    // items.
+    static std::size_t splitBySurfaceArea(std::span<const BV> leaves, std::vector<Index>& items, std::size_t begin, std::size_t end) {
+        Eigen::AlignedBox3d centres;
+        for (std::size_t i = begin; i < end; ++i) centres.extend(centreOf(leaves[items[i]]));
+        const std::span<const Index> range(items.data() + begin, end - begin);
+        BinCut best;
+        if (range.size() > 2)
+            for (int axis = 0; axis < 3; ++axis)
+                if (centres.sizes()[axis] > 0.0) best = cheapestCut(leaves, range, centres, axis, best);
+        if (best.axis < 0) return split(leaves, items, begin, end);
+        auto first = items.begin() + std::ptrdiff_t(begin), last = items.begin() + std::ptrdiff_t(end);
+        return std::size_t(std::partition(first, last, [&](Index i) { return binOf(leaves, i, centres, best.axis) < best.bin; }) - items.begin());
+    }
+
+    Split split_ = Split::Centre;
     std::vector<Node> nodes_;
     std::vector<std::int32_t> parents_;  // (nodes) parent node, -1 for the root
     std::vector<Index> leafOf_;          // item -> leaf node

@@ -22,7 +22,7 @@ void buildHierarchy(Bvh<BV>& bvh, const Part& part, ExactTest test) {
     const auto& faces = part.model().mesh.faces;
     std::vector<BV> leaves(faces.size());
     for (std::size_t f = 0; f < faces.size(); ++f) leaves[f] = leafVolume((const BV*)nullptr, part.state().positions, faces[f], test);
-    bvh.build(leaves);
+    bvh.build(leaves, Bvh<BV>::Split::SurfaceArea);
 }
 
 

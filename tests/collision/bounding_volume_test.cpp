@@ -1,10 +1,13 @@
 // Bounding volumes: the oriented-box test against a corner-projection implementation of its 6
 // face axes (and, for what it leaves out, of all 15 separating axes), and the enclosing
-// constructions against their members.
+// constructions against their members; the hierarchy's structure under both splits, and the
+// surface-area split's trees against the centre split's by their area.
 #include "flexfit/flexfit.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <random>
 
 using namespace flexfit;
@@ -117,27 +120,96 @@ TEST(BoundingVolume, EnclosuresContainTheirMembers) {
 
 TEST(BoundingVolume, EachSubtreeIsTheNodeRangeItsLeavesAreIn) {
     // Brute force over parent links: leaf l is in node n's subtree when n is l or an ancestor.
-    std::mt19937 rng(8);
-    std::uniform_real_distribution<double> u(-3, 3);
-    for (std::size_t count : {1u, 2u, 3u, 7u, 50u}) {
-        std::vector<Aabb> leaves;
-        for (std::size_t i = 0; i < count; ++i) {
-            const Vec3 c(u(rng), u(rng), u(rng));
-            leaves.push_back({c.array() - 0.1, c.array() + 0.1});
-        }
-        Bvh<Aabb> tree;
-        tree.build(leaves);
-        const auto& nodes = tree.nodes();
-        ASSERT_EQ(nodes.size(), 2 * count - 1);
-        for (std::int32_t n = 0; n < std::int32_t(nodes.size()); ++n) {
-            std::size_t below = 0;
-            for (std::int32_t l = 0; l < std::int32_t(nodes.size()); ++l) {
-                bool inSubtree = false;
-                for (std::int32_t m = l; m >= 0 && !inSubtree; m = tree.parent(std::size_t(m))) inSubtree = m == n;
-                EXPECT_EQ(inSubtree, l >= n && l < tree.subtreeEnd(n)) << "node " << n << ", node " << l;
-                below += inSubtree && nodes[std::size_t(l)].isLeaf();
+    // Both ways of splitting; every node's volume encloses its children's, every item is in
+    // exactly one leaf.
+    using Split = Bvh<Aabb>::Split;
+    for (Split how : {Split::Centre, Split::SurfaceArea}) {
+        std::mt19937 rng(8);
+        std::uniform_real_distribution<double> u(-3, 3);
+        for (std::size_t count : {1u, 2u, 3u, 7u, 50u}) {
+            std::vector<Aabb> leaves;
+            for (std::size_t i = 0; i < count; ++i) {
+                const Vec3 c(u(rng), u(rng), u(rng));
+                leaves.push_back({c.array() - 0.1, c.array() + 0.1});
             }
-            EXPECT_EQ(tree.itemCount(n), below) << "node " << n;
+            Bvh<Aabb> tree;
+            tree.build(leaves, how);
+            const auto& nodes = tree.nodes();
+            ASSERT_EQ(nodes.size(), 2 * count - 1);
+            std::vector<int> leafOfItem(count, 0);
+            for (std::int32_t n = 0; n < std::int32_t(nodes.size()); ++n) {
+                const auto& node = nodes[std::size_t(n)];
+                if (node.isLeaf()) {
+                    ++leafOfItem[node.item];
+                    EXPECT_TRUE(node.volume.min == leaves[node.item].min && node.volume.max == leaves[node.item].max);
+                } else {
+                    for (std::int32_t child : {node.left, node.right}) {
+                        EXPECT_EQ(tree.parent(std::size_t(child)), n);
+                        const Aabb& c = nodes[std::size_t(child)].volume;
+                        EXPECT_TRUE((node.volume.min.array() <= c.min.array()).all() && (c.max.array() <= node.volume.max.array()).all());
+                    }
+                }
+                std::size_t below = 0;
+                for (std::int32_t l = 0; l < std::int32_t(nodes.size()); ++l) {
+                    bool inSubtree = false;
+                    for (std::int32_t m = l; m >= 0 && !inSubtree; m = tree.parent(std::size_t(m))) inSubtree = m == n;
+                    EXPECT_EQ(inSubtree, l >= n && l < tree.subtreeEnd(n)) << "node " << n << ", node " << l;
+                    below += inSubtree && nodes[std::size_t(l)].isLeaf();
+                }
+                EXPECT_EQ(tree.itemCount(n), below) << "node " << n;
+            }
+            EXPECT_EQ(std::count(leafOfItem.begin(), leafOfItem.end(), 1), std::ptrdiff_t(count));
         }
+    }
+}
+
+namespace {
+
+// The surface-area cost of a tree, computed from its nodes: the sum of its internal boxes'
+// areas (the expected node tests of a random query, up to a constant).
+double internalArea(const Bvh<Aabb>& tree) {
+    double area = 0.0;
+    for (const auto& node : tree.nodes()) {
+        if (node.isLeaf()) continue;
+        const Vec3 d = node.volume.max - node.volume.min;
+        area += d.x() * d.y() + d.y() * d.z() + d.z() * d.x();
+    }
+    return area;
+}
+
+std::vector<Aabb> faceBoxes(const TriMesh& mesh) {
+    std::vector<Aabb> boxes;
+    for (const Face& f : mesh.faces) {
+        const std::array<Vec3, 3> corners{mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
+        boxes.push_back(Aabb::around(corners));
+    }
+    return boxes;
+}
+
+}  // namespace
+
+// The surface-area split makes trees of less area than the centre split on the meshes the
+// face hierarchies meet: a regular sphere, a torus, and a soup of long thin and small triangles
+// (as CAD exports have); Wuson, a third-party part, when assimp-testmodels is installed.
+TEST(BoundingVolume, SurfaceAreaSplitsMakeTreesOfLessArea) {
+    std::vector<std::pair<std::string, std::vector<Aabb>>> cases{{"icosphere", faceBoxes(makeIcoSphere(1.0, 4))},
+                                                                  {"torus", faceBoxes(makeTorus(10.0, 2.5, 152, 48))}};
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1), length(0.001, 1.0);
+    std::vector<Aabb> soup;
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 c(u(rng), u(rng), u(rng)), direction = Vec3(u(rng), u(rng), u(rng)).normalized();
+        const double l = length(rng) * length(rng);
+        const std::array<Vec3, 3> corners{c, c + l * direction, c + 0.01 * l * Vec3(u(rng), u(rng), u(rng))};
+        soup.push_back(Aabb::around(corners));
+    }
+    cases.emplace_back("soup", soup);
+    const std::filesystem::path wuson = "/usr/share/assimp/models/OFF/Wuson.off";
+    if (std::filesystem::exists(wuson)) cases.emplace_back("Wuson", faceBoxes(readMesh(wuson).mesh));
+    for (const auto& [name, boxes] : cases) {
+        Bvh<Aabb> centre, surface;
+        centre.build(boxes, Bvh<Aabb>::Split::Centre);
+        surface.build(boxes, Bvh<Aabb>::Split::SurfaceArea);
+        EXPECT_LT(internalArea(surface), 0.97 * internalArea(centre)) << name;
     }
 }
