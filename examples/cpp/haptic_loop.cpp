@@ -117,6 +117,7 @@ DeviceWorld buildWorld(double rate) {
     GrabSettings hand;
     hand.frequency = 10.0;  // the coupling's spring-damper, critically damped at 10 Hz
     d.world.grab(d.ball, hand);
+    for (const std::string& warning : d.world.warnings()) std::fprintf(stderr, "warning: %s\n", warning.c_str());  // none with anchors
     d.world.prepare();  // the first step then costs what the next ones do
     return d;
 }

@@ -69,6 +69,8 @@
 
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace flexfit {
 
@@ -168,6 +170,14 @@ public:
     std::uint64_t stepCount() const;
 
     const std::vector<Contact>& contacts() const;  // of the last step's narrow phase
+    // What the world noticed and went on with, in order. Today one kind: a deforming part added
+    // (or given settings) whose restoration constraint takes the default per-step fraction at a
+    // world time step other than the 1 ms it was chosen for, so that it restores faster and
+    // resists loads more stiffly than at 1 ms (defaultFractionAt, part.hpp; the text names both
+    // factors and the two ways out). A fraction other than the default, or a rate, is taken
+    // as chosen; the default value set explicitly cannot be told apart and is reported too.
+    // Scene files and Python report the same in their own key names.
+    const std::vector<std::string>& warnings() const;
     const Profile& profile() const;
     const CollisionWorld& collision() const;
 

@@ -22,6 +22,17 @@ void checkPose(const Pose& pose, const char* what) {
         throw InputError(kSource, 0, std::string(what) + ": the pose must be finite, with a non-zero rotation quaternion");
 }
 
+// World::warnings(): a deforming part's restoration constraint left at its per-step default
+// fraction (no rate) at a world time step other than 1 ms.
+void noteDefaultFraction(detail::WorldData& d, BodyId id, const PartSettings& part) {
+    const RestorationSettings& r = part.simulation.restoration;
+    if (r.constraintRate > 0.0 || r.constraintFraction != RestorationSettings{}.constraintFraction) return;
+    if (const std::optional<DefaultFractionElsewhere> e = defaultFractionAt(part, d.settings.timeStep))
+        d.warnings.push_back("body " + std::to_string(id) + ": " +
+                             describe(*e, {"WorldSettings::timeStep = ", "RestorationSettings::constraintRate = ", " (1/s)",
+                                           "RestorationMethod::AnchorSprings"}));
+}
+
 }  // namespace
 
 World::World(WorldSettings settings) {
@@ -55,6 +66,7 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
     d.collision.add(id, *part, settings.boundingVolume);  // strong: registers all or nothing
     d.bodies.add(std::move(part), body);                   // no throw after the reserve
     d.response.stiffness.push_back(stiffness);
+    noteDefaultFraction(d, id, partSettings);
     return id;
 }
 
@@ -78,7 +90,10 @@ void World::setPartSettings(BodyId id, const PartSettings& settings) {
     Part& part = *data_->bodies.parts[id];
     part.setSettings(settings);
     data_->response.stiffness[id] = detail::effectiveContactStiffness(part, data_->settings.timeStep);
+    noteDefaultFraction(*data_, id, settings);
 }
+
+const std::vector<std::string>& World::warnings() const { return data_->warnings; }
 
 double World::contactStiffness(BodyId id) const {
     checkBody(id, "stiffness");

@@ -23,6 +23,7 @@ struct WorldData {
     RigidMotionScratch rigidMotion;  // the sub-steps' solver and contacts
     AssemblyState assembly;     // the rules and their events
     Profile profile;
+    std::vector<std::string> warnings;  // World::warnings()
     std::uint64_t stepIndex = 0;
     double time = 0.0;
 

@@ -1,6 +1,7 @@
 // The world (src/world/world.cpp): its profile partitions every step among the stages, runs
 // are deterministic, a deformable rim stops or yields to a ball by its stiffness, settings
-// change while it runs, and its calls refuse what does not exist.
+// change while it runs, and its calls refuse what does not exist; the default per-step
+// restoration at another time step is reported in warnings().
 #include "test_bodies.hpp"
 #include "flexfit/flexfit.hpp"
 
@@ -168,6 +169,36 @@ TEST(World, DeformableRimStopsAWeakPushAndYieldsToAStrongOne) {
     const auto [passed, deformedSoft] = run(1e-5, 2500.0);
     EXPECT_LT(passed, -20.0);
     EXPECT_GT(deformedSoft, deformedStiff / 2);
+}
+
+// A deforming part left at the restoration constraint's default per-step fraction, at a time
+// step other than 1 ms, is reported once per add or settings change, word for word; chosen
+// restorations, rigid parts and 1 ms steps are not.
+TEST(World, TheDefaultPerStepRestorationAtAnotherTimeStepIsAWarning) {
+    WorldSettings fast;
+    fast.timeStep = 2e-4;
+    World world(fast);
+    const auto model = buildPartModel(makeTorus1());
+    world.add(model, PartSettings{}, BodySettings{}, Pose{});
+    ASSERT_EQ(world.warnings().size(), 1u);
+    EXPECT_EQ(world.warnings()[0],
+              "body 0: the restoration constraint's default fraction 0.001 is per step, chosen for 1 ms steps: at "
+              "WorldSettings::timeStep = 0.0002 the part restores 5 times as fast and resists loads about 25 times as stiffly; "
+              "RestorationSettings::constraintRate = 0.5 (1/s) keeps the restoration time, RestorationMethod::AnchorSprings a "
+              "stiffness independent of the step");
+    PartSettings rate, fraction, anchors, rigid;
+    rate.simulation.restoration.constraintRate = 0.5;
+    fraction.simulation.restoration.constraintFraction = 2e-3;
+    anchors.simulation.restoration.method = RestorationMethod::AnchorSprings;
+    rigid.mode = PartMode::Rigid;
+    for (const PartSettings& chosen : {rate, fraction, anchors, rigid}) world.add(model, chosen, BodySettings{}, Pose{});
+    EXPECT_EQ(world.warnings().size(), 1u);
+    world.setPartSettings(3, PartSettings{});  // the anchored part back to the default
+    ASSERT_EQ(world.warnings().size(), 2u);
+    EXPECT_EQ(world.warnings()[1].rfind("body 3: the restoration constraint's default fraction", 0), 0u) << world.warnings()[1];
+    World atOneMs;
+    atOneMs.add(model, PartSettings{}, BodySettings{}, Pose{});
+    EXPECT_TRUE(atOneMs.warnings().empty());
 }
 
 TEST(World, PartSettingsChangeWhileRunning) {
