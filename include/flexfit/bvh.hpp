@@ -21,9 +21,9 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <numeric>
 #include <vector>
 
@@ -231,7 +231,7 @@ private:
         return std::size_t(std::partition(first, last, [&](Index i) { return binOf(leaves, i, centres, best.axis) < best.bin; }) - items.begin());
     }
 
-    Split split_ = Split::Centre;
+    Split split_ = Split::Centre;        // the last build()'s
     std::vector<Node> nodes_;
     std::vector<std::int32_t> parents_;  // (nodes) parent node, -1 for the root
     std::vector<Index> leafOf_;          // item -> leaf node
