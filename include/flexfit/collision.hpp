@@ -201,6 +201,8 @@ struct PairCoherence {
     Take lastPlain;
     std::uint32_t plainQueries = 0;        // answered so since it began
     std::uint64_t traversals = 0;          // lists taken
+    std::uint64_t plainTraversals = 0;     // queries answered by a whole traversal (queryPair)
+    std::uint64_t scans = 0;               // queries answered from the list
 };
 
 // queryPair()'s contacts, in the same order, from the pair's last candidates while they still

@@ -132,9 +132,11 @@ public:
     // The bodies whose hierarchy the last narrowPhase() or contactsOf() refitted from their
     // part's changed masses: those parts' lists can be cleared (Part::clearChangedMasses).
     std::span<const BodyId> refittedBodies() const { return refitted_.members(); }
-    // Face queries answered so far, and how many of them needed a traversal (coherent
-    // queries reuse the pair's candidates otherwise). A point-shell pair's sharp faces count
-    // as one face query, always traversed.
+    // Face queries answered so far, and how many of them needed a traversal: every plain
+    // query; a coherent one when it took a list, or when the pair moved too fast for lists and
+    // a whole traversal answered (queryPairCoherent); the other coherent queries scanned the
+    // pair's candidates. A point-shell pair's sharp faces count as one face query, always
+    // traversed.
     std::uint64_t faceQueries() const { return faceQueries_; }
     std::uint64_t faceTraversals() const { return faceTraversals_; }
 

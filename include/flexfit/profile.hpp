@@ -53,7 +53,7 @@ struct Profile {
     std::uint64_t cutMoves = 0;  // sub-step moves cut short by the contact slop (bisected)
     std::uint64_t rigidQueries = 0;  // one body's contact queries inside the sub-steps
     std::uint64_t faceQueries = 0;     // pair queries by face hierarchies, in all
-    std::uint64_t faceTraversals = 0;  // of which traversed the hierarchies (the others reused candidates)
+    std::uint64_t faceTraversals = 0;  // of which traversed the hierarchies (CollisionWorld::faceTraversals; the others scanned candidates)
 };
 
 // The tail of step times a haptic loop cares about (its worst steps, not the mean): the

@@ -247,7 +247,11 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
                        QueryStats& stats) {
     requireBuiltFor(colliderA, colliderB, test);
     const RelativePose bInA = relativePose(a, b);
-    if (c.plain && stillTooFast(colliderA, colliderB, bInA, c)) return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
+    const auto plainTraversal = [&] {
+        ++c.plainTraversals;
+        queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
+    };
+    if (c.plain && stillTooFast(colliderA, colliderB, bInA, c)) return plainTraversal();
     Coverage now = c.valid ? coverageOf(colliderA, colliderB, bInA, c.list) : Coverage{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
     const bool outrun = !(now.slack() <= c.list.margin);
     ++c.queries;
@@ -257,7 +261,7 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
         c.plain = true;
         c.plainQueries = 0;
         notePose(c.lastPlain, colliderA, colliderB, bInA);
-        return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
+        return plainTraversal();
     }
     dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) {
         // The next list: finished now when the current one no longer covers (if it covers, else
@@ -285,10 +289,11 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
         }
         if (!(now.slack() <= c.list.margin)) {  // only when a list taken at once was outrun as it was taken: never at one pose
             c.valid = false;
-            return queryPair(idA, a, colliderA, idB, b, colliderB, test, contacts, stats);
+            return plainTraversal();
         }
         LeafPairTester tester(idA, a, colliderA, idB, b, test, bInA, contacts, stats);
         scanCandidates(bvhA, bvhB, bInA, now.reach, tester, c, contacts, stats);
+        ++c.scans;
     });
     ++c.queriesSince;
 }

@@ -79,9 +79,11 @@ void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, Qu
     }
     KeptCoherence& kept = coherence_[std::uint64_t(a) << 32 | b];
     kept.lastUpdate = updates_;
-    const std::uint64_t traversals = kept.coherence.traversals;
+    // Lists taken, and the whole traversals that answered instead of a list.
+    const auto traversed = [&] { return kept.coherence.traversals + kept.coherence.plainTraversals; };
+    const std::uint64_t before = traversed();
     queryPairCoherent(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, kept.coherence, out, stats);
-    faceTraversals_ += kept.coherence.traversals - traversals;
+    faceTraversals_ += traversed() - before;
 }
 
 void CollisionWorld::queryPointShellPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats) {

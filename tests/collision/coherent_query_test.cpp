@@ -334,12 +334,16 @@ TEST(CoherentQueryCost, MotionThatOutrunsEveryListIsAnsweredByPlainQueriesUntilI
     }
     EXPECT_TRUE(run.coherence.plain);
     EXPECT_LE(run.coherence.traversals, 4u) << "lists taken while every one is outrun at once (16 plain queries each: 8)";
+    EXPECT_GE(run.coherence.plainTraversals, 110u) << "whole traversals answered most of the 130 jumps";
     for (int rest = 0; rest < 17; ++rest, ++step) run.check(step, false);
     EXPECT_FALSE(run.coherence.plain) << "at rest, the plain queries end after their 16";
     EXPECT_TRUE(run.coherence.valid);
-    const std::uint64_t settled = run.coherence.traversals;
+    const std::uint64_t settled = run.coherence.traversals, plainSettled = run.coherence.plainTraversals;
     for (int rest = 0; rest < 50; ++rest, ++step) run.check(step, false);
     EXPECT_EQ(run.coherence.traversals, settled);
+    EXPECT_EQ(run.coherence.plainTraversals, plainSettled);
+    // Every query is answered one way: by a whole traversal or by a scan of the list.
+    EXPECT_EQ(run.coherence.plainTraversals + run.coherence.scans, std::uint64_t(step));
 }
 
 TEST(CoherentQueryCost, ARebuiltHierarchyIsTraversedAgain) {

@@ -1,6 +1,6 @@
 // The narrow phase (narrow_phase.cpp): its contacts against the pairwise queries it stands
-// for, one body's contacts against the whole narrow phase, and the hierarchies refitted only
-// when a query needs them, never by reading them.
+// for, one body's contacts against the whole narrow phase, the hierarchies refitted only
+// when a query needs them, never by reading them, and its traversal count.
 #include "flexfit/flexfit.hpp"
 #include "same_contacts.hpp"
 #include "test_bodies.hpp"
@@ -197,4 +197,35 @@ TEST(NarrowPhase, AWarmUpTakesThePairsFirstTraversalAndChangesNoContact) {
             EXPECT_EQ(cold.world.faceTraversals(), 1u);
         }
     }
+}
+
+TEST(NarrowPhase, FaceTraversalsCountTheWholeTraversalsOfAPairTooFastForLists) {
+    // A ball jumping about a rigid tube, 0.3 a step (far beyond any list's margin): the coherent
+    // query answers nearly every step by a whole traversal, and faceTraversals counts them as
+    // the plain query's count does; at rest, lists answer and the count stops.
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Part torus(buildPartModel(makeTorus(3.0, 1.0, 24, 12)), rigidPart());
+    Part ball(buildPartModel(makeIcoSphere(1.0, 1)), rigidPart());
+    CollisionWorld coherent, plain([] {
+        CollisionSettings settings;
+        settings.coherent = false;
+        return settings;
+    }());
+    for (CollisionWorld* world : {&coherent, &plain}) {
+        world->add(0, torus);
+        world->add(1, ball);
+    }
+    const Vec3 home(3.0, 1.6, 0.0);
+    for (int step = 0; step < 130; ++step) {
+        ball.setPose(Pose{Eigen::Quaterniond::Identity(), home + 0.3 * Vec3(u(rng), u(rng), u(rng))});
+        expectSameContacts(coherent.findContacts(), plain.findContacts(), step);
+    }
+    EXPECT_EQ(plain.faceQueries(), 130u);
+    EXPECT_EQ(plain.faceTraversals(), 130u);
+    EXPECT_EQ(coherent.faceQueries(), 130u);
+    EXPECT_GE(coherent.faceTraversals(), 110u) << "whole traversals answer the jumps";
+    const std::uint64_t jumping = coherent.faceTraversals();
+    for (int step = 0; step < 60; ++step) coherent.findContacts();
+    EXPECT_LE(coherent.faceTraversals(), jumping + 18) << "at rest, at most the 16 plain queries and a list";
 }
