@@ -1,12 +1,13 @@
 // Bounding volumes: the oriented-box test against a corner-projection implementation of its 6
 // face axes (and, for what it leaves out, of all 15 separating axes), and the enclosing
 // constructions against their members; the hierarchy's structure under both splits, and the
-// surface-area split's trees against the centre split's by their area.
+// surface-area split's trees against the centre split's by their area; a refit against a whole one.
 #include "flexfit/flexfit.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <random>
 
@@ -212,4 +213,43 @@ TEST(BoundingVolume, SurfaceAreaSplitsMakeTreesOfLessArea) {
         surface.build(boxes, Bvh<Aabb>::Split::SurfaceArea);
         EXPECT_LT(internalArea(surface), 0.97 * internalArea(centre)) << name;
     }
+}
+
+// A refit of some leaves gives every node the volume a whole bottom-up refit (refitAll) gives,
+// bit for bit: few changed leaves (their ancestors merged deepest first) and many (a scan of
+// every node), boxes and spheres, both splits.
+template <class BV>
+void expectRefitEqualsRefitAll(BV (*volumeAt)(const Vec3&, double)) {
+    using Tree = Bvh<BV>;
+    std::mt19937 rng(21);
+    std::uniform_real_distribution<double> u(-3, 3), r(0.01, 0.3);
+    std::vector<BV> leaves;
+    for (int i = 0; i < 500; ++i) leaves.push_back(volumeAt(Vec3(u(rng), u(rng), u(rng)), r(rng)));
+    for (typename Tree::Split how : {Tree::Split::Centre, Tree::Split::SurfaceArea}) {
+        for (std::size_t changed : {1u, 7u, 40u, 300u}) {
+            Tree tree;
+            tree.build(leaves, how);
+            // Built nodes enclose their leaves directly (encloseAll); a sphere merged from its
+            // children's differs, so both trees start from merged volumes.
+            tree.refitAll([&](Index i) { return leaves[i]; });
+            std::vector<BV> now = leaves;
+            std::vector<Index> items;
+            for (std::size_t k = 0; k < changed; ++k) {
+                const auto item = Index(std::uniform_int_distribution<int>(0, 499)(rng));
+                now[item] = volumeAt(Vec3(u(rng), u(rng), u(rng)), r(rng));
+                items.push_back(item);
+            }
+            Tree whole = tree;
+            tree.refit(items, [&](Index i) { return now[i]; });
+            whole.refitAll([&](Index i) { return now[i]; });
+            for (std::size_t n = 0; n < tree.nodes().size(); ++n)
+                ASSERT_EQ(std::memcmp(&tree.nodes()[n].volume, &whole.nodes()[n].volume, sizeof(BV)), 0)
+                    << "node " << n << ", " << changed << " leaves changed";
+        }
+    }
+}
+
+TEST(BoundingVolume, RefitGivesEveryNodeTheVolumeOfAWholeRefit) {
+    expectRefitEqualsRefitAll<Aabb>([](const Vec3& c, double r) { return Aabb{c.array() - r, c.array() + r}; });
+    expectRefitEqualsRefitAll<Sphere>([](const Vec3& c, double r) { return Sphere{c, r}; });
 }
