@@ -109,8 +109,8 @@ SimulationSettings SimulationOptions::simulationSettings(const PartModel& model)
     if (!stability.message.empty()) fmt::print(stderr, "warning: {}\n", stability.message);
     const bool defaultFraction = fractionOption == nullptr || fractionOption->count() == 0;
     const bool rateGiven = rateOption != nullptr && rateOption->count() > 0;
-    if (s.restoration.method == RestorationMethod::Constraint && defaultFraction && !rateGiven)
-        if (const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(timeStep))
+    if (defaultFraction && !rateGiven)
+        if (const std::optional<DefaultFractionElsewhere> d = defaultFractionAt(s.restoration, timeStep))
             warn("option --dt: " + describe(*d, {"--dt ", "--constraint-rate ", "", "--restore anchors"}));
     return s;
 }

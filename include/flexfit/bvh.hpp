@@ -55,7 +55,6 @@ public:
 
     // Builds over items 0..n-1 with the given leaf volumes.
     void build(std::span<const BV> leafVolumes, Split how = Split::Centre) {
-        split_ = how;
         nodes_.clear();
         parents_.clear();
         maxDepth_ = 0;
@@ -66,7 +65,7 @@ public:
         subtreeEnd_.assign(2 * leafVolumes.size() - 1, 0);
         std::vector<Index> items(leafVolumes.size());
         std::iota(items.begin(), items.end(), Index(0));
-        buildNode(leafVolumes, items, 0, items.size(), -1, 0);
+        buildNode(leafVolumes, items, 0, items.size(), -1, 0, how);
         dirty_.reset(nodes_.size());
     }
 
@@ -126,7 +125,7 @@ public:
 
 private:
     std::int32_t buildNode(std::span<const BV> leaves, std::vector<Index>& items, std::size_t begin, std::size_t end,
-                           std::int32_t parent, std::uint16_t depth) {
+                           std::int32_t parent, std::uint16_t depth, Split how) {
         const auto index = std::int32_t(nodes_.size());
         nodes_.push_back({});
         parents_.push_back(parent);
@@ -141,9 +140,9 @@ private:
             return index;
         }
         nodes_[std::size_t(index)].volume = encloseAll(leaves, range);
-        const std::size_t middle = split_ == Split::SurfaceArea ? splitBySurfaceArea(leaves, items, begin, end) : split(leaves, items, begin, end);
-        const std::int32_t left = buildNode(leaves, items, begin, middle, index, std::uint16_t(depth + 1));
-        const std::int32_t right = buildNode(leaves, items, middle, end, index, std::uint16_t(depth + 1));
+        const std::size_t middle = how == Split::SurfaceArea ? splitBySurfaceArea(leaves, items, begin, end) : split(leaves, items, begin, end);
+        const std::int32_t left = buildNode(leaves, items, begin, middle, index, std::uint16_t(depth + 1), how);
+        const std::int32_t right = buildNode(leaves, items, middle, end, index, std::uint16_t(depth + 1), how);
         nodes_[std::size_t(index)].left = left;
         nodes_[std::size_t(index)].right = right;
         subtreeEnd_[std::size_t(index)] = std::int32_t(nodes_.size());
@@ -244,7 +243,6 @@ private:
         return std::size_t(std::partition(first, last, [&](Index i) { return binOf(leaves, i, centres, best.axis) < best.bin; }) - items.begin());
     }
 
-    Split split_ = Split::Centre;        // the last build()'s
     std::vector<Node> nodes_;
     std::vector<std::int32_t> parents_;  // (nodes) parent node, -1 for the root
     std::vector<Index> leafOf_;          // item -> leaf node

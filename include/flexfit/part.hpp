@@ -76,8 +76,7 @@ struct PartSettings {
     ZoneSettings zones;
 };
 
-// defaultFractionAt (simulation.hpp) for a part: nullopt too for a rigid part or another
-// restoration method.
+// defaultFractionAt (simulation.hpp) for a part's restoration: nullopt too for a rigid part.
 std::optional<DefaultFractionElsewhere> defaultFractionAt(const PartSettings& part, double timeStep);
 
 struct ZoneSeed {

@@ -74,6 +74,9 @@ struct DefaultFractionElsewhere {
     double faster = 1.0, stiffer = 1.0, keepingTime = 0.0;
 };
 std::optional<DefaultFractionElsewhere> defaultFractionAt(double timeStep);
+// The same for a restoration that takes that default: nullopt too for another method, a rate,
+// or another fraction.
+std::optional<DefaultFractionElsewhere> defaultFractionAt(const RestorationSettings& restoration, double timeStep);
 
 // How a reader spells its keys in the warning: "time_step = " then the step; "constraint_rate = "
 // then the rate then " (1/s)"; "restoration = \"anchors\"" (a scene file's spelling).

@@ -218,6 +218,35 @@ namespace {
 
 #define FLEXFIT_AVX2 __attribute__((target("avx2")))
 
+// Lanes of doubles as GCC vector types (the intrinsics' __m256d and __m512d, without their
+// may_alias attribute, which a template argument would drop).
+using Doubles4 = double __attribute__((vector_size(32)));
+using Doubles8 = double __attribute__((vector_size(64)));
+
+// A sample's distance and gradient, as lanes.
+template <class V>
+struct LaneSamples {
+    V distance, gx, gy, gz;
+};
+
+// sample()'s interpolation of the corner values v (x fastest) at the fractions t, and its
+// gradient, for V = Doubles4 or Doubles8: GCC vector types, whose + - * / are each lane's
+// correctly rounded operation (never fused: -ffp-contract=off), so every lane gives sample()'s
+// bits. Inlined into sampleFour and sampleEight, whose targets give it their instructions.
+template <class V>
+[[gnu::always_inline]] inline void interpolateLanes(const V (&v)[8], const V (&t)[3], const V& cell, LaneSamples<V>& out) {
+    const V x0 = 1.0 - t[0], y0 = 1.0 - t[1], z0 = 1.0 - t[2];
+    // Along x, then y, then z; each w0 a + w1 b with both products rounded, then the sum.
+    const V a00 = x0 * v[0] + t[0] * v[1], a10 = x0 * v[2] + t[0] * v[3];
+    const V a01 = x0 * v[4] + t[0] * v[5], a11 = x0 * v[6] + t[0] * v[7];
+    const V b0 = y0 * a00 + t[1] * a10, b1 = y0 * a01 + t[1] * a11;
+    out.distance = z0 * b0 + t[2] * b1;
+    const V dx00 = v[1] - v[0], dx10 = v[3] - v[2], dx01 = v[5] - v[4], dx11 = v[7] - v[6];
+    out.gx = (z0 * (y0 * dx00 + t[1] * dx10) + t[2] * (y0 * dx01 + t[1] * dx11)) / cell;
+    out.gy = (z0 * (a10 - a00) + t[2] * (a11 - a01)) / cell;
+    out.gz = (b1 - b0) / cell;
+}
+
 // What the vector sampler needs of a grid, as lanes.
 struct GridLanes {
     __m256d min[3], hi[3], cell;
@@ -232,16 +261,11 @@ FLEXFIT_AVX2 __m256d clampLanes(__m256d v, __m256d lo, __m256d hi) {
     return _mm256_blendv_pd(_mm256_blendv_pd(v, hi, _mm256_cmp_pd(hi, v, _CMP_LT_OQ)), lo, _mm256_cmp_pd(v, lo, _CMP_LT_OQ));
 }
 
-// w0 a + w1 b, the products rounded, then the sum.
-FLEXFIT_AVX2 inline __m256d mix(__m256d w0, __m256d a, __m256d w1, __m256d b) {
-    return _mm256_add_pd(_mm256_mul_pd(w0, a), _mm256_mul_pd(w1, b));
-}
-
 // Four points' samples as sample(Grid&, p) computes them, lane by lane; false (nothing
 // written) when a corner is not computed yet.
 FLEXFIT_AVX2 bool sampleFour(const GridLanes& g, const Vec3* p, SignedDistanceField::Interpolated* out) {
     const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
-    __m256d t[3];
+    Doubles4 t[3];
     __m128i base[3];
     for (int d = 0; d < 3; ++d) {
         const __m256d x = _mm256_div_pd(_mm256_sub_pd(lanesOf(p, d), g.min[d]), g.cell);
@@ -254,28 +278,20 @@ FLEXFIT_AVX2 bool sampleFour(const GridLanes& g, const Vec3* p, SignedDistanceFi
     const __m128i sy = g.dx, sz = _mm_mullo_epi32(g.dx, g.dy), sx = _mm_set1_epi32(1);
     const __m128i offset[8] = {_mm_setzero_si128(), sx, sy, _mm_add_epi32(sx, sy), sz, _mm_add_epi32(sz, sx), _mm_add_epi32(sz, sy),
                                _mm_add_epi32(_mm_add_epi32(sz, sx), sy)};
-    __m256d v[8];
+    Doubles4 v[8];
     __m256d unknown = zero;
     for (int n = 0; n < 8; ++n) {
         v[n] = _mm256_cvtps_pd(_mm_i32gather_ps(g.values, _mm_add_epi32(node, offset[n]), 4));
         unknown = _mm256_or_pd(unknown, _mm256_cmp_pd(v[n], v[n], _CMP_UNORD_Q));
     }
     if (_mm256_movemask_pd(unknown) != 0) return false;
-    const __m256d x0 = _mm256_sub_pd(one, t[0]), y0 = _mm256_sub_pd(one, t[1]), z0 = _mm256_sub_pd(one, t[2]);
-    const __m256d a00 = mix(x0, v[0], t[0], v[1]), a10 = mix(x0, v[2], t[0], v[3]);
-    const __m256d a01 = mix(x0, v[4], t[0], v[5]), a11 = mix(x0, v[6], t[0], v[7]);
-    const __m256d b0 = mix(y0, a00, t[1], a10), b1 = mix(y0, a01, t[1], a11);
-    const __m256d distance = mix(z0, b0, t[2], b1);
-    const __m256d dx00 = _mm256_sub_pd(v[1], v[0]), dx10 = _mm256_sub_pd(v[3], v[2]);
-    const __m256d dx01 = _mm256_sub_pd(v[5], v[4]), dx11 = _mm256_sub_pd(v[7], v[6]);
-    const __m256d gx = _mm256_div_pd(mix(z0, mix(y0, dx00, t[1], dx10), t[2], mix(y0, dx01, t[1], dx11)), g.cell);
-    const __m256d gy = _mm256_div_pd(mix(z0, _mm256_sub_pd(a10, a00), t[2], _mm256_sub_pd(a11, a01)), g.cell);
-    const __m256d gz = _mm256_div_pd(_mm256_sub_pd(b1, b0), g.cell);
+    LaneSamples<Doubles4> s;
+    interpolateLanes(v, t, g.cell, s);
     alignas(32) double lanes[4][4];
-    _mm256_store_pd(lanes[0], distance);
-    _mm256_store_pd(lanes[1], gx);
-    _mm256_store_pd(lanes[2], gy);
-    _mm256_store_pd(lanes[3], gz);
+    _mm256_store_pd(lanes[0], s.distance);
+    _mm256_store_pd(lanes[1], s.gx);
+    _mm256_store_pd(lanes[2], s.gy);
+    _mm256_store_pd(lanes[3], s.gz);
     for (int i = 0; i < 4; ++i) {
         out[i].distance = lanes[0][i];
         out[i].gradient = Vec3(lanes[1][i], lanes[2][i], lanes[3][i]);
@@ -330,13 +346,9 @@ FLEXFIT_AVX512 inline __m512d clampLanes8(__m512d v, __m512d lo, __m512d hi) {
     return _mm512_mask_blend_pd(_mm512_cmp_pd_mask(v, lo, _CMP_LT_OQ), high, lo);
 }
 
-FLEXFIT_AVX512 inline __m512d mix8(__m512d w0, __m512d a, __m512d w1, __m512d b) {
-    return _mm512_add_pd(_mm512_mul_pd(w0, a), _mm512_mul_pd(w1, b));
-}
-
 FLEXFIT_AVX512 bool sampleEight(const GridLanes8& g, const Vec3* p, SignedDistanceField::Interpolated* out) {
     const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1.0);
-    __m512d t[3];
+    Doubles8 t[3];
     __m256i base[3];
     for (int d = 0; d < 3; ++d) {
         const __m512d x = _mm512_div_pd(_mm512_sub_pd(lanesOf8(p, d), g.min[d]), g.cell);
@@ -348,31 +360,23 @@ FLEXFIT_AVX512 bool sampleEight(const GridLanes8& g, const Vec3* p, SignedDistan
     const __m256i sy = g.dx, sz = _mm256_mullo_epi32(g.dx, g.dy), sx = _mm256_set1_epi32(1);
     const __m256i offset[8] = {_mm256_setzero_si256(), sx, sy, _mm256_add_epi32(sx, sy), sz, _mm256_add_epi32(sz, sx),
                                _mm256_add_epi32(sz, sy), _mm256_add_epi32(_mm256_add_epi32(sz, sx), sy)};
-    __m512d v[8];
+    Doubles8 v[8];
     __mmask8 unknown = 0;
     for (int n = 0; n < 8; ++n) {
         v[n] = _mm512_cvtps_pd(_mm256_i32gather_ps(g.values, _mm256_add_epi32(node, offset[n]), 4));
         unknown |= _mm512_cmp_pd_mask(v[n], v[n], _CMP_UNORD_Q);
     }
     if (unknown != 0) return false;
-    const __m512d x0 = _mm512_sub_pd(one, t[0]), y0 = _mm512_sub_pd(one, t[1]), z0 = _mm512_sub_pd(one, t[2]);
-    const __m512d a00 = mix8(x0, v[0], t[0], v[1]), a10 = mix8(x0, v[2], t[0], v[3]);
-    const __m512d a01 = mix8(x0, v[4], t[0], v[5]), a11 = mix8(x0, v[6], t[0], v[7]);
-    const __m512d b0 = mix8(y0, a00, t[1], a10), b1 = mix8(y0, a01, t[1], a11);
-    const __m512d distance = mix8(z0, b0, t[2], b1);
-    const __m512d dx00 = _mm512_sub_pd(v[1], v[0]), dx10 = _mm512_sub_pd(v[3], v[2]);
-    const __m512d dx01 = _mm512_sub_pd(v[5], v[4]), dx11 = _mm512_sub_pd(v[7], v[6]);
-    const __m512d gx = _mm512_div_pd(mix8(z0, mix8(y0, dx00, t[1], dx10), t[2], mix8(y0, dx01, t[1], dx11)), g.cell);
-    const __m512d gy = _mm512_div_pd(mix8(z0, _mm512_sub_pd(a10, a00), t[2], _mm512_sub_pd(a11, a01)), g.cell);
-    const __m512d gz = _mm512_div_pd(_mm512_sub_pd(b1, b0), g.cell);
+    LaneSamples<Doubles8> s;
+    interpolateLanes(v, t, g.cell, s);
+    // Interpolated is 4 doubles (distance, gradient): each point's as lane i of the 4 vectors.
     static_assert(sizeof(SignedDistanceField::Interpolated) == 4 * sizeof(double));
-// Interpolated is 4 doubles (distance, gradient): each point's as lane i of the 4 vectors.
     const __m512i at = _mm512_setr_epi64(0, 4, 8, 12, 16, 20, 24, 28);
     double* o = &out[0].distance;
-    _mm512_i64scatter_pd(o, at, distance, 8);
-    _mm512_i64scatter_pd(o + 1, at, gx, 8);
-    _mm512_i64scatter_pd(o + 2, at, gy, 8);
-    _mm512_i64scatter_pd(o + 3, at, gz, 8);
+    _mm512_i64scatter_pd(o, at, s.distance, 8);
+    _mm512_i64scatter_pd(o + 1, at, s.gx, 8);
+    _mm512_i64scatter_pd(o + 2, at, s.gy, 8);
+    _mm512_i64scatter_pd(o + 3, at, s.gz, 8);
     return true;
 }
 

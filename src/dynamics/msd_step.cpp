@@ -49,6 +49,12 @@ std::optional<DefaultFractionElsewhere> defaultFractionAt(double timeStep) {
     return d;
 }
 
+std::optional<DefaultFractionElsewhere> defaultFractionAt(const RestorationSettings& r, double timeStep) {
+    if (r.method != RestorationMethod::Constraint || r.constraintRate > 0.0 || r.constraintFraction != RestorationSettings{}.constraintFraction)
+        return std::nullopt;
+    return defaultFractionAt(timeStep);
+}
+
 std::string describe(const DefaultFractionElsewhere& d, const FractionKeys& keys) {
     const auto shortly = [](double x) {
         char text[32];

@@ -39,8 +39,8 @@ struct Part::Zone {
 };
 
 std::optional<DefaultFractionElsewhere> defaultFractionAt(const PartSettings& part, double timeStep) {
-    if (part.mode == PartMode::Rigid || part.simulation.restoration.method != RestorationMethod::Constraint) return std::nullopt;
-    return defaultFractionAt(timeStep);
+    if (part.mode == PartMode::Rigid) return std::nullopt;
+    return defaultFractionAt(part.simulation.restoration, timeStep);
 }
 
 Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)

@@ -25,8 +25,6 @@ void checkPose(const Pose& pose, const char* what) {
 // World::warnings(): a deforming part's restoration constraint left at its per-step default
 // fraction (no rate) at a world time step other than 1 ms.
 void noteDefaultFraction(detail::WorldData& d, BodyId id, const PartSettings& part) {
-    const RestorationSettings& r = part.simulation.restoration;
-    if (r.constraintRate > 0.0 || r.constraintFraction != RestorationSettings{}.constraintFraction) return;
     if (const std::optional<DefaultFractionElsewhere> e = defaultFractionAt(part, d.settings.timeStep))
         d.warnings.push_back("body " + std::to_string(id) + ": " +
                              describe(*e, {"WorldSettings::timeStep = ", "RestorationSettings::constraintRate = ", " (1/s)",
