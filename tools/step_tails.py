@@ -17,10 +17,10 @@ import math
 import re
 import statistics
 import subprocess
-import tempfile
 from pathlib import Path
 
 from ab_stages import percentile  # nearest rank, as every other table here
+from results_table import alternating_runs
 
 COLUMNS = ["first_step_us", "slowest_step_us", "contact_step_us_p50", "contact_step_us_p99", "contact_step_us_max"]
 
@@ -48,13 +48,7 @@ def main():
     ap.add_argument("--csv", required=True)
     args = ap.parse_args()
     builds = [tuple(b.split("=", 1)) for b in args.flexfit]
-    results = {}  # (scene, build) -> [(tails, hash)]
-    with tempfile.TemporaryDirectory() as tmp:
-        for r in range(args.rounds):
-            order = builds if r % 2 == 0 else builds[::-1]
-            for scene in args.scene:
-                for name, path in order:
-                    results.setdefault((scene, name), []).append(run(path, scene, str(Path(tmp) / name)))
+    results = alternating_runs(builds, args.scene, args.rounds, run)  # (scene, build) -> [(tails, hash)]
     with open(args.csv, "w", newline="") as f:
         out = csv.writer(f)
         out.writerow(["scene", "build", *COLUMNS, "state_hash", "rounds"])

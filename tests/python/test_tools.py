@@ -93,3 +93,29 @@ def test_ab_bench_table_takes_medians_over_rounds_and_the_reference_of_the_same_
     assert header[:5] == ["benchmark", "mesh", "before_us", "after_us", "speedup"]
     assert rows == [["BM_Ours/0", "torus1", "6.000", "4.500", f"{6000 / 4500:.3f}", "12.000", "12.000",
                      f"{12000 / 6000:.3f}", f"{12000 / 4500:.3f}", 3]]
+
+
+def test_tail_repeats_tells_a_slow_step_of_every_run_from_stalls_that_move():
+    import tail_repeats
+    # Each run stalls on another step: every step's fastest time is the work's 10 us, each run's
+    # own p99 (nearest rank of 4 steps: the slowest) is its stall, and no slow step repeats.
+    moving = tail_repeats.summary("s.toml", "a", [([10.0, 50.0, 10.0, 10.0], "h"), ([10.0, 10.0, 10.0, 60.0], "h"), ([10.0, 10.0, 40.0, 10.0], "h")])
+    assert (moving["measured_p99"], moving["floor_p50"], moving["floor_p99"], moving["floor_max"]) == (50.0, 10.0, 10.0, 10.0)
+    assert (moving["top_repeat_pct"], moving["top_chance_pct"]) == (0.0, 25.0)
+    # A step slow in every run is the work's: the floor keeps its fastest time, and it repeats.
+    work = tail_repeats.summary("s.toml", "a", [([10.0, 50.0, 12.0], "h"), ([11.0, 45.0, 10.0], "h")])
+    assert (work["floor_p50"], work["floor_p99"], work["top_repeat_pct"]) == (10.0, 45.0, 100.0)
+    # Runs that did not simulate the same steps are not compared.
+    with pytest.raises(SystemExit, match="not one trajectory"):
+        tail_repeats.summary("s.toml", "a", [([10.0], "h"), ([10.0], "g")])
+    assert tail_repeats.summary("s.toml", "a", [([], "h"), ([], "h")])["floor_p99"] == ""
+
+
+def test_tail_repeats_reads_the_step_timer_or_older_builds_stage_sums(tmp_path):
+    import tail_repeats
+    timed = tmp_path / "timed.csv"
+    timed.write_text("time,contacts,us_a,us_world_step\n0.001,0,1.0,7.5\n0.002,3,1.0,2.0\n0.003,4,2.0,9.0\n")
+    assert tail_repeats.contact_step_times(timed) == [2.0, 9.0]
+    older = tmp_path / "older.csv"
+    older.write_text("time,contacts,us_a,us_b\n0.001,2,1.0,2.5\n0.002,0,1.0,7.0\n")
+    assert tail_repeats.contact_step_times(older) == [3.5]
