@@ -116,6 +116,65 @@ inline double parseCoordinate(std::string_view token, const std::string& source,
 }
 
 // The whole file as text; InputError naming it when it is missing, not a file, or unreadable.
+// Code point c (at most 0x10FFFF) appended to `out` in UTF-8.
+inline void appendUtf8(std::string& out, char32_t c) {
+    if (c < 0x80) {
+        out += char(c);
+    } else if (c < 0x800) {
+        out += char(0xC0 | (c >> 6));
+        out += char(0x80 | (c & 0x3F));
+    } else if (c < 0x10000) {
+        out += char(0xE0 | (c >> 12));
+        out += char(0x80 | ((c >> 6) & 0x3F));
+        out += char(0x80 | (c & 0x3F));
+    } else {
+        out += char(0xF0 | (c >> 18));
+        out += char(0x80 | ((c >> 12) & 0x3F));
+        out += char(0x80 | ((c >> 6) & 0x3F));
+        out += char(0x80 | (c & 0x3F));
+    }
+}
+
+// UTF-16 `units` (the bytes after the byte order mark) as UTF-8: the same lines, so the readers'
+// line numbers stay the file's. Text cut short (an odd number of bytes) or an unpaired
+// surrogate is an InputError of `source`, with the line it is on.
+inline std::string utf8FromUtf16(std::string_view units, bool bigEndian, const std::string& source) {
+    if (units.size() % 2 != 0) throw InputError(source, 0, "UTF-16 text cut short: an odd number of bytes");
+    const auto unitAt = [&](std::size_t i) {
+        const auto high = static_cast<unsigned char>(units[bigEndian ? i : i + 1]);
+        const auto low = static_cast<unsigned char>(units[bigEndian ? i + 1 : i]);
+        return char32_t(high << 8 | low);
+    };
+    std::string out;
+    out.reserve(units.size() / 2);
+    std::size_t line = 1;
+    for (std::size_t i = 0; i < units.size(); i += 2) {
+        char32_t c = unitAt(i);
+        if (c >= 0xDC00 && c <= 0xDFFF) throw InputError(source, line, "invalid UTF-16: a low surrogate with no high one before it");
+        if (c >= 0xD800 && c <= 0xDBFF) {
+            const char32_t low = i + 2 < units.size() ? unitAt(i + 2) : 0;
+            if (!(low >= 0xDC00 && low <= 0xDFFF)) throw InputError(source, line, "invalid UTF-16: a high surrogate with no low one after it");
+            c = 0x10000 + ((c - 0xD800) << 10) + (low - 0xDC00);
+            i += 2;
+        }
+        line += c == U'\n' ? 1 : 0;
+        appendUtf8(out, c);
+    }
+    return out;
+}
+
+// A text file's bytes as the readers take them: UTF-16 with its byte order mark (Windows tools
+// write it: PowerShell's redirection, Notepad's "Unicode") turned into UTF-8, anything else as
+// it is (a UTF-8 mark is LineCursor's to skip). UTF-32 is refused.
+inline std::string decodedText(std::string bytes, const std::string& source) {
+    const std::string_view b = bytes;
+    if (b.substr(0, 4) == std::string_view("\x00\x00\xFE\xFF", 4) || b.substr(0, 4) == std::string_view("\xFF\xFE\x00\x00", 4))
+        throw InputError(source, 0, "UTF-32 text (its byte order mark) is not read: save the file as UTF-8 or ASCII");
+    if (b.substr(0, 2) == "\xFE\xFF") return utf8FromUtf16(b.substr(2), true, source);
+    if (b.substr(0, 2) == "\xFF\xFE") return utf8FromUtf16(b.substr(2), false, source);
+    return bytes;
+}
+
 inline std::string readTextFile(const std::filesystem::path& path) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))

@@ -115,6 +115,50 @@ TEST(ObjIo, ConvexPolygonsAreFansUnlessACornerIsOnAStraightEdge) {
     expectExactCover(t.mesh, 4.0);
 }
 
+// `text` as UTF-16 bytes with its byte order mark, in either byte order.
+std::string utf16Bytes(const std::u16string& text, bool bigEndian) {
+    std::string out = bigEndian ? "\xFE\xFF" : "\xFF\xFE";
+    for (const char16_t unit : text) {
+        const char high = char(unit >> 8), low = char(unit & 0xFF);
+        out += bigEndian ? std::string{high, low} : std::string{low, high};
+    }
+    return out;
+}
+
+TEST(ObjIo, UTF16TextReadsAsItsUTF8) {
+    // Windows tools write UTF-16 (PowerShell's redirection, Notepad's "Unicode"): it had read as
+    // an empty mesh. A comment beyond the basic plane (a surrogate pair) and one beyond ASCII.
+    const std::u16string text = u"# gr\u00f6\u00dfe \U0001F600\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+    TempDir dir;
+    const MeshReadResult expected = readMesh(dir.write("plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n"));
+    for (const bool bigEndian : {true, false}) {
+        const MeshReadResult r = readMesh(dir.write("u16.obj", utf16Bytes(text, bigEndian)));
+        EXPECT_EQ(r.mesh.vertices, expected.mesh.vertices) << bigEndian;
+        EXPECT_EQ(r.mesh.faces, expected.mesh.faces) << bigEndian;
+        EXPECT_TRUE(r.diagnostics.warnings.empty()) << bigEndian;
+        // The file's lines: a bad face on line 3 is named there.
+        const InputError e = readObjError(utf16Bytes(u"v 0 0 0\nv 1 0 0\nf 1 2 9\n", bigEndian));
+        EXPECT_EQ(e.line(), 3u) << e.what();
+    }
+    // Cut short, an unpaired surrogate (on line 2), and UTF-32: refused, saying why.
+    std::string odd = utf16Bytes(u"v 0 0 0\n", true);
+    odd.pop_back();
+    EXPECT_TRUE(contains(readObjError(odd).what(), "UTF-16 text cut short")) << readObjError(odd).what();
+    const InputError lone = readObjError(utf16Bytes(u"v 0 0 0\n# \xD800 x\n", false));
+    EXPECT_EQ(lone.line(), 2u);
+    EXPECT_TRUE(contains(lone.what(), "a high surrogate with no low one")) << lone.what();
+    const InputError low = readObjError(utf16Bytes(u"# \xDC00\n", true));
+    EXPECT_TRUE(contains(low.what(), "a low surrogate with no high one")) << low.what();
+    EXPECT_TRUE(contains(readObjError(std::string("\xFF\xFE\0\0v 0 0 0\n", 12)).what(), "UTF-32"));
+    // Debian's assimp test model in UTF-16 (big-endian): the box its UTF-8 twin holds.
+    const std::filesystem::path models = "/usr/share/assimp/models/OBJ";
+    if (!std::filesystem::exists(models / "box_UTF16BE.obj")) GTEST_SKIP() << "assimp-testmodels not installed";
+    const MeshReadResult box = readMesh(models / "box.obj"), box16 = readMesh(models / "box_UTF16BE.obj");
+    EXPECT_EQ(box16.mesh.vertices, box.mesh.vertices);
+    EXPECT_EQ(box16.mesh.faces, box.mesh.faces);
+    EXPECT_EQ(box16.mesh.faces.size(), 12u);
+}
+
 TEST(ObjIo, ConcavePolygonsAreClippedByEars) {
     // An L of area 3, started at a corner that does not see every other one.
     TempDir dir;
