@@ -8,6 +8,7 @@
 #include "flexfit/mesh_io.hpp"
 
 #include "io/scene_document.hpp"
+#include "io/text_lines.hpp"
 
 #include <toml++/toml.h>
 
@@ -685,7 +686,7 @@ Scene loadScene(const std::filesystem::path& file, const SceneReadOptions& optio
     if (!in) throw InputError(file.string(), 0, "cannot open the scene file");
     std::ostringstream text;
     text << in.rdbuf();
-    return parseScene(text.str(), file.string(), file.parent_path(), options);
+    return parseScene(detail::decodedText(text.str(), file.string()), file.string(), file.parent_path(), options);
 }
 
 }  // namespace flexfit

@@ -3,6 +3,7 @@
 
 #include "core/fnv1a.hpp"
 #include "io/scene_document.hpp"
+#include "io/text_lines.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -33,7 +34,7 @@ std::string readText(const std::filesystem::path& file, const char* what) {
     if (!in) throw InputError(file.string(), 0, std::string("cannot open the ") + what);
     std::ostringstream text;
     text << in.rdbuf();
-    return text.str();
+    return detail::decodedText(text.str(), file.string());
 }
 
 toml::table parseText(const std::string& text, const std::filesystem::path& file) {

@@ -124,6 +124,28 @@ TEST(SceneFile, SyntaxErrorNamesTheLine) {
         << errorOf(withLine("[world]", "time_step = = 3"));
 }
 
+TEST(SceneFile, AUTF16SceneReadsAsItsUTF8WithItsLines) {
+    // What Windows tools write (PowerShell's redirection): little-endian UTF-16 after its mark.
+    const auto utf16 = [](const std::string& ascii) {
+        std::string out = "\xFF\xFE";
+        for (const char c : ascii) out += std::string{c, '\0'};
+        return out;
+    };
+    flexfit::testing::TempDir dir;
+    const Scene s = loadScene(dir.write("scene.toml", utf16(kBall)));
+    const Scene expected = parseScene(kBall, "scene.toml", dir.path());
+    ASSERT_EQ(s.parts.size(), expected.parts.size());
+    EXPECT_EQ(s.parts[1].pose.translation, expected.parts[1].pose.translation);
+    ASSERT_EQ(s.actions.size(), 2u);
+    EXPECT_EQ(s.actions[1].line, 32u);  // the file's line
+    try {
+        loadScene(dir.write("bad.toml", utf16(withLine("[world]", "time_step = = 3"))));
+        FAIL() << "a syntax error was read";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.line(), 3u) << e.what();
+    }
+}
+
 TEST(SceneFile, UnknownKeyIsReported) {
     const std::string e = errorOf(withLine("name = \"ball\"", "densty = 2"));
     EXPECT_NE(e.find("scene.toml:18: part 2, key 'densty': unknown key"), std::string::npos) << e;
