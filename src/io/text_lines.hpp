@@ -115,7 +115,6 @@ inline double parseCoordinate(std::string_view token, const std::string& source,
     return value;
 }
 
-// The whole file as text; InputError naming it when it is missing, not a file, or unreadable.
 // Code point c (at most 0x10FFFF) appended to `out` in UTF-8.
 inline void appendUtf8(std::string& out, char32_t c) {
     if (c < 0x80) {
@@ -147,7 +146,8 @@ inline std::string utf8FromUtf16(std::string_view units, bool bigEndian, const s
     };
     std::string out;
     out.reserve(units.size() / 2);
-    std::size_t line = 1;
+    std::size_t line = 1;  // counted as LineCursor counts: "\r\n", '\n' or '\r' ends one
+    char32_t previous = 0;
     for (std::size_t i = 0; i < units.size(); i += 2) {
         char32_t c = unitAt(i);
         if (c >= 0xDC00 && c <= 0xDFFF) throw InputError(source, line, "invalid UTF-16: a low surrogate with no high one before it");
@@ -157,7 +157,8 @@ inline std::string utf8FromUtf16(std::string_view units, bool bigEndian, const s
             c = 0x10000 + ((c - 0xD800) << 10) + (low - 0xDC00);
             i += 2;
         }
-        line += c == U'\n' ? 1 : 0;
+        line += c == U'\r' || (c == U'\n' && previous != U'\r') ? 1 : 0;
+        previous = c;
         appendUtf8(out, c);
     }
     return out;
@@ -175,6 +176,7 @@ inline std::string decodedText(std::string bytes, const std::string& source) {
     return bytes;
 }
 
+// The whole file as text; InputError naming it when it is missing, not a file, or unreadable.
 inline std::string readTextFile(const std::filesystem::path& path) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))

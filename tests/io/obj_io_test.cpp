@@ -147,6 +147,7 @@ TEST(ObjIo, UTF16TextReadsAsItsUTF8) {
     const InputError lone = readObjError(utf16Bytes(u"v 0 0 0\n# \xD800 x\n", false));
     EXPECT_EQ(lone.line(), 2u);
     EXPECT_TRUE(contains(lone.what(), "a high surrogate with no low one")) << lone.what();
+    EXPECT_EQ(readObjError(utf16Bytes(u"v 0 0 0\r\nv 1 0 0\r# \xD800\n", true)).line(), 3u);  // "\r\n" and '\r' end lines
     const InputError low = readObjError(utf16Bytes(u"# \xDC00\n", true));
     EXPECT_TRUE(contains(low.what(), "a low surrogate with no high one")) << low.what();
     EXPECT_TRUE(contains(readObjError(std::string("\xFF\xFE\0\0v 0 0 0\n", 12)).what(), "UTF-32"));
