@@ -5,11 +5,30 @@
 #include <fmt/core.h>
 
 #include <charconv>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
 namespace flexfit::cli {
+
+namespace {
+
+// A validator of numbers for which accepts(value) holds, `what` naming them in its message.
+CLI::Validator numberCheck(bool (*accepts)(double), const std::string& what, const std::string& description) {
+    return CLI::Validator(
+        [accepts, what](std::string& text) {
+            double value = 0.0;
+            if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) && accepts(value)) return std::string();
+            return text + " is not a finite number " + what;
+        },
+        description);
+}
+
+}  // namespace
+
+const CLI::Validator positiveNumber = numberCheck([](double v) { return v > 0.0; }, "> 0", "POSITIVE");
+const CLI::Validator nonNegativeNumber = numberCheck([](double v) { return v >= 0.0; }, ">= 0", "NONNEGATIVE");
 
 void warn(const std::string& text) { fmt::print(stderr, "warning: {}\n", text); }
 
@@ -85,7 +104,7 @@ MeshReadOptions MeshOptions::read() const {
 void addMeshOptions(CLI::App* cmd, MeshOptions& options, bool weld) {
     if (weld)
         options.weldOption = cmd->add_option("--weld", options.weld, "Weld vertices closer than this distance (default: near-duplicates, 1e-6 of the diagonal)")
-                                 ->check(CLI::NonNegativeNumber);
+                                 ->check(nonNegativeNumber);
     cmd->add_flag("--strict", options.strict,
                   "Refuse meshes with geometric defects (degenerate or duplicate faces, near-duplicate or unused vertices, "
                   "inconsistent windings) instead of repairing them");

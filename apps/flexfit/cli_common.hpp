@@ -14,6 +14,12 @@
 
 namespace flexfit::cli {
 
+// Checks of a number option with plain messages ("--edge: -1 is not a finite number > 0"):
+// CLI11 2.1's PositiveNumber and NonNegativeNumber let NaN through and print their range's end,
+// the largest double, in 309 digits.
+extern const CLI::Validator positiveNumber;     // finite, > 0
+extern const CLI::Validator nonNegativeNumber;  // finite, >= 0
+
 // "x,y,z" -> Vec3; throws InputError naming `option`.
 Vec3 parseVec3(const std::string& text, const std::string& option);
 // "MASS:FX,FY,FZ" -> PointLoad; throws InputError naming `option`.

@@ -99,7 +99,7 @@ void registerCollide(CLI::App& app) {
     cmd->add_option("--test", opt->test, "Exact test: triangle (triangle-triangle) or sphere (thesis: sphere-triangle)")
         ->check(CLI::IsMember(enumChoices<ExactTest>()))->capture_default_str();
     cmd->add_flag("--json", opt->json, "Print one JSON object with every contact");
-    cmd->add_option("--max", opt->maxPrint, "Contacts listed in the text output")->check(CLI::NonNegativeNumber)->capture_default_str();
+    cmd->add_option("--max", opt->maxPrint, "Contacts listed in the text output")->check(nonNegativeNumber)->capture_default_str();
     cmd->callback([opt] { run(*opt); });
 }
 

@@ -381,7 +381,7 @@ void registerExperimentBallTorus(CLI::App& experiment) {
                                                         "rigid-deformable, with friction, and the snap jump");
     auto opt = std::make_shared<Options>();
     cmd->add_option("--out", opt->out, "Output directory")->capture_default_str();
-    cmd->add_option("--duration", opt->duration, "Simulated seconds per run")->capture_default_str()->check(CLI::PositiveNumber);
+    cmd->add_option("--duration", opt->duration, "Simulated seconds per run")->capture_default_str()->check(positiveNumber);
     cmd->add_option("--segments-u", opt->u, "Mouth segments around the ring")->capture_default_str()->check(CLI::Range(3, 4096));
     cmd->add_option("--segments-v", opt->v, "Mouth segments around the tube")->capture_default_str()->check(CLI::Range(3, 4096));
     cmd->add_option("--friction", opt->frictions,

@@ -157,10 +157,10 @@ void registerExperimentContact(CLI::App& experiment) {
     cmd->add_option("--out", opt->out, "Output directory")->capture_default_str();
     cmd->add_option("--depth", opt->pressDepth, "Overlap of the tubes at the deepest point")->check(CLI::Range(0.0, 4.0))
         ->capture_default_str();
-    cmd->add_option("--speed", opt->speed, "Speed of the rigid torus (units/s)")->check(CLI::PositiveNumber)->capture_default_str();
-    cmd->add_option("--hold", opt->hold, "Seconds at the deepest point")->check(CLI::NonNegativeNumber)->capture_default_str();
-    cmd->add_option("--max-time", opt->maxTime, "Simulated seconds at most")->check(CLI::PositiveNumber)->capture_default_str();
-    cmd->add_option("--frames-every", opt->frameEvery, "Seconds between OBJ frames (0: none)")->check(CLI::NonNegativeNumber)
+    cmd->add_option("--speed", opt->speed, "Speed of the rigid torus (units/s)")->check(positiveNumber)->capture_default_str();
+    cmd->add_option("--hold", opt->hold, "Seconds at the deepest point")->check(nonNegativeNumber)->capture_default_str();
+    cmd->add_option("--max-time", opt->maxTime, "Simulated seconds at most")->check(positiveNumber)->capture_default_str();
+    cmd->add_option("--frames-every", opt->frameEvery, "Seconds between OBJ frames (0: none)")->check(nonNegativeNumber)
         ->capture_default_str();
     cmd->add_option("--bv", opt->bv, "Bounding volume")->check(CLI::IsMember(enumChoices<BoundingVolumeKind>()))->capture_default_str();
     cmd->add_option("--test", opt->test, "Exact test")->check(CLI::IsMember(enumChoices<ExactTest>()))->capture_default_str();

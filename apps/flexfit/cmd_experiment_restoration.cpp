@@ -344,16 +344,16 @@ void registerExperimentRestoration(CLI::App& experiment) {
     auto* cmd = experiment.add_subcommand("restoration", "Thesis Table 4.2 and Fig. 4.5/4.6: restoration of torus1");
     auto opt = std::make_shared<ExperimentOptions>();
     cmd->add_option("--out", opt->out, "Output directory")->capture_default_str();
-    cmd->add_option("--force", opt->force, "Force along +x (N)")->check(CLI::PositiveNumber)->capture_default_str();
-    cmd->add_option("--load-duration", opt->loadDuration, "Seconds the force acts")->check(CLI::PositiveNumber)->capture_default_str();
-    cmd->add_option("--max-duration", opt->maxDuration, "Simulated seconds at most per material")->check(CLI::PositiveNumber)
+    cmd->add_option("--force", opt->force, "Force along +x (N)")->check(positiveNumber)->capture_default_str();
+    cmd->add_option("--load-duration", opt->loadDuration, "Seconds the force acts")->check(positiveNumber)->capture_default_str();
+    cmd->add_option("--max-duration", opt->maxDuration, "Simulated seconds at most per material")->check(positiveNumber)
         ->capture_default_str();
-    cmd->add_option("--dt", opt->timeStep, "Time step (s)")->check(CLI::PositiveNumber)->capture_default_str();
-    cmd->add_option("--global-damping", opt->globalDamping, "Global damping gamma (kg/s)")->check(CLI::NonNegativeNumber)
+    cmd->add_option("--dt", opt->timeStep, "Time step (s)")->check(positiveNumber)->capture_default_str();
+    cmd->add_option("--global-damping", opt->globalDamping, "Global damping gamma (kg/s)")->check(nonNegativeNumber)
         ->capture_default_str();
     cmd->add_option("--mass", opt->mass, "Loaded mass")->check(CLI::Range(0, 575))->capture_default_str();
     cmd->add_option("--cost-steps", opt->costSteps, "Steps per round when timing the restoration methods")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(positiveNumber)->capture_default_str();
     cmd->add_flag("!--no-plots", opt->plots, "Skip the PNG plots");
     cmd->add_option("--kicks", opt->kicks, "Calibration: kick sizes along +x (m/s) on --mass, the thesis's perturbation")
         ->delimiter(',')->capture_default_str();

@@ -207,9 +207,9 @@ void registerExperimentZones(CLI::App& experiment) {
     cmd->add_option("--out", opt->out, "Output directory")->capture_default_str();
     cmd->add_option("--max-zones", opt->maxZones, "Zones 1..N")->check(CLI::Range(1, 64))->capture_default_str();
     cmd->add_option("--max-level", opt->maxLevel, "Levels 1..N")->check(CLI::Range(1, 64))->capture_default_str();
-    cmd->add_option("--min-time", opt->minTime, "Seconds of stepping per measurement")->check(CLI::PositiveNumber)
+    cmd->add_option("--min-time", opt->minTime, "Seconds of stepping per measurement")->check(positiveNumber)
         ->capture_default_str();
-    cmd->add_option("--force", opt->force, "Force on each seed per step (N)")->check(CLI::NonNegativeNumber)->capture_default_str();
+    cmd->add_option("--force", opt->force, "Force on each seed per step (N)")->check(nonNegativeNumber)->capture_default_str();
     cmd->add_flag("!--no-plots", opt->plots, "Skip the PNG plots");
     cmd->callback([opt] { run(*opt); });
 }

@@ -39,7 +39,7 @@ void registerRemesh(CLI::App& app) {
     auto opt = std::make_shared<Options>();
     cmd->add_option("input", opt->in, "Input mesh")->required();
     cmd->add_option("output", opt->out, "Output mesh (.tri or .obj)")->required();
-    cmd->add_option("--edge", opt->remesh.targetEdge, "Target edge length, in the mesh's units")->required()->check(CLI::PositiveNumber);
+    cmd->add_option("--edge", opt->remesh.targetEdge, "Target edge length, in the mesh's units")->required()->check(positiveNumber);
     cmd->add_option("--iterations", opt->remesh.iterations, "Remeshing rounds")->capture_default_str()->check(CLI::Range(1, 100));
     cmd->add_option("--feature-angle", opt->remesh.featureAngle, "Edges whose faces meet at more than this many degrees stay sharp")
         ->capture_default_str()->check(CLI::Range(0.0, 180.0));

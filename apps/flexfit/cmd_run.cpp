@@ -21,12 +21,12 @@ void registerRun(CLI::App& app) {
     };
     auto opt = std::make_shared<Options>();
     cmd->add_option("scene", opt->scene, "Scene file (.toml)")->required();
-    cmd->add_option("--duration", opt->duration, "Simulated seconds (default: the scene's [world] duration)")->check(CLI::PositiveNumber);
+    cmd->add_option("--duration", opt->duration, "Simulated seconds (default: the scene's [world] duration)")->check(positiveNumber);
     cmd->add_option("--out", opt->out, "Directory for metrics.csv, summary.json and OBJ frames");
     cmd->add_flag("--no-progress", opt->noProgress, "No progress bar");
-    cmd->add_option("--obj-every", opt->objEvery, "Seconds between OBJ frames (default: the scene's [output]; 0: none)")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--vtk-every", opt->vtkEvery, "Seconds between VTK frames for ParaView (frame_*.vtp, frames.pvd; 0: none)")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--glb-every", opt->glbEvery, "Seconds between glTF binary frames for Blender (frame_*.glb; 0: none)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--obj-every", opt->objEvery, "Seconds between OBJ frames (default: the scene's [output]; 0: none)")->check(nonNegativeNumber);
+    cmd->add_option("--vtk-every", opt->vtkEvery, "Seconds between VTK frames for ParaView (frame_*.vtp, frames.pvd; 0: none)")->check(nonNegativeNumber);
+    cmd->add_option("--glb-every", opt->glbEvery, "Seconds between glTF binary frames for Blender (frame_*.glb; 0: none)")->check(nonNegativeNumber);
     addSceneOptions(cmd, opt->read);
     cmd->callback([opt] {
         const Scene scene = loadScene(opt->scene, opt->read.read());

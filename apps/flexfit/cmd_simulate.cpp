@@ -169,8 +169,8 @@ void registerSimulate(CLI::App& app) {
     cmd->add_option("--force", opt->forces, "Point load MASS:FX,FY,FZ (repeatable)");
     cmd->add_option("--kick", opt->kicks,
                     "Velocity change MASS:VX,VY,VZ (m/s) of one mass at the start, the thesis's perturbation (repeatable)");
-    cmd->add_option("--force-duration", opt->forceDuration, "Seconds the loads act before release")->check(CLI::NonNegativeNumber)->capture_default_str();
-    cmd->add_option("--duration", opt->duration, "Simulated seconds")->check(CLI::PositiveNumber)->capture_default_str();
+    cmd->add_option("--force-duration", opt->forceDuration, "Seconds the loads act before release")->check(nonNegativeNumber)->capture_default_str();
+    cmd->add_option("--duration", opt->duration, "Simulated seconds")->check(positiveNumber)->capture_default_str();
     cmd->add_option("--threshold", opt->thresholds, "Activity thresholds (length units)")->capture_default_str();
     cmd->add_option("--mode", opt->mode, "rigid (never deforms), rigid-deformable (zones), full-deformable (whole-mesh MSD)")
         ->check(CLI::IsMember(enumChoices<PartMode>()))->capture_default_str();
@@ -183,8 +183,8 @@ void registerSimulate(CLI::App& app) {
         ->check(CLI::IsMember({"locality", "as_given"}))->capture_default_str();
     cmd->add_flag("--until-restored", opt->untilRestored, "Stop once every threshold has restored after the release");
     cmd->add_option("--csv", opt->csv, "Per-step metrics CSV");
-    cmd->add_option("--every", opt->every, "Write every N-th step to the CSV")->check(CLI::PositiveNumber)->capture_default_str();
-    cmd->add_option("--obj-at", opt->objTimes, "Times (s) at which to write the deformed mesh as OBJ")->delimiter(',')->check(CLI::NonNegativeNumber);
+    cmd->add_option("--every", opt->every, "Write every N-th step to the CSV")->check(positiveNumber)->capture_default_str();
+    cmd->add_option("--obj-at", opt->objTimes, "Times (s) at which to write the deformed mesh as OBJ")->delimiter(',')->check(nonNegativeNumber);
     cmd->add_option("--obj-prefix", opt->objPrefix, "Path prefix of the OBJ frames")->capture_default_str();
     cmd->callback([opt] { run(*opt); });
 }

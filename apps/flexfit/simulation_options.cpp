@@ -11,15 +11,15 @@ namespace flexfit::cli {
 void SimulationOptions::addTo(CLI::App& cmd) {
     auto* preset = cmd.add_option("--material", material, "Spring material preset (thesis Table 4.1)")
                        ->check(CLI::IsMember({"rigid", "elastic", "superelastic"}))->capture_default_str();
-    auto* k = cmd.add_option("--stiffness", stiffness, "Spring stiffness k (overrides the preset)")->check(CLI::NonNegativeNumber);
-    auto* b = cmd.add_option("--damping", damping, "Spring damping b (overrides the preset)")->check(CLI::NonNegativeNumber);
-    auto* m = cmd.add_option("--mass", vertexMass, "Mass of every vertex (kg)")->check(CLI::PositiveNumber)->capture_default_str();
+    auto* k = cmd.add_option("--stiffness", stiffness, "Spring stiffness k (overrides the preset)")->check(nonNegativeNumber);
+    auto* b = cmd.add_option("--damping", damping, "Spring damping b (overrides the preset)")->check(nonNegativeNumber);
+    auto* m = cmd.add_option("--mass", vertexMass, "Mass of every vertex (kg)")->check(positiveNumber)->capture_default_str();
     // A physical material (the mesh in metres): it gives the springs and the masses.
     auto* e = cmd.add_option("--youngs-modulus", shell.youngsModulus,
                              "Physical material: Young's modulus (Pa) of a shell of the surface; needs --thickness and --density")
-                  ->check(CLI::PositiveNumber);
-    auto* t = cmd.add_option("--thickness", shell.thickness, "Physical material: shell thickness (m)")->check(CLI::PositiveNumber);
-    auto* rho = cmd.add_option("--density", shell.density, "Physical material: density (kg/m^3)")->check(CLI::PositiveNumber);
+                  ->check(positiveNumber);
+    auto* t = cmd.add_option("--thickness", shell.thickness, "Physical material: shell thickness (m)")->check(positiveNumber);
+    auto* rho = cmd.add_option("--density", shell.density, "Physical material: density (kg/m^3)")->check(positiveNumber);
     auto* nu = cmd.add_option("--poisson-ratio", shell.poissonRatio, "Physical material: Poisson's ratio [0, 0.5) (bending rigidity)")
                    ->check(CLI::Validator(
                        [](std::string& text) {
@@ -30,25 +30,25 @@ void SimulationOptions::addTo(CLI::App& cmd) {
                        "FLOAT in [0, 0.5)"))
                    ->capture_default_str();
     auto* zeta = cmd.add_option("--damping-ratio", shell.dampingRatio, "Physical material: damping ratio of each spring")
-                     ->check(CLI::NonNegativeNumber)->capture_default_str();
+                     ->check(nonNegativeNumber)->capture_default_str();
     auto* bend = cmd.add_flag("--bending-springs", shell.bendingSprings, "Physical material: a spring across each interior edge");
     e->needs(t)->needs(rho)->excludes(preset)->excludes(k)->excludes(b)->excludes(m);
     for (CLI::Option* o : {t, rho, nu, zeta, bend}) o->needs(e);
     cmd.add_option("--restore", restore, "Shape restoration: " + nameList<RestorationMethod>())
         ->check(CLI::IsMember(enumChoices<RestorationMethod>()))->capture_default_str();
     cmd.add_option("--anchor-stiffness", anchorStiffness, "Anchor spring k_a (default: the material's k; a physical material's mean spring k)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(nonNegativeNumber);
     cmd.add_option("--anchor-damping", anchorDamping, "Anchor spring b_a (default: the material's b; a physical material's mean spring b)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(nonNegativeNumber);
     fractionOption = cmd.add_option("--constraint-fraction", constraintFraction, "Share of the separation restored per step (0, 1]")
                          ->capture_default_str();
     rateOption = cmd.add_option("--constraint-rate", constraintRate,
                    "Restoration as a rate (1/s), the same restoration time at any --dt; replaces --constraint-fraction")
-        ->check(CLI::NonNegativeNumber);
+        ->check(nonNegativeNumber);
     cmd.add_option("--integrator", integrator, "Time integrator: " + nameList<Integrator>())
         ->check(CLI::IsMember(enumChoices<Integrator>()))->capture_default_str();
     cmd.add_option("--implicit-iterations", implicitIterations, "Implicit integrator: conjugate-gradient iterations at most")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(positiveNumber)->capture_default_str();
     cmd.add_option("--implicit-tolerance", implicitTolerance,
                    "Implicit integrator: relative residual to stop at (0: always run every iteration)")
         ->check(CLI::Range(0.0, 0.999999))->capture_default_str();

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <limits>
 
 using namespace flexfit;
 using namespace flexfit::viewer;
@@ -25,10 +26,10 @@ int main(int argc, char** argv) {
     bool egl = false, hidden = false;
     std::vector<std::string> show;
     cli.add_option("scene", scene, "scene file (TOML)")->required()->check(CLI::ExistingFile);
-    cli.add_option("--frames", frames, "render this many frames at 60 Hz of simulated time, then exit (headless)")->check(CLI::NonNegativeNumber);
+    cli.add_option("--frames", frames, "render this many frames at 60 Hz of simulated time, then exit (headless)")->check(CLI::Range(0, std::numeric_limits<int>::max()));
     cli.add_option("--screenshot", screenshotFile, "after the last frame, save a PNG here");
     cli.add_option("--record", recordDir, "save every K-th frame as DIR/frame_NNNNN.png");
-    cli.add_option("--every", every, "K for --record")->check(CLI::PositiveNumber);
+    cli.add_option("--every", every, "K for --record")->check(CLI::Range(1, std::numeric_limits<int>::max()));
     cli.add_option("--width", width, "image or window width in pixels")->check(CLI::Range(64, 8192));
     cli.add_option("--height", height, "image or window height in pixels")->check(CLI::Range(64, 8192));
     cli.add_flag("--egl", egl, "render with EGL surfaceless (no X server needed; implies headless)");
