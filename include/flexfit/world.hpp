@@ -157,7 +157,8 @@ public:
     // end of the step, throws DivergenceError (core.hpp) naming the body, the time at the start
     // of the step and the likely cause (the part's time step above its stability bound, or a
     // force beyond what the model can take). The check costs O(bodies + moving masses); the
-    // world then holds the non-finite state and must not be stepped again.
+    // world then holds that step's state, partly non-finite, and every later step() throws a
+    // DivergenceError saying so (and quoting the first) without touching it.
     void step();
     // Optional, before a real-time loop: does now what the first step would do once and then
     // not again, so that the first step costs what the next ones do. The collision world's

@@ -202,8 +202,10 @@ void World::prepare() {
     detail::sizeResponseScratch(d.bodies, d.response);
 }
 
-void World::step() {
-    detail::WorldData& d = *data_;
+namespace {
+
+// The stages of one step, in order (world.hpp).
+void stepStages(detail::WorldData& d) {
     const StepContext step = d.context();
     detail::StepProfiler profiler(d.profile, Stage::OperatorInput);
     detail::operatorInput(step, d.op, d.bodies);                   // coupling force, kinematic targets
@@ -229,6 +231,22 @@ void World::step() {
     ++d.profile.steps;
     d.profile.faceQueries = d.collision.faceQueries();
     d.profile.faceTraversals = d.collision.faceTraversals();
+}
+
+}  // namespace
+
+void World::step() {
+    detail::WorldData& d = *data_;
+    if (d.diverged)  // its state is that step's, partly non-finite: stepping it would spread garbage
+        throw DivergenceError(d.diverged->body(), d.time,
+                              "the world diverged in an earlier step and holds that step's state: it cannot be stepped again (that step: " +
+                                  d.diverged->problem() + ")");
+    try {
+        stepStages(d);
+    } catch (const DivergenceError& e) {
+        d.diverged = e;
+        throw;
+    }
 }
 
 double World::time() const { return data_->time; }

@@ -10,6 +10,8 @@
 #include "operator_input.hpp"
 #include "rigid_motion.hpp"
 
+#include <optional>
+
 namespace flexfit::detail {
 
 struct WorldData {
@@ -24,6 +26,7 @@ struct WorldData {
     AssemblyState assembly;     // the rules and their events
     Profile profile;
     std::vector<std::string> warnings;  // World::warnings()
+    std::optional<DivergenceError> diverged;  // the step that diverged: no step after it
     std::uint64_t stepIndex = 0;
     double time = 0.0;
 

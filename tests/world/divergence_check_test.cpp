@@ -95,6 +95,32 @@ TEST(DivergenceCheck, AHugeForceOnAZoneStopsTheWorldNamingTheBodyAndTheTime) {
     EXPECT_LT(world.part(torus).movingMasses().size(), world.part(torus).model().massCount());  // a zone: the check read only it
 }
 
+TEST(DivergenceCheck, AWorldThatDivergedRefusesEveryLaterStepWithoutTouchingIt) {
+    // A later step had run on the diverged state: finite garbage (a position of 1e298 after a
+    // force of 1e308) could have gone on silently.
+    World world;
+    world.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidPart(), BodySettings{}, at(Vec3(40, 0, 0)));  // body 0: bystander
+    const BodyId torus = world.add(buildPartModel(makeTorus1()), PartSettings{}, BodySettings{}, Pose{});
+    const auto [error, start] = stepUntilDivergence(world, [&] { world.applyMassForce(torus, 100, Vec3(0, 1e300, 0)); }, 10);
+    ASSERT_TRUE(error) << "a force of 1e300 did not diverge";
+    const std::uint64_t hash = world.stateHash(), steps = world.stepCount();
+    for (int again = 0; again < 2; ++again) {
+        try {
+            world.step();
+            ADD_FAILURE() << "a diverged world stepped again";
+        } catch (const DivergenceError& e) {
+            EXPECT_EQ(e.body(), torus);
+            EXPECT_EQ(e.time(), start);
+            const std::string what = e.what();
+            EXPECT_TRUE(contains(what, "the world diverged in an earlier step and holds that step's state: it cannot be stepped again")) << what;
+            EXPECT_TRUE(contains(what, "(that step: " + error->problem() + ")")) << what;
+        }
+        EXPECT_EQ(world.stateHash(), hash);
+        EXPECT_EQ(world.stepCount(), steps);
+        EXPECT_EQ(world.time(), start);
+    }
+}
+
 TEST(DivergenceCheck, AFullDeformablePartThatDivergesIsNamedByItsBody) {
     // The full step throws first (stepFullModel knows no body); the zone dynamics stage names it.
     World world;
