@@ -596,6 +596,15 @@ void readWorld(Table& root, Scene& scene) {
     }
 }
 
+// The [world] key a run of no step or of too many is reported at: the time step when it lies
+// outside what simulations use (1 us to 1 s) or the table states no duration, else the
+// duration (a duration of 1e300 had been reported at the time step's line).
+const char* stepCountKey(const toml::table* world, double timeStep) {
+    const bool usualStep = timeStep >= 1e-6 && timeStep <= 1.0;
+    const bool hasDuration = world != nullptr && world->contains("duration"), hasStep = world != nullptr && world->contains("time_step");
+    return hasStep && (!usualStep || !hasDuration) ? "time_step" : "duration";
+}
+
 }  // namespace
 
 Scene parseScene(std::string_view text, const std::string& source, const std::filesystem::path& baseDirectory,
@@ -611,7 +620,7 @@ Scene parseScene(std::string_view text, const std::string& source, const std::fi
     if (const std::optional<std::string> problem = stepCountProblem(scene.duration, scene.world.timeStep)) {
         const toml::node* world = document.get("world");
         const toml::table* w = world != nullptr ? world->as_table() : nullptr;
-        const char* key = w != nullptr && w->contains("time_step") ? "time_step" : "duration";
+        const char* key = stepCountKey(w, scene.world.timeStep);
         const toml::node* at = w != nullptr ? w->get(key) : nullptr;
         throw InputError(source, at != nullptr ? lineOf(*at) : 0, std::string("scene.world, key '") + key + "': " + *problem);
     }

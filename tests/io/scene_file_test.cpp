@@ -386,6 +386,14 @@ TEST(SceneFile, RunsOfNoStepOrOfTooManyStepsAreReported) {
     EXPECT_NE(longer.find(":3: scene.world, key 'time_step': the duration 2.5 s is shorter than half the time step 6 s"), std::string::npos)
         << longer;
     EXPECT_EQ(errorOf(withTimeStep("2.5")), "");  // one step
+    // At a usual time step the duration is what is off, and its line is named.
+    const auto withDuration = [](const std::string& value) { return replaced(kBall, "duration = 2.5", "duration = " + value); };
+    const std::string endless = errorOf(withDuration("1e300"));
+    EXPECT_NE(endless.find("scene.toml:5: scene.world, key 'duration': the duration 1e+300 s at the time step 0.002 s"), std::string::npos)
+        << endless;
+    const std::string instant = errorOf(withDuration("1e-9"));
+    EXPECT_NE(instant.find("scene.toml:5: scene.world, key 'duration': the duration 1e-09 s is shorter than half the time step"), std::string::npos)
+        << instant;
     EXPECT_FALSE(stepCountProblem(1e10 * 1e-3, 1e-3).has_value());
     EXPECT_TRUE(stepCountProblem(1.01e10 * 1e-3, 1e-3).has_value());
 }
