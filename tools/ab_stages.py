@@ -29,6 +29,11 @@ def percentile(sorted_values, p):
     return sorted_values[min(len(sorted_values), max(1, math.ceil(p / 100 * len(sorted_values)))) - 1]
 
 
+def step_us(row, stages):
+    """World::step's time in a metrics.csv row: its us_world_step, or (older builds) the sum of `stages`."""
+    return float(row["us_world_step"]) if "us_world_step" in row else sum(float(row[k]) for k in stages)
+
+
 def measure(flexfit, scene, directory):
     """One run: the in-contact figures and the state hash."""
     out = os.path.join(directory, "run")
@@ -39,7 +44,7 @@ def measure(flexfit, scene, directory):
     if not rows:
         raise SystemExit(f"{scene}: no step with contacts under {flexfit}")
     stages = [k for k in rows[0] if k.startswith("us_") and k != "us_world_step"]
-    steps = sorted(float(r["us_world_step"]) if "us_world_step" in r else sum(float(r[k]) for k in stages) for r in rows)
+    steps = sorted(step_us(r, stages) for r in rows)
     figures = {"step_source": "us_world_step" if "us_world_step" in rows[0] else "sum of stages", "contact_steps": len(rows), "contacts": statistics.mean(float(r["contacts"]) for r in rows),
                "us_step_p50": percentile(steps, 50), "us_step_p99": percentile(steps, 99), "us_step_max": steps[-1]}
     figures.update({k: statistics.mean(float(r[k]) for r in rows) for k in stages})

@@ -27,7 +27,7 @@ import statistics
 import subprocess
 from pathlib import Path
 
-from ab_stages import percentile  # nearest rank, as every other table here
+from ab_stages import percentile, step_us  # nearest rank, as every other table here
 from results_table import alternating_runs, report
 
 COLUMNS = ["measured_p50", "measured_p99", "measured_max", "floor_p50", "floor_p99", "floor_max", "top_repeat_pct", "top_chance_pct"]
@@ -40,7 +40,7 @@ def contact_step_times(metrics):
     if not rows:
         return []
     stages = [k for k in rows[0] if k.startswith("us_") and k != "us_world_step"]
-    return [float(r["us_world_step"]) if "us_world_step" in r else sum(float(r[k]) for k in stages) for r in rows]
+    return [step_us(r, stages) for r in rows]
 
 
 def run(flexfit, scene, out):

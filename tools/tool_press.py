@@ -25,6 +25,7 @@ import statistics
 import subprocess
 import tempfile
 
+from ab_stages import step_us
 from results_table import report
 
 WUSON = "/usr/share/assimp/models/OFF/Wuson.off"
@@ -219,7 +220,7 @@ def measure(flexfit, scene, directory):
     with open(os.path.join(out, "metrics.csv")) as f:
         rows = [r for r in csv.DictReader(f) if float(r["contacts"]) > 0]
     stages = [k for k in rows[0] if k.startswith("us_") and k != "us_world_step"]
-    steps = [float(r["us_world_step"]) if "us_world_step" in r else sum(float(r[k]) for k in stages) for r in rows]
+    steps = [step_us(r, stages) for r in rows]
     narrow = [float(r["us_narrow_phase"]) for r in rows]
     return {"contact_steps": len(rows), "contacts": statistics.mean(float(r["contacts"]) for r in rows),
             "moving_masses": statistics.mean(float(r["moving_masses"]) for r in rows),

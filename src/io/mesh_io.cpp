@@ -66,7 +66,7 @@ MeshReadResult finishPolygonRead(TriMesh mesh, const std::string& source, const 
 }
 
 MeshReadResult readTextMesh(const std::filesystem::path& path, const MeshReadOptions& options, TextMeshParser parse) {
-    MeshReadResult result = parse(detail::decodedText(detail::readTextFile(path), path.string()), path.string(), options);
+    MeshReadResult result = parse(detail::readTextDocument(path), path.string(), options);
     result.mesh.name = path.stem().string();
     return result;
 }

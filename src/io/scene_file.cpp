@@ -14,9 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 namespace flexfit {
 namespace {
@@ -691,11 +689,7 @@ Scene detail::readSceneDocument(const toml::table& document, const std::string& 
 }
 
 Scene loadScene(const std::filesystem::path& file, const SceneReadOptions& options) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(file.string(), 0, "cannot open the scene file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parseScene(detail::decodedText(text.str(), file.string()), file.string(), file.parent_path(), options);
+    return parseScene(detail::readTextDocument(file, "scene file"), file.string(), file.parent_path(), options);
 }
 
 }  // namespace flexfit

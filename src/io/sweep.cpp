@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -28,14 +27,6 @@ struct SweepDocument {
 namespace {
 
 using detail::SweepDocument;
-
-std::string readText(const std::filesystem::path& file, const char* what) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(file.string(), 0, std::string("cannot open the ") + what);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return detail::decodedText(text.str(), file.string());
-}
 
 toml::table parseText(const std::string& text, const std::filesystem::path& file) {
     try {
@@ -301,7 +292,7 @@ Scene sweepScene(const Sweep& sweep, std::size_t run) {
 
 Sweep loadSweep(const std::filesystem::path& file, bool checkRuns, const SceneReadOptions& read) {
     const std::string name = file.string();
-    const toml::table root = parseText(readText(file, "sweep file"), file);
+    const toml::table root = parseText(detail::readTextDocument(file, "sweep file"), file);
     for (const auto& [k, v] : root)
         if (k != "scene" && k != "duration" && k != "set" && k != "parameter") throw InputError(name, lineOf(v), "unknown key '" + std::string(k.str()) + "'");
     Sweep sweep;
@@ -316,7 +307,7 @@ Sweep loadSweep(const std::filesystem::path& file, bool checkRuns, const SceneRe
         sweep.duration = d;
     }
     auto document = std::make_shared<SweepDocument>();
-    document->sceneText = readText(sweep.scene, "base scene file");
+    document->sceneText = detail::readTextDocument(sweep.scene, "base scene file");
     (void)parseText(document->sceneText, sweep.scene);  // its syntax errors name its own lines
     if (const toml::node* set = root.get("set")) {
         const toml::table* t = set->as_table();

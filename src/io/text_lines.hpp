@@ -189,4 +189,16 @@ inline std::string readTextFile(const std::filesystem::path& path) {
     return buffer.str();
 }
 
+// A text format's file (mesh, scene, sweep) as its reader parses it: the bytes UTF-16 decoded
+// (decodedText). With `what`, a file that cannot be opened is "cannot open the <what>";
+// without, readTextFile's errors.
+inline std::string readTextDocument(const std::filesystem::path& path) { return decodedText(readTextFile(path), path.string()); }
+inline std::string readTextDocument(const std::filesystem::path& path, const char* what) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path.string(), 0, std::string("cannot open the ") + what);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return decodedText(text.str(), path.string());
+}
+
 }  // namespace flexfit::detail

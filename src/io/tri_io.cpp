@@ -120,7 +120,7 @@ MeshReadResult parseTri(std::string_view text, const std::string& source, const 
 }
 
 MeshReadResult readTri(const std::filesystem::path& path, const MeshReadOptions& options) {
-    return parseTri(detail::decodedText(detail::readTextFile(path), path.string()), path.string(), options);
+    return parseTri(detail::readTextDocument(path), path.string(), options);
 }
 
 std::string formatTri(const TriMesh& mesh) {
