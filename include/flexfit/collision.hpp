@@ -74,6 +74,10 @@ public:
 
     BoundingVolumeKind kind() const { return kind_; }
     ExactTest exactTest() const { return test_; }
+    // Whether the part's rest mesh bounds a solid (solidDefect: closed, consistently and outward
+    // wound). Two such parts' triangle contacts push each face only out of the other's solid
+    // (intersectTriangles' ofSolids); an open or inside-out mesh is met two-sided.
+    bool boundsSolid() const { return solid_; }
     // Rebuilds the hierarchy from the part's current (part-frame) positions.
     void rebuild(const Part& part);
     // Refits the faces around `changedMasses` from the part's positions, and their ancestors
@@ -121,6 +125,7 @@ private:
     std::vector<std::array<Eigen::Vector4d, 4>> restPlanes_;  // (F)
     BoundingVolumeKind kind_;
     ExactTest test_;
+    bool solid_ = false;
     std::variant<Bvh<Sphere>, Bvh<Aabb>> bvh_;
     Sphere restSphere_;
     double maxDisplacement_ = 0.0;

@@ -51,4 +51,11 @@ struct Topology {
 // Faces must hold indices < vertexCount (validateMesh guarantees it).
 Topology buildTopology(std::span<const Face> faces, std::size_t vertexCount);
 
+// Whether a mesh bounds a solid: closed and manifold (every edge on two faces), consistently
+// oriented (each edge used once in each direction) and outward (a positive enclosed volume).
+// The first of these it fails, or None. The signed distance field needs a solid; the
+// triangle test reads a solid's faces one-sided (collision.hpp).
+enum class SolidDefect { None, Open, Inconsistent, InsideOut };
+SolidDefect solidDefect(std::span<const Vec3> vertices, std::span<const Face> faces, const Topology& topology);
+
 }  // namespace flexfit

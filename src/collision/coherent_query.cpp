@@ -276,7 +276,7 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
         if (c.walking) {
             const std::size_t budget = atOnce ? std::numeric_limits<std::size_t>::max() : std::max(kMinWalkNodes, c.list.nodes / kWalkShare);
             std::vector<Contact> none;
-            LeafPairTester walker(idA, a, colliderA, idB, b, test, c.next.pose, none, stats, walkScratch());
+            LeafPairTester walker(idA, a, colliderA, idB, b, colliderB, test, c.next.pose, none, stats, walkScratch());
             if (advanceTake(c.next, budget, bvhA, bvhB, walker, stats, !atOnce)) {
                 const Coverage next = coverageOf(colliderA, colliderB, bInA, c.next);
                 if (next.slack() <= c.next.margin) {
@@ -291,7 +291,7 @@ void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& col
             c.valid = false;
             return plainTraversal();
         }
-        LeafPairTester tester(idA, a, colliderA, idB, b, test, bInA, contacts, stats);
+        LeafPairTester tester(idA, a, colliderA, idB, b, colliderB, test, bInA, contacts, stats);
         scanCandidates(bvhA, bvhB, bInA, now.reach, tester, c, contacts, stats);
         ++c.scans;
     });

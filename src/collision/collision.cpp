@@ -61,6 +61,7 @@ PartCollider::PartCollider(const Part& part, BoundingVolumeKind kind, ExactTest 
     restSphere_ = Sphere::around(part.model().restPositions);
     changedFaces_.reset(part.model().faceCount());
     const auto& rest = part.model().restPositions;
+    solid_ = solidDefect(rest, part.model().mesh.faces, part.model().topology) == SolidDefect::None;
     restPlanes_.reserve(part.model().faceCount());
     for (const Face& f : part.model().mesh.faces) {
         const Vec3 n = (rest[f[1]] - rest[f[0]]).cross(rest[f[2]] - rest[f[0]]).normalized();
@@ -188,7 +189,7 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
     requireBuiltFor(colliderA, colliderB, test);
     const RelativePose bInA = relativePose(a, b);
     const std::size_t first = contacts.size();
-    LeafPairTester tester(idA, a, colliderA, idB, b, test, bInA, contacts, stats);
+    LeafPairTester tester(idA, a, colliderA, idB, b, colliderB, test, bInA, contacts, stats);
     auto leafPair = [&](Index fa, Index fb) {
         if (candidates) candidates->emplace_back(fa, fb);
         tester(fa, fb);

@@ -33,20 +33,14 @@ double angleAt(const Vec3& corner, const Vec3& u, const Vec3& v) {
 SignedDistanceField::SignedDistanceField(const TriMesh& mesh, const Topology& topology, double cellSize)
     : vertices_(mesh.vertices), faces_(mesh.faces) {
     if (faces_.empty()) throw std::invalid_argument("signed distance field: the mesh has no faces");
-    for (Index count : topology.edgeFaceCount)
-        if (count != 2) throw std::invalid_argument("signed distance field: the mesh '" + mesh.name + "' is not closed and manifold");
-    // Consistently oriented: each edge used once in each direction by its two faces.
-    std::vector<std::pair<Index, Index>> directed;
-    directed.reserve(3 * faces_.size());
-    for (const Face& f : faces_)
-        for (int k = 0; k < 3; ++k) directed.emplace_back(f[std::size_t(k)], f[std::size_t(k + 1) % 3]);
-    std::sort(directed.begin(), directed.end());
-    if (std::adjacent_find(directed.begin(), directed.end()) != directed.end())
+    switch (solidDefect(vertices_, faces_, topology)) {
+    case SolidDefect::None: break;
+    case SolidDefect::Open: throw std::invalid_argument("signed distance field: the mesh '" + mesh.name + "' is not closed and manifold");
+    case SolidDefect::Inconsistent:
         throw std::invalid_argument("signed distance field: the faces of '" + mesh.name + "' are not consistently oriented");
-    // Outward: a positive enclosed volume (divergence theorem over the faces).
-    double volume = 0.0;
-    for (const Face& f : faces_) volume += vertices_[f[0]].dot(vertices_[f[1]].cross(vertices_[f[2]])) / 6.0;
-    if (!(volume > 0.0)) throw std::invalid_argument("signed distance field: the mesh '" + mesh.name + "' is inside out (negative volume)");
+    case SolidDefect::InsideOut:
+        throw std::invalid_argument("signed distance field: the mesh '" + mesh.name + "' is inside out (negative volume)");
+    }
     faceNormal_.resize(faces_.size());
     vertexNormal_.assign(vertices_.size(), Vec3::Zero());
     double edgeSum = 0.0;

@@ -279,9 +279,10 @@ void sortContacts(std::vector<Contact>& contacts, std::size_t first);
 class LeafPairTester {
 public:
     LeafPairTester(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
-                   ExactTest test, const RelativePose& bInA, std::vector<Contact>& contacts, QueryStats& stats,
-                   RestPlaneFilter::Scratch& scratch = restPlaneScratch())
-        : idA_(idA), idB_(idB), a_(a), b_(b), test_(test), bInA_(bInA), ra_(a.pose().rotation.toRotationMatrix()),
+                   const PartCollider& colliderB, ExactTest test, const RelativePose& bInA, std::vector<Contact>& contacts,
+                   QueryStats& stats, RestPlaneFilter::Scratch& scratch = restPlaneScratch())
+        : idA_(idA), idB_(idB), a_(a), b_(b), test_(test), ofSolids_(colliderA.boundsSolid() && colliderB.boundsSolid()),
+          bInA_(bInA), ra_(a.pose().rotation.toRotationMatrix()),
           pa_(a.state().positions), pb_(b.state().positions), facesA_(a.model().mesh.faces), facesB_(b.model().mesh.faces),
           filter_(a, colliderA, bInA, scratch), contacts_(contacts), stats_(stats) {}
 
@@ -295,7 +296,7 @@ public:
             const Sphere s = faceSphere(pa_, facesA_[fa]);
             hit = sphereTriangleContact(s.centre, s.radius, tb);
         } else {
-            hit = intersectTriangles(triangleOf(pa_, facesA_[fa]), tb);
+            hit = intersectTriangles(triangleOf(pa_, facesA_[fa]), tb, ofSolids_);
         }
         if (!hit) return;
         ++stats_.contacts;
@@ -360,6 +361,7 @@ private:
     const Part& a_;
     const Part& b_;
     ExactTest test_;
+    bool ofSolids_;  // both rest meshes bound solids: intersectTriangles' ofSolids
     const RelativePose& bInA_;
     Eigen::Matrix3d ra_;
     std::span<const Vec3> pa_, pb_;

@@ -172,7 +172,7 @@ void querySharpFeatures(std::uint32_t idA, const Part& a, const PartCollider& co
     requireBuiltFor(colliderA, colliderB, test);
     const RelativePose bInA = relativePose(a, b);
     const std::size_t first = contacts.size();
-    LeafPairTester tester(idA, a, colliderA, idB, b, test, bInA, contacts, stats);
+    LeafPairTester tester(idA, a, colliderA, idB, b, colliderB, test, bInA, contacts, stats);
     auto leafPair = [&](Index k, Index fb) { tester(features.faces[k], fb); };
     auto prune = [&](Index k, const auto& volumeB) { return tester.prunes(features.faces[k], volumeB); };
     if (const Bvh<Sphere>* spheres = colliderB.spheres())

@@ -83,11 +83,27 @@ bool clearlyApartOnAnEdgeAxis(const Triangle& first, const Triangle& second, std
     return false;
 }
 
+// How far a push may lean out along first's normal or into second's (the cosine with the unit
+// normal) and still count as leaving the other's solid: 60 degrees from the face planes. A push
+// along a face plane stays allowed at any rounding, and at a solid's convex edge the push that
+// does separate leans into the plane of the face beside it by up to the edge's turn.
+constexpr double kSolidPushSlack = 0.5;
+
+// Which ways along an axis intersectTriangles may push `first` (the header's `ofSolids`):
+// either way, or with `active` neither clearly out along n1 nor clearly against n2 (unit
+// outward normals).
+struct PushCone {
+    bool active = false;
+    Vec3 n1 = Vec3::Zero(), n2 = Vec3::Zero();
+    // Along +axis, given axis . n1 and axis . n2; along -axis, the same with both negated.
+    static bool allows(double along1, double along2) { return along1 <= kSolidPushSlack && along2 >= -kSolidPushSlack; }
+};
+
 // The separating-axis loop of intersectTriangles: over `axes` in order, skipping those shorter
-// than `minLength2`, the smallest overlap and its axis (pointing the way `first` must move);
-// false when an axis separates the triangles.
+// than `minLength2`, the smallest overlap and its axis (pointing the way `first` must move)
+// among the ways `cone` allows; false when an axis separates the triangles.
 bool smallestOverlap(const Triangle& first, const Triangle& second, std::span<const Vec3> axes, double minLength2,
-                     double& bestOverlap, Vec3& bestAxis) {
+                     const PushCone& cone, double& bestOverlap, Vec3& bestAxis) {
     for (Vec3 axis : axes) {
         const double length2 = axis.squaredNorm();
         if (!(length2 > minLength2)) continue;  // parallel edges: no axis
@@ -96,10 +112,17 @@ bool smallestOverlap(const Triangle& first, const Triangle& second, std::span<co
         const double pushUp = i2.max - i1.min;    // move first along +axis by this to separate
         const double pushDown = i1.max - i2.min;  // or along -axis by this
         if (pushUp < 0 || pushDown < 0) return false;  // separating axis
-        const double overlap = std::min(pushUp, pushDown);
+        bool up = true, down = true;
+        if (cone.active) {
+            const double along1 = axis.dot(cone.n1), along2 = axis.dot(cone.n2);
+            up = PushCone::allows(along1, along2);
+            down = PushCone::allows(-along1, -along2);
+        }
+        if (!up && !down) continue;
+        const double overlap = !down ? pushUp : !up ? pushDown : std::min(pushUp, pushDown);
         if (overlap < bestOverlap) {
             bestOverlap = overlap;
-            bestAxis = pushUp <= pushDown ? axis : Vec3(-axis);
+            bestAxis = (up && (!down || pushUp <= pushDown)) ? axis : Vec3(-axis);
         }
     }
     return true;
@@ -118,9 +141,11 @@ FLEXFIT_AVX2_LANES inline __m256d max3(__m256d a, __m256d b, __m256d c) { return
 // lanes, by the same operations in the same order, so each lane gives the scalar loop's bits;
 // the smallest overlap is then taken lane by lane in the axes' order, as the loop takes it.
 FLEXFIT_AVX2_LANES bool smallestOverlapFours(const Triangle& first, const Triangle& second, std::span<const Vec3> axes,
-                                             double minLength2, double& bestOverlap, Vec3& bestAxis) {
+                                             double minLength2, const PushCone& cone, double& bestOverlap, Vec3& bestAxis) {
     const Lanes3 a1 = broadcast(first.a), b1 = broadcast(first.b), c1 = broadcast(first.c);
     const Lanes3 a2 = broadcast(second.a), b2 = broadcast(second.b), c2 = broadcast(second.c);
+    const Lanes3 n1 = broadcast(cone.n1), n2 = broadcast(cone.n2);
+    const __m256d tolerance = _mm256_set1_pd(kSolidPushSlack), minusTolerance = _mm256_set1_pd(-kSolidPushSlack);
     const __m256d threshold = _mm256_set1_pd(minLength2), zero = _mm256_setzero_pd();
     const Vec3 none = Vec3::Zero();  // pads the last four: length 0, never an axis
     for (std::size_t k = 0; k < axes.size(); k += 4) {
@@ -135,10 +160,22 @@ FLEXFIT_AVX2_LANES bool smallestOverlapFours(const Triangle& first, const Triang
         const __m256d pushDown = _mm256_sub_pd(max3(pa1, pb1, pc1), min3(pa2, pb2, pc2));
         const __m256d separates = _mm256_and_pd(valid, _mm256_or_pd(_mm256_cmp_pd(pushUp, zero, _CMP_LT_OQ), _mm256_cmp_pd(pushDown, zero, _CMP_LT_OQ)));
         if (_mm256_movemask_pd(separates) != 0) return false;
+        __m256d overlaps = _mm256_min_pd(pushDown, pushUp);  // std::min(pushUp, pushDown)
+        __m256d upward = _mm256_cmp_pd(pushUp, pushDown, _CMP_LE_OQ);
+        __m256d allowed = valid;
+        if (cone.active) {  // PushCone::allows for +axis and -axis, then the loop's choice
+            const __m256d along1 = dot(unit, n1), along2 = dot(unit, n2);
+            const __m256d up = _mm256_and_pd(_mm256_cmp_pd(along1, tolerance, _CMP_LE_OQ), _mm256_cmp_pd(along2, minusTolerance, _CMP_GE_OQ));
+            const __m256d down = _mm256_and_pd(_mm256_cmp_pd(along1, minusTolerance, _CMP_GE_OQ), _mm256_cmp_pd(along2, tolerance, _CMP_LE_OQ));
+            const __m256d both = _mm256_and_pd(up, down);
+            overlaps = _mm256_blendv_pd(_mm256_blendv_pd(pushDown, pushUp, up), overlaps, both);
+            upward = _mm256_blendv_pd(up, _mm256_and_pd(upward, up), both);
+            allowed = _mm256_and_pd(valid, _mm256_or_pd(up, down));
+        }
         alignas(32) double overlap[4], up[4];
-        _mm256_store_pd(overlap, _mm256_min_pd(pushDown, pushUp));  // std::min(pushUp, pushDown)
-        _mm256_store_pd(up, _mm256_cmp_pd(pushUp, pushDown, _CMP_LE_OQ));
-        const int validLanes = _mm256_movemask_pd(valid);
+        _mm256_store_pd(overlap, overlaps);
+        _mm256_store_pd(up, upward);
+        const int validLanes = _mm256_movemask_pd(allowed);
         const Stored3 units = store(unit);
         for (int l = 0; l < 4; ++l) {
             if ((validLanes >> l & 1) == 0 || !(overlap[l] < bestOverlap)) continue;
@@ -152,11 +189,38 @@ FLEXFIT_AVX2_LANES bool smallestOverlapFours(const Triangle& first, const Triang
 
 // smallestOverlap, four axes a vector where lanes run.
 bool smallestOverlapByLanes(const Triangle& first, const Triangle& second, std::span<const Vec3> axes, double minLength2,
-                            double& bestOverlap, Vec3& bestAxis) {
+                            const PushCone& cone, double& bestOverlap, Vec3& bestAxis) {
 #if defined(FLEXFIT_LANES256)
-    if (detail::lanesEnabled()) return smallestOverlapFours(first, second, axes, minLength2, bestOverlap, bestAxis);
+    if (detail::lanesEnabled()) return smallestOverlapFours(first, second, axes, minLength2, cone, bestOverlap, bestAxis);
 #endif
-    return smallestOverlap(first, second, axes, minLength2, bestOverlap, bestAxis);
+    return smallestOverlap(first, second, axes, minLength2, cone, bestOverlap, bestAxis);
+}
+
+// Whether two face normals lie within 30 degrees of one line (either way).
+bool nearlyParallel(const Vec3& n1, const Vec3& n2) {
+    const double c = n1.dot(n2);
+    return c * c > 0.75 * n1.squaredNorm() * n2.squaredNorm();  // cos^2(30 deg)
+}
+
+// Faces of solids (intersectTriangles' ofSolids) more than 30 degrees from parallel: when the smallest push
+// clearly leaves the cone (out along first's normal or into second), the smallest push within
+// the cone instead, if it is short: within a tenth of the shorter of the two triangles' longest
+// edges. A longer one is more likely a slide along a face than the solids' overlap (at a convex
+// edge turned more than the slack, the push that separates leaves the cone of one of the
+// faces), and the two-sided push stays.
+void solidPush(const Triangle& first, const Triangle& second, std::span<const Vec3> axes, double minLength2, const Vec3& n1,
+               const Vec3& n2, double& bestOverlap, Vec3& bestAxis) {
+    const PushCone cone{true, n1.normalized(), n2.normalized()};
+    if (PushCone::allows(bestAxis.dot(cone.n1), bestAxis.dot(cone.n2))) return;
+    auto longestEdge2 = [](const Triangle& t) { return std::max({(t.b - t.a).squaredNorm(), (t.c - t.b).squaredNorm(), (t.a - t.c).squaredNorm()}); };
+    const double reach = 0.1 * std::sqrt(std::min(longestEdge2(first), longestEdge2(second)));
+    double overlap = std::numeric_limits<double>::infinity();
+    Vec3 axis = bestAxis;
+    smallestOverlapByLanes(first, second, axes, minLength2, cone, overlap, axis);
+    if (overlap <= reach) {
+        bestOverlap = overlap;
+        bestAxis = axis;
+    }
 }
 
 }  // namespace
@@ -240,7 +304,7 @@ double triangleGap(const Triangle& first, const Triangle& second, double enough)
     return gap;
 }
 
-std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second) {
+std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second, bool ofSolids) {
     const std::array<Vec3, 3> e1{first.b - first.a, first.c - first.b, first.a - first.c};
     const std::array<Vec3, 3> e2{second.b - second.a, second.c - second.b, second.a - second.c};
     const Vec3 n1 = e1[0].cross(-e1[2]), n2 = e2[0].cross(-e2[2]);
@@ -265,8 +329,10 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
 
     double bestOverlap = std::numeric_limits<double>::infinity();
     Vec3 bestAxis = Vec3::UnitY();
-    if (!smallestOverlapByLanes(first, second, std::span<const Vec3>(axes.data(), axisCount), 1e-24 * scale * scale, bestOverlap, bestAxis))
-        return std::nullopt;
+    const std::span<const Vec3> allAxes(axes.data(), axisCount);
+    const double minLength2 = 1e-24 * scale * scale;
+    if (!smallestOverlapByLanes(first, second, allAxes, minLength2, PushCone{}, bestOverlap, bestAxis)) return std::nullopt;
+    if (ofSolids && !nearlyParallel(n1, n2)) solidPush(first, second, allAxes, minLength2, n1, n2, bestOverlap, bestAxis);
     // Contact point: centroid of the edge-through-triangle intersection points.
     PointSet points;
     if (!coplanar) {

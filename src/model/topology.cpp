@@ -110,4 +110,18 @@ Topology buildTopology(std::span<const Face> faces, std::size_t vertexCount) {
     return topo;
 }
 
+SolidDefect solidDefect(std::span<const Vec3> vertices, std::span<const Face> faces, const Topology& topology) {
+    if (faces.empty() || std::any_of(topology.edgeFaceCount.begin(), topology.edgeFaceCount.end(), [](Index n) { return n != 2; }))
+        return SolidDefect::Open;
+    std::vector<std::pair<Index, Index>> directed;
+    directed.reserve(3 * faces.size());
+    for (const Face& f : faces)
+        for (std::size_t k = 0; k < 3; ++k) directed.emplace_back(f[k], f[(k + 1) % 3]);
+    std::sort(directed.begin(), directed.end());
+    if (std::adjacent_find(directed.begin(), directed.end()) != directed.end()) return SolidDefect::Inconsistent;
+    double volume = 0.0;  // the divergence theorem over the faces
+    for (const Face& f : faces) volume += vertices[f[0]].dot(vertices[f[1]].cross(vertices[f[2]])) / 6.0;
+    return volume > 0.0 ? SolidDefect::None : SolidDefect::InsideOut;
+}
+
 }  // namespace flexfit

@@ -220,6 +220,69 @@ TEST(TriangleTriangle, EdgesTouchingAtAPointIntersect) {
     EXPECT_TRUE(intersectTriangles(below, shifted(above, {0, 0, -1e-9})));
 }
 
+// Faces of solids (ofSolids): an upper box sunk 0.01 into an equal one below, flush. Its side
+// face (x = 0.5, facing +x) meets the lower box's top face (y = 0.5, facing +y) only along the
+// lower box's top edge, which lies in the side face's plane: two-sided, the smallest push slides
+// the side face off that edge by 0 (out along its own normal); the solids overlap by 0.01 along
+// y, the push that takes the upper box out.
+TEST(TriangleTriangle, FacesOfSolidsArePushedOutOfEachOtherNotOffAnEdge) {
+    const Triangle side{{0.5, 0.49, -0.5}, {0.5, 1.49, -0.5}, {0.5, 0.49, 0.5}};  // normal +x
+    const Triangle top{{0.5, 0.5, -0.5}, {-0.5, 0.5, -0.5}, {0.5, 0.5, 0.5}};     // normal +y
+    const auto twoSided = intersectTriangles(side, top);
+    ASSERT_TRUE(twoSided);
+    EXPECT_LT(twoSided->depth, 1e-12);
+    EXPECT_GT(twoSided->normal.x(), 0.5);  // out along the side face's own normal
+    const auto solids = intersectTriangles(side, top, true);
+    ASSERT_TRUE(solids);
+    EXPECT_NEAR(solids->depth, 0.01, 1e-12);
+    EXPECT_TRUE(solids->normal.isApprox(Vec3::UnitY(), 1e-12));
+    // The same with the lower box's face first: it is pushed down, out of the upper box.
+    const auto reversed = intersectTriangles(top, side, true);
+    ASSERT_TRUE(reversed);
+    EXPECT_NEAR(reversed->depth, 0.01, 1e-12);
+    EXPECT_TRUE(reversed->normal.isApprox(-Vec3::UnitY(), 1e-12));
+    // Sunk deeper than a tenth of the faces' size, the push along y is no longer taken for the
+    // solids' overlap (it could be a slide along a face): the two-sided push stays.
+    const Triangle deep = shifted(side, {0, -0.2, 0});
+    EXPECT_LT(intersectTriangles(deep, top, true)->depth, 1e-12);
+}
+
+// On random pairs, faces of solids change the push only as the header says: the contact is
+// there exactly when the two-sided one is; the push is the two-sided one unless that leans more
+// than 30 degrees out along the first face's normal or into the second's, and then it leans
+// less, is no longer than a tenth of the shorter triangle's longest edge, and still separates
+// the triangles (checked by the existence test, which does not depend on the push). With lanes
+// and one at a time, the same bits.
+TEST(TriangleTriangle, FacesOfSolidsChangeOnlyPushesOutOfTheCone) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> small(-0.3, 0.3);
+    int changed = 0, contacts = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const Triangle x = randomTriangle(rng);
+        const Triangle y = k % 2 == 0 ? randomTriangle(rng) : shifted(x, {small(rng), small(rng), small(rng)});
+        const auto twoSided = intersectTriangles(x, y), solids = intersectTriangles(x, y, true);
+        ASSERT_EQ(twoSided.has_value(), solids.has_value()) << "pair " << k;
+        if (!solids) continue;
+        ++contacts;
+        if (detail::lanesEnabled()) {
+            const detail::ScopedScalarLanes oneAtATime;
+            expectSameBits(solids, intersectTriangles(x, y, true), k);
+        }
+        if (bitsOf(solids->depth) == bitsOf(twoSided->depth) && solids->normal == twoSided->normal) continue;
+        ++changed;
+        const Vec3 n1 = (x.b - x.a).cross(x.c - x.a).normalized(), n2 = (y.b - y.a).cross(y.c - y.a).normalized();
+        EXPECT_TRUE(twoSided->normal.dot(n1) > 0.5 || twoSided->normal.dot(n2) < -0.5) << "pair " << k;
+        EXPECT_LE(solids->normal.dot(n1), 0.5) << "pair " << k;
+        EXPECT_GE(solids->normal.dot(n2), -0.5) << "pair " << k;
+        const double shorter = std::min({std::max({(x.b - x.a).norm(), (x.c - x.b).norm(), (x.a - x.c).norm()}),
+                                         std::max({(y.b - y.a).norm(), (y.c - y.b).norm(), (y.a - y.c).norm()})});
+        EXPECT_LE(solids->depth, 0.1 * shorter + 1e-12) << "pair " << k;
+        EXPECT_FALSE(intersectTriangles(shifted(x, (solids->depth * (1 + 1e-6) + 1e-9) * solids->normal), y)) << "pair " << k;
+    }
+    EXPECT_GT(contacts, 2000);
+    EXPECT_GT(changed, 50);
+}
+
 TEST(TriangleGap, ALowerBoundOnTheDistanceThatKeepsPairsApart) {
     // Random pairs: intersecting ones have no gap; separated ones a gap no wider than their
     // distance (sampled: the closest sampled point of one to each vertex and edge sample of the
