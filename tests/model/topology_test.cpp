@@ -187,6 +187,30 @@ TEST(Topology, OpenSingleTriangle) {
     EXPECT_TRUE(topo.faceNeighborsOf(0).empty());
 }
 
+// solidDefect against meshes whose answer is known by construction: a cube and a torus bound
+// solids; the cube with a face removed is open, with one face turned over inconsistent, with
+// every face turned over inside out; two tetrahedra glued along an edge are not manifold.
+TEST(Topology, SolidDefectNamesWhatKeepsAMeshFromBoundingASolid) {
+    auto defect = [](const TriMesh& mesh) { return solidDefect(mesh.vertices, mesh.faces, buildTopology(mesh.faces, mesh.vertices.size())); };
+    const TriMesh box = cube();
+    EXPECT_EQ(defect(box), SolidDefect::None);
+    EXPECT_EQ(defect(makeTorus(3.0, 1.0, 5, 4)), SolidDefect::None);
+    TriMesh open = box;
+    open.faces.pop_back();
+    EXPECT_EQ(defect(open), SolidDefect::Open);
+    TriMesh turned = box;
+    std::swap(turned.faces[3][1], turned.faces[3][2]);
+    EXPECT_EQ(defect(turned), SolidDefect::Inconsistent);
+    TriMesh insideOut = box;
+    for (Face& f : insideOut.faces) std::swap(f[1], f[2]);
+    EXPECT_EQ(defect(insideOut), SolidDefect::InsideOut);
+    TriMesh glued;
+    glued.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, -1, 0}, {0, 0, -1}};
+    glued.faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}, {0, 1, 4}, {0, 5, 1}, {0, 4, 5}, {1, 5, 4}};
+    EXPECT_EQ(defect(glued), SolidDefect::Open);
+    EXPECT_EQ(defect(TriMesh{}), SolidDefect::Open);
+}
+
 TEST(Topology, UnreferencedVerticesHaveEmptyRanges) {
     // Vertices 0, 3 and 6 are used by no face.
     const std::vector<Face> faces = {{1, 2, 4}, {4, 2, 5}};
