@@ -144,8 +144,6 @@ FLEXFIT_AVX2_LANES bool smallestOverlapFours(const Triangle& first, const Triang
                                              double minLength2, const PushCone& cone, double& bestOverlap, Vec3& bestAxis) {
     const Lanes3 a1 = broadcast(first.a), b1 = broadcast(first.b), c1 = broadcast(first.c);
     const Lanes3 a2 = broadcast(second.a), b2 = broadcast(second.b), c2 = broadcast(second.c);
-    const Lanes3 n1 = broadcast(cone.n1), n2 = broadcast(cone.n2);
-    const __m256d tolerance = _mm256_set1_pd(kSolidPushSlack), minusTolerance = _mm256_set1_pd(-kSolidPushSlack);
     const __m256d threshold = _mm256_set1_pd(minLength2), zero = _mm256_setzero_pd();
     const Vec3 none = Vec3::Zero();  // pads the last four: length 0, never an axis
     for (std::size_t k = 0; k < axes.size(); k += 4) {
@@ -164,7 +162,8 @@ FLEXFIT_AVX2_LANES bool smallestOverlapFours(const Triangle& first, const Triang
         __m256d upward = _mm256_cmp_pd(pushUp, pushDown, _CMP_LE_OQ);
         __m256d allowed = valid;
         if (cone.active) {  // PushCone::allows for +axis and -axis, then the loop's choice
-            const __m256d along1 = dot(unit, n1), along2 = dot(unit, n2);
+            const __m256d tolerance = _mm256_set1_pd(kSolidPushSlack), minusTolerance = _mm256_set1_pd(-kSolidPushSlack);
+            const __m256d along1 = dot(unit, broadcast(cone.n1)), along2 = dot(unit, broadcast(cone.n2));
             const __m256d up = _mm256_and_pd(_mm256_cmp_pd(along1, tolerance, _CMP_LE_OQ), _mm256_cmp_pd(along2, minusTolerance, _CMP_GE_OQ));
             const __m256d down = _mm256_and_pd(_mm256_cmp_pd(along1, minusTolerance, _CMP_GE_OQ), _mm256_cmp_pd(along2, tolerance, _CMP_LE_OQ));
             const __m256d both = _mm256_and_pd(up, down);
@@ -202,6 +201,14 @@ bool nearlyParallel(const Vec3& n1, const Vec3& n2) {
     return c * c > 0.75 * n1.squaredNorm() * n2.squaredNorm();  // cos^2(30 deg)
 }
 
+// Whether a push along `unit` leaves the cone of PushCone::allows, from the unnormalised face
+// normals (no square root on the common path: a push that stays in the cone).
+bool leavesCone(const Vec3& unit, const Vec3& n1, const Vec3& n2) {
+    const double along1 = unit.dot(n1), along2 = unit.dot(n2);
+    constexpr double slack2 = kSolidPushSlack * kSolidPushSlack;
+    return (along1 > 0.0 && along1 * along1 > slack2 * n1.squaredNorm()) || (along2 < 0.0 && along2 * along2 > slack2 * n2.squaredNorm());
+}
+
 // Faces of solids (intersectTriangles' ofSolids) more than 30 degrees from parallel: when the smallest push
 // clearly leaves the cone (out along first's normal or into second), the smallest push within
 // the cone instead, if it is short: within a tenth of the shorter of the two triangles' longest
@@ -211,7 +218,6 @@ bool nearlyParallel(const Vec3& n1, const Vec3& n2) {
 void solidPush(const Triangle& first, const Triangle& second, std::span<const Vec3> axes, double minLength2, const Vec3& n1,
                const Vec3& n2, double& bestOverlap, Vec3& bestAxis) {
     const PushCone cone{true, n1.normalized(), n2.normalized()};
-    if (PushCone::allows(bestAxis.dot(cone.n1), bestAxis.dot(cone.n2))) return;
     auto longestEdge2 = [](const Triangle& t) { return std::max({(t.b - t.a).squaredNorm(), (t.c - t.b).squaredNorm(), (t.a - t.c).squaredNorm()}); };
     const double reach = 0.1 * std::sqrt(std::min(longestEdge2(first), longestEdge2(second)));
     double overlap = std::numeric_limits<double>::infinity();
@@ -332,7 +338,7 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
     const std::span<const Vec3> allAxes(axes.data(), axisCount);
     const double minLength2 = 1e-24 * scale * scale;
     if (!smallestOverlapByLanes(first, second, allAxes, minLength2, PushCone{}, bestOverlap, bestAxis)) return std::nullopt;
-    if (ofSolids && !nearlyParallel(n1, n2)) solidPush(first, second, allAxes, minLength2, n1, n2, bestOverlap, bestAxis);
+    if (ofSolids && leavesCone(bestAxis, n1, n2) && !nearlyParallel(n1, n2)) solidPush(first, second, allAxes, minLength2, n1, n2, bestOverlap, bestAxis);
     // Contact point: centroid of the edge-through-triangle intersection points.
     PointSet points;
     if (!coplanar) {
