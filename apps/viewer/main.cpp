@@ -37,7 +37,12 @@ int main(int argc, char** argv) {
     cli.add_option("--show", show, "overlays shown at start (default: zones contacts assembly coupling)")
         ->delimiter(',')
         ->check(CLI::IsMember({"zones", "springs", "hierarchy", "spheres", "contacts", "assembly", "coupling"}));
-    CLI11_PARSE(cli, argc, argv);
+    try {
+        cli.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        // --help prints and succeeds; a usage error exits 2, as the flexfit command's do.
+        return cli.exit(e) == 0 ? EXIT_SUCCESS : 2;
+    }
 
     const bool headless = frames > 0 || egl || hidden;
     if (headless && frames == 0) frames = 1;
@@ -69,7 +74,10 @@ int main(int argc, char** argv) {
             last = now;
             app.frame(seconds);
         }
-    } catch (const std::exception& e) {
+    } catch (const InputError& e) {  // the scene or a file it names: exit 2, as `flexfit run` does
+        fmt::print(stderr, "error: {}\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {  // no display, no OpenGL 3.3, a file that cannot be written
         fmt::print(stderr, "error: {}\n", e.what());
         return EXIT_FAILURE;
     }
