@@ -209,12 +209,12 @@ bool leavesCone(const Vec3& unit, const Vec3& n1, const Vec3& n2) {
     return (along1 > 0.0 && along1 * along1 > slack2 * n1.squaredNorm()) || (along2 < 0.0 && along2 * along2 > slack2 * n2.squaredNorm());
 }
 
-// Faces of solids (intersectTriangles' ofSolids) more than 30 degrees from parallel: when the smallest push
-// clearly leaves the cone (out along first's normal or into second), the smallest push within
-// the cone instead, if it is short: within a tenth of the shorter of the two triangles' longest
-// edges. A longer one is more likely a slide along a face than the solids' overlap (at a convex
-// edge turned more than the slack, the push that separates leaves the cone of one of the
-// faces), and the two-sided push stays.
+// Faces of solids (intersectTriangles' ofSolids) more than 30 degrees from parallel whose
+// smallest push clearly leaves the cone (out along first's normal or into second): the
+// smallest push within the cone instead, if it is short: within a tenth of the shorter of the
+// two triangles' longest edges. A longer one is more likely a slide along a face than the
+// solids' overlap (at a convex edge turned more than the slack, the push that separates leaves
+// the cone of one of the faces), and the two-sided push stays.
 void solidPush(const Triangle& first, const Triangle& second, std::span<const Vec3> axes, double minLength2, const Vec3& n1,
                const Vec3& n2, double& bestOverlap, Vec3& bestAxis) {
     const PushCone cone{true, n1.normalized(), n2.normalized()};
@@ -338,7 +338,8 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
     const std::span<const Vec3> allAxes(axes.data(), axisCount);
     const double minLength2 = 1e-24 * scale * scale;
     if (!smallestOverlapByLanes(first, second, allAxes, minLength2, PushCone{}, bestOverlap, bestAxis)) return std::nullopt;
-    if (ofSolids && leavesCone(bestAxis, n1, n2) && !nearlyParallel(n1, n2)) solidPush(first, second, allAxes, minLength2, n1, n2, bestOverlap, bestAxis);
+    if (ofSolids && leavesCone(bestAxis, n1, n2) && !nearlyParallel(n1, n2))
+        solidPush(first, second, allAxes, minLength2, n1, n2, bestOverlap, bestAxis);
     // Contact point: centroid of the edge-through-triangle intersection points.
     PointSet points;
     if (!coplanar) {

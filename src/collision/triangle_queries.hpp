@@ -8,9 +8,9 @@
 // intersectTriangles is a separating-axis test on the 11 axes of two triangles (both normals
 // and the 9 edge-edge cross products; in-plane edge normals when they are coplanar). When no
 // axis separates them it reports the minimum-overlap axis as the contact normal (for faces of
-// solids, among the pushes that move neither face into the other's solid), the overlap as the
-// depth, and the centroid of the intersection points (edges of each through the other)
-// as the contact point.
+// solids, not one that only slides a face off the other's edge, where a short push is left),
+// the overlap as the depth, and the centroid of the intersection points (edges of each through
+// the other) as the contact point.
 #pragma once
 
 #include "flexfit/bvh.hpp"
@@ -69,9 +69,9 @@ std::optional<TriangleContact> sphereTriangleContact(const Vec3& centre, double 
 // Known limits: faces within 30 degrees of parallel keep the two-sided push, which for
 // opposing faces may point through them (replacing it there, with a push that is deeper and
 // put at the pair's one contact point, made a stack stepped at 50 ms jitter, and from 10
-// degrees a rigid ball pressed on the rigid mouth creep at 2.4x the step time: such faces need
-// a contact per vertex); a push that does separate the solids at a convex edge turned by more than 60
-// degrees leaves one face's cone too, and is replaced when a short push is left.
+// degrees a rigid ball pressed on the rigid mouth creep at 2.4x the step time: such faces
+// need a contact per vertex); a push that does separate the solids at a convex edge turned by
+// more than 60 degrees leaves one face's cone too, and is replaced when a short push is left.
 std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second, bool ofSolids = false);
 
 // How far apart two triangles are along the best of intersectTriangles' axes (both normals and
