@@ -76,7 +76,7 @@ public:
     ExactTest exactTest() const { return test_; }
     // Whether the part's rest mesh bounds a solid (solidDefect: closed, consistently and outward
     // wound). Two such parts' triangle contacts push each face only out of the other's solid
-    // (intersectTriangles' ofSolids); an open or inside-out mesh is met two-sided.
+    // (triangle_queries.hpp, FaceSides); an open or inside-out mesh is met two-sided.
     bool boundsSolid() const { return solid_; }
     // Rebuilds the hierarchy from the part's current (part-frame) positions.
     void rebuild(const Part& part);

@@ -274,6 +274,13 @@ RestPlaneFilter::Scratch& restPlaneScratch();
 // Sorts contacts[first..] into (faceA, faceB) order (collision.cpp).
 void sortContacts(std::vector<Contact>& contacts, std::size_t first);
 
+// How the triangle test reads two parts' faces: as solids when both rest meshes bound one, and
+// with opposing faces pushed back when neither part is deformable (FaceSides).
+inline FaceSides facesSides(const Part& a, const PartCollider& colliderA, const Part& b, const PartCollider& colliderB) {
+    if (!colliderA.boundsSolid() || !colliderB.boundsSolid()) return FaceSides::TwoSided;
+    return a.mode() == PartMode::Rigid && b.mode() == PartMode::Rigid ? FaceSides::RigidSolids : FaceSides::Solids;
+}
+
 // The exact test of one leaf pair (face of A, face of B) at the parts' current shapes and poses,
 // shared by the full and the coherent query.
 class LeafPairTester {
@@ -281,7 +288,7 @@ public:
     LeafPairTester(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
                    const PartCollider& colliderB, ExactTest test, const RelativePose& bInA, std::vector<Contact>& contacts,
                    QueryStats& stats, RestPlaneFilter::Scratch& scratch = restPlaneScratch())
-        : idA_(idA), idB_(idB), a_(a), b_(b), test_(test), ofSolids_(colliderA.boundsSolid() && colliderB.boundsSolid()),
+        : idA_(idA), idB_(idB), a_(a), b_(b), test_(test), sides_(facesSides(a, colliderA, b, colliderB)),
           bInA_(bInA), ra_(a.pose().rotation.toRotationMatrix()),
           pa_(a.state().positions), pb_(b.state().positions), facesA_(a.model().mesh.faces), facesB_(b.model().mesh.faces),
           filter_(a, colliderA, bInA, scratch), contacts_(contacts), stats_(stats) {}
@@ -296,7 +303,7 @@ public:
             const Sphere s = faceSphere(pa_, facesA_[fa]);
             hit = sphereTriangleContact(s.centre, s.radius, tb);
         } else {
-            hit = intersectTriangles(triangleOf(pa_, facesA_[fa]), tb, ofSolids_);
+            hit = intersectTriangles(triangleOf(pa_, facesA_[fa]), tb, sides_);
         }
         if (!hit) return;
         ++stats_.contacts;
@@ -361,7 +368,7 @@ private:
     const Part& a_;
     const Part& b_;
     ExactTest test_;
-    bool ofSolids_;  // both rest meshes bound solids: intersectTriangles' ofSolids
+    FaceSides sides_;  // how intersectTriangles reads the faces (facesSides)
     const RelativePose& bInA_;
     Eigen::Matrix3d ra_;
     std::span<const Vec3> pa_, pb_;

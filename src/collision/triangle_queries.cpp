@@ -89,7 +89,7 @@ bool clearlyApartOnAnEdgeAxis(const Triangle& first, const Triangle& second, std
 // does separate leans into the plane of the face beside it by up to the edge's turn.
 constexpr double kSolidPushSlack = 0.5;
 
-// Which ways along an axis intersectTriangles may push `first` (the header's `ofSolids`):
+// Which ways along an axis intersectTriangles may push `first` (the header's FaceSides):
 // either way, or with `active` neither clearly out along n1 nor clearly against n2 (unit
 // outward normals).
 struct PushCone {
@@ -209,7 +209,7 @@ bool leavesCone(const Vec3& unit, const Vec3& n1, const Vec3& n2) {
     return (along1 > 0.0 && along1 * along1 > slack2 * n1.squaredNorm()) || (along2 < 0.0 && along2 * along2 > slack2 * n2.squaredNorm());
 }
 
-// Faces of solids (intersectTriangles' ofSolids) more than 30 degrees from parallel whose
+// Faces of solids (FaceSides::Solids) more than 30 degrees from parallel whose
 // smallest push clearly leaves the cone (out along first's normal or into second): the
 // smallest push within the cone instead, if it is short: within a tenth of the shorter of the
 // two triangles' longest edges. A longer one is more likely a slide along a face than the
@@ -227,6 +227,54 @@ void solidPush(const Triangle& first, const Triangle& second, std::span<const Ve
         bestOverlap = overlap;
         bestAxis = axis;
     }
+}
+
+// The deepest point of `t` behind the plane of `base` (unit outward normal `unit`) within the
+// prism over `base` (its triangle swept along the normal): t clipped by the prism's three sides
+// (Sutherland-Hodgman), then the clipped polygon's deepest corner. Depth > 0, or none.
+struct Deepest {
+    Vec3 point;
+    double depth;
+};
+std::optional<Deepest> deepestBehind(const Triangle& t, const Triangle& base, const Vec3& unit) {
+    PointSet polygon, clipped;
+    for (const Vec3& v : {t.a, t.b, t.c}) polygon.push(v);
+    const std::array<Vec3, 3> corners{base.a, base.b, base.c};
+    for (std::size_t e = 0; e < 3 && polygon.count > 0; ++e) {
+        const Vec3& p = corners[e];
+        const Vec3 inward = unit.cross(corners[(e + 1) % 3] - p);  // counter-clockwise seen from outside
+        clipped.count = 0;
+        for (int i = 0; i < polygon.count; ++i) {
+            const Vec3& x = polygon.points[std::size_t(i)];
+            const Vec3& y = polygon.points[std::size_t((i + 1) % polygon.count)];
+            const double dx = inward.dot(x - p), dy = inward.dot(y - p);
+            if (dx >= 0.0) clipped.push(x);
+            if ((dx >= 0.0) != (dy >= 0.0)) clipped.push(x + (dx / (dx - dy)) * (y - x));
+        }
+        polygon = clipped;
+    }
+    std::optional<Deepest> deepest;
+    const double offset = unit.dot(base.a);
+    for (int i = 0; i < polygon.count; ++i) {
+        const Vec3& x = polygon.points[std::size_t(i)];
+        const double depth = offset - unit.dot(x);
+        if (depth > 0.0 && (!deepest || depth > deepest->depth)) deepest = Deepest{x, depth};
+    }
+    return deepest;
+}
+
+// Opposing faces of rigid solids within 30 degrees of parallel whose smallest push leaves the cone
+// (it goes through the other face): the push back, out of the other's solid along one face's
+// normal, by the depth of one triangle's deepest point behind the other within its prism, at
+// the middle of that depth. Of first pushed along n2 and first pushed back along -n1 (second's
+// deepest point behind first), the shallower; none when neither reaches behind the other there.
+std::optional<TriangleContact> opposingFacesPush(const Triangle& first, const Triangle& second, const Vec3& n1, const Vec3& n2) {
+    const Vec3 u1 = n1.normalized(), u2 = n2.normalized();
+    const std::optional<Deepest> firstBehind = deepestBehind(first, second, u2), secondBehind = deepestBehind(second, first, u1);
+    if (firstBehind && (!secondBehind || firstBehind->depth <= secondBehind->depth))
+        return TriangleContact{firstBehind->point + (0.5 * firstBehind->depth) * u2, u2, firstBehind->depth};
+    if (secondBehind) return TriangleContact{secondBehind->point + (0.5 * secondBehind->depth) * u1, Vec3(-u1), secondBehind->depth};
+    return std::nullopt;
 }
 
 }  // namespace
@@ -310,7 +358,7 @@ double triangleGap(const Triangle& first, const Triangle& second, double enough)
     return gap;
 }
 
-std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second, bool ofSolids) {
+std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second, FaceSides sides) {
     const std::array<Vec3, 3> e1{first.b - first.a, first.c - first.b, first.a - first.c};
     const std::array<Vec3, 3> e2{second.b - second.a, second.c - second.b, second.a - second.c};
     const Vec3 n1 = e1[0].cross(-e1[2]), n2 = e2[0].cross(-e2[2]);
@@ -338,8 +386,12 @@ std::optional<TriangleContact> intersectTriangles(const Triangle& first, const T
     const std::span<const Vec3> allAxes(axes.data(), axisCount);
     const double minLength2 = 1e-24 * scale * scale;
     if (!smallestOverlapByLanes(first, second, allAxes, minLength2, PushCone{}, bestOverlap, bestAxis)) return std::nullopt;
-    if (ofSolids && leavesCone(bestAxis, n1, n2) && !nearlyParallel(n1, n2))
-        solidPush(first, second, allAxes, minLength2, n1, n2, bestOverlap, bestAxis);
+    if (sides != FaceSides::TwoSided && leavesCone(bestAxis, n1, n2)) {
+        if (!nearlyParallel(n1, n2))
+            solidPush(first, second, allAxes, minLength2, n1, n2, bestOverlap, bestAxis);
+        else if (sides == FaceSides::RigidSolids && n1.dot(n2) < 0.0)
+            if (const std::optional<TriangleContact> back = opposingFacesPush(first, second, n1, n2)) return back;
+    }
     // Contact point: centroid of the edge-through-triangle intersection points.
     PointSet points;
     if (!coplanar) {

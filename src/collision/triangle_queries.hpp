@@ -7,10 +7,10 @@
 //
 // intersectTriangles is a separating-axis test on the 11 axes of two triangles (both normals
 // and the 9 edge-edge cross products; in-plane edge normals when they are coplanar). When no
-// axis separates them it reports the minimum-overlap axis as the contact normal (for faces of
-// solids, not one that only slides a face off the other's edge, where a short push is left),
-// the overlap as the depth, and the centroid of the intersection points (edges of each through
-// the other) as the contact point.
+// axis separates them it reports the minimum-overlap axis as the contact normal, the overlap
+// as the depth, and the centroid of the intersection points (edges of each through the other)
+// as the contact point; for faces of solids, not a push that only slides a face off the
+// other's edge or through it (see intersectTriangles).
 #pragma once
 
 #include "flexfit/bvh.hpp"
@@ -57,22 +57,32 @@ std::optional<TriangleContact> sphereTriangleContact(const Vec3& centre, double 
 // Contact of two triangles; nullopt when they do not intersect (touching counts as
 // intersecting). Normal: pushing `first` by depth * normal separates it from `second`.
 //
-// `ofSolids`: both are faces of solids (closed, outward-wound meshes: solidDefect), whose
-// insides lie behind them. A push of `first` clearly out along its own normal or into `second`
-// against its normal (more than 30 degrees out of the face planes) parts the two triangles only
-// by sliding one off the other's edge, and the solids stay as deep in each other. When the
-// smallest push is such a one, and the faces meet at more than 30 degrees from parallel, the
-// smallest push that is not replaces it, if that is short (a tenth of the triangles' size:
-// triangle_queries.cpp, solidPush). The case that needs it: equal boxes stacked flush, where
-// every crossing lies on a coincident edge and the two-sided test reports depth 0 sideways
-// while the boxes sink into each other. Whether there is a contact does not depend on it.
-// Known limits: faces within 30 degrees of parallel keep the two-sided push, which for
-// opposing faces may point through them (replacing it there, with a push that is deeper and
-// put at the pair's one contact point, made a stack stepped at 50 ms jitter, and from 10
-// degrees a rigid ball pressed on the rigid mouth creep at 2.4x the step time: such faces
-// need a contact per vertex); a push that does separate the solids at a convex edge turned by
-// more than 60 degrees leaves one face's cone too, and is replaced when a short push is left.
-std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second, bool ofSolids = false);
+// How intersectTriangles reads the two faces (FaceSides::TwoSided: as surfaces).
+//
+// Solids: both are faces of solids (closed, outward-wound meshes: solidDefect), whose insides
+// lie behind them. A push of `first` clearly out along its own normal or into `second` against
+// its normal (more than 30 degrees out of the face planes) parts the two triangles only by
+// sliding one off the other's edge or through the other, and the solids stay as deep in each
+// other. When the smallest push is such a one and the faces meet more than 30 degrees from
+// parallel, the smallest push that is not replaces it, if that is short (a tenth of the
+// triangles' size: triangle_queries.cpp, solidPush). Equal boxes stacked flush need it: every
+// crossing lies on a coincident edge, and the two-sided test reported depth 0 sideways while
+// the boxes sank into each other.
+// RigidSolids: as Solids, and besides, opposing faces within 30 degrees of parallel (a box face
+// tilted on the one below, a peg's side on the hole's wall, a ball pressed on a face) whose
+// smallest push goes through the other face get the push back along one face's normal, by the
+// depth of one triangle's deepest point behind the other within its prism, put at the middle of
+// that depth (opposingFacesPush). Two-sided, such pairs pointed through the other face about as
+// often as not, which the contact solver read as separating. For rigid pairs only: a
+// deformable part's contact response moves a face's three masses by the contact's depth, and
+// with the deepest point's depth a tool pressed into a face pushed its masses 0.1 mm beyond
+// the tool's surface (stiff_clip.toml, where the two-sided contacts left them on it).
+// Whether there is a contact does not depend on it. Known limits: a push that does separate
+// the solids at a convex edge turned by more than 60 degrees leaves one face's cone too, and
+// is replaced when a short push is left; overlaps deeper than a tenth of the faces keep the
+// two-sided push between faces meeting at a steep angle.
+enum class FaceSides : std::uint8_t { TwoSided, Solids, RigidSolids };
+std::optional<TriangleContact> intersectTriangles(const Triangle& first, const Triangle& second, FaceSides sides = FaceSides::TwoSided);
 
 // How far apart two triangles are along the best of intersectTriangles' axes (both normals and
 // the nine edge-edge cross products, unit): a lower bound on their distance. While no vertex

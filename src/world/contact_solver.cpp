@@ -114,6 +114,7 @@ void addContacts(std::span<const Contact> contacts, const Bodies& bodies, Contac
         const RigidBody& ba = bodies.rigid[a];
         const RigidBody& bb = bodies.rigid[b];
         SolverContact c;
+        c.key = {a, b, contact.faceA, contact.faceB, contact.massB};
         c.a = a;
         c.b = b;
         c.ra = contact.point - bodies.centreOfMass(a);
@@ -129,6 +130,26 @@ void addContacts(std::span<const Contact> contacts, const Bodies& bodies, Contac
         c.kineticFriction = combinedFriction(ba.kineticFriction, bb.kineticFriction);
         c.restitution = combinedRestitution(ba.restitution, bb.restitution);
         solver.contacts.push_back(c);
+    }
+}
+
+void keepImpulses(ContactSolver& solver) {
+    solver.kept.clear();
+    for (const SolverContact& c : solver.contacts)
+        solver.kept.push_back({c.key, c.normalImpulse, c.tangentImpulse1 * c.tangent1 + c.tangentImpulse2 * c.tangent2, c.normal});
+    std::sort(solver.kept.begin(), solver.kept.end(), [](const auto& x, const auto& y) { return x.key < y.key; });
+}
+
+void warmStart(Bodies& bodies, ContactSolver& solver) {
+    auto byKey = [](const ContactSolver::Kept& k, const ContactKey& key) { return k.key < key; };
+    for (SolverContact& c : solver.contacts) {
+        const auto found = std::lower_bound(solver.kept.begin(), solver.kept.end(), c.key, byKey);
+        if (found == solver.kept.end() || found->key != c.key || found->normal.dot(c.normal) < kWarmStartAlignment) continue;
+        c.normalImpulse = std::min(found->normalImpulse, c.normalMass * c.bounceThreshold);
+        const double kept = found->normalImpulse > 0.0 ? c.normalImpulse / found->normalImpulse : 0.0;
+        c.tangentImpulse1 = kept * found->tangentImpulse.dot(c.tangent1);
+        c.tangentImpulse2 = kept * found->tangentImpulse.dot(c.tangent2);
+        applyImpulse(c.normalImpulse * c.normal + c.tangentImpulse1 * c.tangent1 + c.tangentImpulse2 * c.tangent2, solver, c, bodies);
     }
 }
 

@@ -124,6 +124,7 @@ double loadSpeedOf(BodyId id, const Bodies& bodies, const RigidMotionScratch& s)
 // 1. The dynamic bodies' rigid contacts into the solver, each pair once, with their
 // restitution threshold; every moving body's stopping pairs' depths.
 void gatherContacts(Bodies& bodies, CollisionWorld& collision, RigidMotionScratch& s, StepProfiler& profiler) {
+    keepImpulses(s.solver);
     s.solver.contacts.clear();
     updateInverseInertia(s.moving, bodies, s.solver);
     s.startDepths.clear();  // recordStartDepths sets each mover's offset and count
@@ -292,6 +293,7 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
     for (int sub = 0; sub < substeps; ++sub) {
         gatherContacts(bodies, collision, s, profiler);
         profiler.enter(Stage::ContactSolver);
+        warmStart(bodies, s.solver);
         solveVelocities(settings.contactIterations, separation, bodies, s.solver);
         profiler.enter(Stage::RigidMotion);
         for (BodyId id : s.moving) {

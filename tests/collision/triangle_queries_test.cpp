@@ -220,7 +220,7 @@ TEST(TriangleTriangle, EdgesTouchingAtAPointIntersect) {
     EXPECT_TRUE(intersectTriangles(below, shifted(above, {0, 0, -1e-9})));
 }
 
-// Faces of solids (ofSolids): an upper box sunk 0.01 into an equal one below, flush. Its side
+// Faces of solids (FaceSides::Solids): an upper box sunk 0.01 into an equal one below, flush. Its side
 // face (x = 0.5, facing +x) meets the lower box's top face (y = 0.5, facing +y) only along the
 // lower box's top edge, which lies in the side face's plane: two-sided, the smallest push slides
 // the side face off that edge by 0 (out along its own normal); the solids overlap by 0.01 along
@@ -232,41 +232,70 @@ TEST(TriangleTriangle, FacesOfSolidsArePushedOutOfEachOtherNotOffAnEdge) {
     ASSERT_TRUE(twoSided);
     EXPECT_LT(twoSided->depth, 1e-12);
     EXPECT_GT(twoSided->normal.x(), 0.5);  // out along the side face's own normal
-    const auto solids = intersectTriangles(side, top, true);
+    const auto solids = intersectTriangles(side, top, FaceSides::Solids);
     ASSERT_TRUE(solids);
     EXPECT_NEAR(solids->depth, 0.01, 1e-12);
     EXPECT_TRUE(solids->normal.isApprox(Vec3::UnitY(), 1e-12));
     // The same with the lower box's face first: it is pushed down, out of the upper box.
-    const auto reversed = intersectTriangles(top, side, true);
+    const auto reversed = intersectTriangles(top, side, FaceSides::Solids);
     ASSERT_TRUE(reversed);
     EXPECT_NEAR(reversed->depth, 0.01, 1e-12);
     EXPECT_TRUE(reversed->normal.isApprox(-Vec3::UnitY(), 1e-12));
     // Sunk deeper than a tenth of the faces' size, the push along y is no longer taken for the
     // solids' overlap (it could be a slide along a face): the two-sided push stays.
     const Triangle deep = shifted(side, {0, -0.2, 0});
-    EXPECT_LT(intersectTriangles(deep, top, true)->depth, 1e-12);
+    EXPECT_LT(intersectTriangles(deep, top, FaceSides::Solids)->depth, 1e-12);
 }
 
-// On random pairs, faces of solids change the push only as the header says: the contact is
+// Faces of solids meeting nearly parallel and opposing: a small face tilted 3.8 degrees on a
+// large floor face, one side 0.06 below the floor's plane and the other 0.006 above. Two-sided,
+// the smallest push lifts the floor through the small face by 0.006; read as solids, the floor
+// is pushed back down by the small face's depth behind it, 0.06 (its lowest corners), at the
+// middle of that depth. (The floor behind the tilted face reaches 0.06 / cos 3.8 deg: deeper.)
+TEST(TriangleTriangle, OpposingFacesOfSolidsArePushedBackNotThrough) {
+    const Triangle floor{{-5, 0, -5}, {-5, 0, 10}, {10, 0, -5}};     // normal +y
+    const Triangle tilted{{0, -0.06, 0}, {1, 0.006, 0}, {0, -0.06, 1}};  // normal (0.066, -1, 0), down
+    const auto twoSided = intersectTriangles(floor, tilted);
+    ASSERT_TRUE(twoSided);
+    EXPECT_GT(twoSided->normal.y(), 0.99);  // through: the floor lifted over the small face
+    EXPECT_NEAR(twoSided->depth, 0.006, 1e-12);
+    expectSameBits(intersectTriangles(floor, tilted, FaceSides::Solids), twoSided, 0);  // deformable pairs: two-sided
+    const auto solids = intersectTriangles(floor, tilted, FaceSides::RigidSolids);
+    ASSERT_TRUE(solids);
+    EXPECT_TRUE(solids->normal.isApprox(-Vec3::UnitY(), 1e-12));
+    EXPECT_NEAR(solids->depth, 0.06, 1e-12);
+    EXPECT_NEAR(solids->point.y(), -0.03, 1e-12);
+    EXPECT_NEAR(solids->point.x(), 0.0, 1e-12);
+    // First and second swapped: the small face is pushed back up out of the floor, as deep.
+    const auto swapped = intersectTriangles(tilted, floor, FaceSides::RigidSolids);
+    ASSERT_TRUE(swapped);
+    EXPECT_NEAR(swapped->depth, 0.06, 1e-12);
+    EXPECT_GT(swapped->normal.y(), 0.99);
+}
+
+// On random pairs, faces of rigid solids change the push only as the header says: the contact is
 // there exactly when the two-sided one is; the push is the two-sided one unless that leans more
 // than 30 degrees out along the first face's normal or into the second's, and then it leans
-// less, is no longer than a tenth of the shorter triangle's longest edge, and still separates
-// the triangles (checked by the existence test, which does not depend on the push). With lanes
-// and one at a time, the same bits.
+// less and still separates the triangles (checked by the existence test, which does not depend
+// on the push); between faces more than 30 degrees from parallel it is no longer than a tenth
+// of the shorter triangle's longest edge, between opposing faces nearer parallel it is along
+// one face's normal (FaceSides::Solids leaves those two-sided). With lanes and one at a time,
+// the same bits.
 TEST(TriangleTriangle, FacesOfSolidsChangeOnlyPushesOutOfTheCone) {
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> small(-0.3, 0.3);
-    int changed = 0, contacts = 0;
+    int changed = 0, contacts = 0, opposing = 0;
     for (int k = 0; k < 20000; ++k) {
         const Triangle x = randomTriangle(rng);
         const Triangle y = k % 2 == 0 ? randomTriangle(rng) : shifted(x, {small(rng), small(rng), small(rng)});
-        const auto twoSided = intersectTriangles(x, y), solids = intersectTriangles(x, y, true);
+        const auto twoSided = intersectTriangles(x, y), solids = intersectTriangles(x, y, FaceSides::RigidSolids);
+        const auto deformable = intersectTriangles(x, y, FaceSides::Solids);
         ASSERT_EQ(twoSided.has_value(), solids.has_value()) << "pair " << k;
         if (!solids) continue;
         ++contacts;
         if (detail::lanesEnabled()) {
             const detail::ScopedScalarLanes oneAtATime;
-            expectSameBits(solids, intersectTriangles(x, y, true), k);
+            expectSameBits(solids, intersectTriangles(x, y, FaceSides::RigidSolids), k);
         }
         if (bitsOf(solids->depth) == bitsOf(twoSided->depth) && solids->normal == twoSided->normal) continue;
         ++changed;
@@ -274,13 +303,22 @@ TEST(TriangleTriangle, FacesOfSolidsChangeOnlyPushesOutOfTheCone) {
         EXPECT_TRUE(twoSided->normal.dot(n1) > 0.5 || twoSided->normal.dot(n2) < -0.5) << "pair " << k;
         EXPECT_LE(solids->normal.dot(n1), 0.5) << "pair " << k;
         EXPECT_GE(solids->normal.dot(n2), -0.5) << "pair " << k;
-        const double shorter = std::min({std::max({(x.b - x.a).norm(), (x.c - x.b).norm(), (x.a - x.c).norm()}),
-                                         std::max({(y.b - y.a).norm(), (y.c - y.b).norm(), (y.a - y.c).norm()})});
-        EXPECT_LE(solids->depth, 0.1 * shorter + 1e-12) << "pair " << k;
+        if (std::abs(n1.dot(n2)) > std::cos(M_PI / 6)) {
+            ++opposing;
+            EXPECT_LT(n1.dot(n2), 0.0) << "pair " << k;
+            EXPECT_TRUE(solids->normal.isApprox(n2, 1e-12) || solids->normal.isApprox(-n1, 1e-12)) << "pair " << k;
+            expectSameBits(deformable, twoSided, k);  // Solids alone leaves these two-sided
+        } else {
+            expectSameBits(deformable, solids, k);
+            const double shorter = std::min({std::max({(x.b - x.a).norm(), (x.c - x.b).norm(), (x.a - x.c).norm()}),
+                                             std::max({(y.b - y.a).norm(), (y.c - y.b).norm(), (y.a - y.c).norm()})});
+            EXPECT_LE(solids->depth, 0.1 * shorter + 1e-12) << "pair " << k;
+        }
         EXPECT_FALSE(intersectTriangles(shifted(x, (solids->depth * (1 + 1e-6) + 1e-9) * solids->normal), y)) << "pair " << k;
     }
     EXPECT_GT(contacts, 2000);
     EXPECT_GT(changed, 50);
+    EXPECT_GT(opposing, 10);
 }
 
 TEST(TriangleGap, ALowerBoundOnTheDistanceThatKeepsPairsApart) {
