@@ -216,27 +216,47 @@ TEST(ContactSolver, BounceKeepsRestitutionSquaredOfTheHeight) {
     }
 }
 
+namespace {
+
+// A static floor (its top at y = 0) and dynamic cubes on it, all with friction 0.5: cube k of
+// half extent cubes[k].first with its centre at height cubes[k].second. Returns the cubes.
+std::vector<BodyId> cubesOnAFloor(World& world, std::initializer_list<std::pair<double, double>> cubes) {
+    world.add(buildPartModel(makeBox(Vec3(5, 1, 5), 1)), rigidPart(), withFriction({}, 0.5, 0.5), at(Vec3(0, -1, 0)));
+    std::vector<BodyId> ids;
+    for (const auto& [half, height] : cubes)
+        ids.push_back(world.add(cube(half), rigidPart(), withFriction(dynamicBody(), 0.5, 0.5), at(Vec3(0, height, 0))));
+    return ids;
+}
+
+// Three cubes, each smaller than the one below (half extents 0.6, 0.45, 0.3), each 1e-6 above
+// where it rests.
+std::vector<BodyId> smallerOnLarger(World& world) {
+    return cubesOnAFloor(world, {{0.6, 0.6 + 1e-6}, {0.45, 1.65 + 1e-6}, {0.3, 2.4 + 1e-6}});
+}
+
+// How far the bodies move and turn over `steps` steps.
+PoseDrift driftOver(World& world, const std::vector<BodyId>& ids, int steps) {
+    PoseDrift drift(world, ids);
+    for (int i = 0; i < steps; ++i) {
+        world.step();
+        drift.record(world);
+    }
+    return drift;
+}
+
+}  // namespace
+
 TEST(ContactSolver, AStackStaysAtRest) {
     // Three cubes, each smaller than the one below, on a floor for 5 s: no jitter, no creep.
     World world(WorldSettings{1e-3, Vec3(0, -kG, 0), {}, 0.25, 4096, 8});
-    world.add(buildPartModel(makeBox(Vec3(5, 1, 5), 1)), rigidPart(), withFriction({}, 0.5, 0.5), at(Vec3(0, -1, 0)));
-    std::vector<BodyId> boxes;
-    double top = 0.0;
-    for (double half : {0.6, 0.45, 0.3}) {
-        boxes.push_back(world.add(cube(half), rigidPart(), withFriction(dynamicBody(), 0.5, 0.5), at(Vec3(0, top + half + 1e-6, 0))));
-        top += 2.0 * half;
-    }
+    const std::vector<BodyId> boxes = smallerOnLarger(world);
     for (int i = 0; i < 200; ++i) world.step();  // settle into the contacts
-    PoseDrift drift(world, boxes);
 #if defined(__SANITIZE_ADDRESS__)
     constexpr int kSteps = 1000;  // ~20x slower there: the Release build checks all 5 s
 #else
     constexpr int kSteps = 5000;
 #endif
-    for (int i = 0; i < kSteps; ++i) {
-        world.step();
-        drift.record(world);
-    }
+    const PoseDrift drift = driftOver(world, boxes, kSteps);
     EXPECT_LT(drift.translation, 1e-3);
     EXPECT_LT(drift.rotation, 1e-3);
 }
@@ -245,20 +265,13 @@ TEST(ContactSolver, AStackOfEqualCubesStandsFlush) {
     // Three equal cubes (half extent 0.45) stacked face on face: each face's rim lies on the
     // other's side faces, so every triangle crossing lies on a coincident edge. Read two-sided,
     // those crossings gave depth 0 sideways and the cubes sank into each other (stack.toml with
-    // three such cubes: 0.073 each in 3 s); read as faces of solids (intersectTriangles'
-    // ofSolids) they push the cubes apart. Each stands at its analytic height (the floor's top at 0, centres at 0.45, 1.35,
-    // 2.25) within the contact slop, and holds still in the third second (warm starting).
+    // three such cubes: 0.073 each in 3 s); read as faces of solids (FaceSides) they push the
+    // cubes apart. Each stands at its analytic height (the floor's top at 0, centres at 0.45,
+    // 1.35, 2.25) within the contact slop, and holds still in the third second (warm starting).
     World world(WorldSettings{1e-3, Vec3(0, -kG, 0), {}, 0.25, 4096, 8});
-    world.add(buildPartModel(makeBox(Vec3(5, 1, 5), 1)), rigidPart(), withFriction({}, 0.5, 0.5), at(Vec3(0, -1, 0)));
-    std::vector<BodyId> cubes;
-    for (int k = 0; k < 3; ++k)
-        cubes.push_back(world.add(cube(0.45), rigidPart(), withFriction(dynamicBody(), 0.5, 0.5), at(Vec3(0, 0.45 + 0.9 * k + 1e-4 * (k + 1), 0))));
+    const std::vector<BodyId> cubes = cubesOnAFloor(world, {{0.45, 0.4501}, {0.45, 1.3502}, {0.45, 2.2503}});
     for (int i = 0; i < 2000; ++i) world.step();
-    PoseDrift drift(world, cubes);
-    for (int i = 0; i < 1000; ++i) {
-        world.step();
-        drift.record(world);
-    }
+    const PoseDrift drift = driftOver(world, cubes, 1000);
     const double slop = world.settings().contactSlop * 0.9;
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(world.centreOfMass(cubes[std::size_t(k)]).y(), 0.45 + 0.9 * k, slop) << "cube " << k;
     EXPECT_LT(drift.translation, 1e-9);
@@ -271,19 +284,9 @@ TEST(ContactSolver, WarmStartedContactsHoldAStackStill) {
     // the first iteration and nothing creeps. With each point started from zero (e42a3eb) the
     // boxes wandered by 3.4e-5 in this second (1.75e-4 over 5 s); now by less than 1e-9.
     World world(WorldSettings{1e-3, Vec3(0, -kG, 0), {}, 0.25, 4096, 8});
-    world.add(buildPartModel(makeBox(Vec3(5, 1, 5), 1)), rigidPart(), withFriction({}, 0.5, 0.5), at(Vec3(0, -1, 0)));
-    std::vector<BodyId> boxes;
-    double top = 0.0;
-    for (double half : {0.6, 0.45, 0.3}) {
-        boxes.push_back(world.add(cube(half), rigidPart(), withFriction(dynamicBody(), 0.5, 0.5), at(Vec3(0, top + half + 1e-6, 0))));
-        top += 2.0 * half;
-    }
+    const std::vector<BodyId> boxes = smallerOnLarger(world);
     for (int i = 0; i < 200; ++i) world.step();
-    PoseDrift drift(world, boxes);
-    for (int i = 0; i < 1000; ++i) {
-        world.step();
-        drift.record(world);
-    }
+    const PoseDrift drift = driftOver(world, boxes, 1000);
     EXPECT_LT(drift.translation, 1e-9);
     EXPECT_LT(drift.rotation, 1e-9);
 }
