@@ -209,12 +209,12 @@ bool leavesCone(const Vec3& unit, const Vec3& n1, const Vec3& n2) {
     return (along1 > 0.0 && along1 * along1 > slack2 * n1.squaredNorm()) || (along2 < 0.0 && along2 * along2 > slack2 * n2.squaredNorm());
 }
 
-// Faces of solids (FaceSides::Solids) more than 30 degrees from parallel whose
-// smallest push clearly leaves the cone (out along first's normal or into second): the
-// smallest push within the cone instead, if it is short: within a tenth of the shorter of the
-// two triangles' longest edges. A longer one is more likely a slide along a face than the
-// solids' overlap (at a convex edge turned more than the slack, the push that separates leaves
-// the cone of one of the faces), and the two-sided push stays.
+// Faces of solids (FaceSides::Solids) more than 30 degrees from parallel whose smallest push
+// clearly leaves the cone (out along first's normal or into second): the smallest push within
+// the cone instead, if it is short: within a tenth of the shorter of the two triangles' longest
+// edges. A longer one is more likely a slide along a face than the solids' overlap (at a
+// convex edge turned more than the slack, the push that separates leaves the cone of one of
+// the faces), and the two-sided push stays.
 void solidPush(const Triangle& first, const Triangle& second, std::span<const Vec3> axes, double minLength2, const Vec3& n1,
                const Vec3& n2, double& bestOverlap, Vec3& bestAxis) {
     const PushCone cone{true, n1.normalized(), n2.normalized()};
@@ -263,11 +263,11 @@ std::optional<Deepest> deepestBehind(const Triangle& t, const Triangle& base, co
     return deepest;
 }
 
-// Opposing faces of rigid solids within 30 degrees of parallel whose smallest push leaves the cone
-// (it goes through the other face): the push back, out of the other's solid along one face's
-// normal, by the depth of one triangle's deepest point behind the other within its prism, at
-// the middle of that depth. Of first pushed along n2 and first pushed back along -n1 (second's
-// deepest point behind first), the shallower; none when neither reaches behind the other there.
+// Opposing faces of rigid solids within 30 degrees of parallel whose smallest push leaves the
+// cone (it goes through the other face): the push back, out of the other's solid along one
+// face's normal, by the depth of one triangle's deepest point behind the other within its
+// prism, at the middle of that depth. Of first pushed along n2 and first pushed back along -n1
+// (second's deepest point behind first), the shallower; none when neither reaches behind.
 std::optional<TriangleContact> opposingFacesPush(const Triangle& first, const Triangle& second, const Vec3& n1, const Vec3& n2) {
     const Vec3 u1 = n1.normalized(), u2 = n2.normalized();
     const std::optional<Deepest> firstBehind = deepestBehind(first, second, u2), secondBehind = deepestBehind(second, first, u1);
