@@ -29,9 +29,14 @@ def percentile(sorted_values, p):
     return sorted_values[min(len(sorted_values), max(1, math.ceil(p / 100 * len(sorted_values)))) - 1]
 
 
-def step_us(row, stages):
-    """World::step's time in a metrics.csv row: its us_world_step, or (older builds) the sum of `stages`."""
-    return float(row["us_world_step"]) if "us_world_step" in row else sum(float(row[k]) for k in stages)
+def stage_columns(row):
+    """A metrics.csv row's per-stage time columns (us_*, but the whole step's)."""
+    return [k for k in row if k.startswith("us_") and k != "us_world_step"]
+
+
+def step_us(row):
+    """World::step's time in a metrics.csv row: its us_world_step, or (older builds) the sum of its stages."""
+    return float(row["us_world_step"]) if "us_world_step" in row else sum(float(row[k]) for k in stage_columns(row))
 
 
 def measure(flexfit, scene, directory):
@@ -43,8 +48,8 @@ def measure(flexfit, scene, directory):
         rows = [r for r in csv.DictReader(f) if float(r["contacts"]) > 0]
     if not rows:
         raise SystemExit(f"{scene}: no step with contacts under {flexfit}")
-    stages = [k for k in rows[0] if k.startswith("us_") and k != "us_world_step"]
-    steps = sorted(step_us(r, stages) for r in rows)
+    stages = stage_columns(rows[0])
+    steps = sorted(step_us(r) for r in rows)
     figures = {"step_source": "us_world_step" if "us_world_step" in rows[0] else "sum of stages", "contact_steps": len(rows), "contacts": statistics.mean(float(r["contacts"]) for r in rows),
                "us_step_p50": percentile(steps, 50), "us_step_p99": percentile(steps, 99), "us_step_max": steps[-1]}
     figures.update({k: statistics.mean(float(r[k]) for r in rows) for k in stages})

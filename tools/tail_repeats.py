@@ -39,8 +39,7 @@ def contact_step_times(metrics):
         rows = [r for r in csv.DictReader(f) if float(r["contacts"]) > 0]
     if not rows:
         return []
-    stages = [k for k in rows[0] if k.startswith("us_") and k != "us_world_step"]
-    return [step_us(r, stages) for r in rows]
+    return [step_us(r) for r in rows]
 
 
 def run(flexfit, scene, out):

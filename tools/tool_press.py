@@ -219,8 +219,7 @@ def measure(flexfit, scene, directory):
     subprocess.run([flexfit, "run", scene, "--out", out, "--no-progress"], check=True, stdout=subprocess.DEVNULL)
     with open(os.path.join(out, "metrics.csv")) as f:
         rows = [r for r in csv.DictReader(f) if float(r["contacts"]) > 0]
-    stages = [k for k in rows[0] if k.startswith("us_") and k != "us_world_step"]
-    steps = [step_us(r, stages) for r in rows]
+    steps = [step_us(r) for r in rows]
     narrow = [float(r["us_narrow_phase"]) for r in rows]
     return {"contact_steps": len(rows), "contacts": statistics.mean(float(r["contacts"]) for r in rows),
             "moving_masses": statistics.mean(float(r["moving_masses"]) for r in rows),

@@ -176,29 +176,24 @@ inline std::string decodedText(std::string bytes, const std::string& source) {
     return bytes;
 }
 
-// The whole file as text; InputError naming it when it is missing, not a file, or unreadable.
-inline std::string readTextFile(const std::filesystem::path& path) {
+// The whole file as text; InputError naming it when it is missing, not a file, or unreadable
+// ("cannot open the <what> for reading", `what` naming the kind of file).
+inline std::string readTextFile(const std::filesystem::path& path, const char* what = "file") {
     std::error_code ec;
+    const std::string cannotOpen = std::string("cannot open the ") + what + " for reading";
     if (!std::filesystem::is_regular_file(path, ec))
-        throw InputError(path.string(), 0, std::filesystem::exists(path, ec) ? "not a regular file"
-                                                                               : "cannot open the file for reading: it does not exist");
+        throw InputError(path.string(), 0, std::filesystem::exists(path, ec) ? "not a regular file" : cannotOpen + ": it does not exist");
     std::ifstream file(path, std::ios::binary);
-    if (!file) throw InputError(path.string(), 0, "cannot open the file for reading");
+    if (!file) throw InputError(path.string(), 0, cannotOpen);
     std::ostringstream buffer;
     buffer << file.rdbuf();
     return buffer.str();
 }
 
-// A text format's file (mesh, scene, sweep) as its reader parses it: the bytes UTF-16 decoded
-// (decodedText). With `what`, a file that cannot be opened is "cannot open the <what>";
-// without, readTextFile's errors.
-inline std::string readTextDocument(const std::filesystem::path& path) { return decodedText(readTextFile(path), path.string()); }
-inline std::string readTextDocument(const std::filesystem::path& path, const char* what) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path.string(), 0, std::string("cannot open the ") + what);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return decodedText(text.str(), path.string());
+// A text format's file (mesh, scene, sweep) as its reader parses it: readTextFile's bytes,
+// UTF-16 decoded (decodedText).
+inline std::string readTextDocument(const std::filesystem::path& path, const char* what = "file") {
+    return decodedText(readTextFile(path, what), path.string());
 }
 
 }  // namespace flexfit::detail

@@ -114,9 +114,11 @@ void addContacts(std::span<const Contact> contacts, const Bodies& bodies, Contac
         const RigidBody& ba = bodies.rigid[a];
         const RigidBody& bb = bodies.rigid[b];
         SolverContact c;
-        c.key = {a, b, contact.faceA, contact.faceB, contact.massB};
         c.a = a;
         c.b = b;
+        c.faceA = contact.faceA;
+        c.faceB = contact.faceB;
+        c.massB = contact.massB;
         c.ra = contact.point - bodies.centreOfMass(a);
         c.rb = contact.point - bodies.centreOfMass(b);
         c.normal = contact.normal;
@@ -136,15 +138,16 @@ void addContacts(std::span<const Contact> contacts, const Bodies& bodies, Contac
 void keepImpulses(ContactSolver& solver) {
     solver.kept.clear();
     for (const SolverContact& c : solver.contacts)
-        solver.kept.push_back({c.key, c.normalImpulse, c.tangentImpulse1 * c.tangent1 + c.tangentImpulse2 * c.tangent2, c.normal});
+        solver.kept.push_back({keyOf(c), c.normalImpulse, c.tangentImpulse1 * c.tangent1 + c.tangentImpulse2 * c.tangent2, c.normal});
     std::sort(solver.kept.begin(), solver.kept.end(), [](const auto& x, const auto& y) { return x.key < y.key; });
 }
 
 void warmStart(Bodies& bodies, ContactSolver& solver) {
     auto byKey = [](const ContactSolver::Kept& k, const ContactKey& key) { return k.key < key; };
     for (SolverContact& c : solver.contacts) {
-        const auto found = std::lower_bound(solver.kept.begin(), solver.kept.end(), c.key, byKey);
-        if (found == solver.kept.end() || found->key != c.key || found->normal.dot(c.normal) < kWarmStartAlignment) continue;
+        const ContactKey key = keyOf(c);
+        const auto found = std::lower_bound(solver.kept.begin(), solver.kept.end(), key, byKey);
+        if (found == solver.kept.end() || found->key != key || found->normal.dot(c.normal) < kWarmStartAlignment) continue;
         c.normalImpulse = std::min(found->normalImpulse, c.normalMass * c.bounceThreshold);
         const double kept = found->normalImpulse > 0.0 ? c.normalImpulse / found->normalImpulse : 0.0;
         c.tangentImpulse1 = kept * found->tangentImpulse.dot(c.tangent1);

@@ -54,8 +54,8 @@ struct ContactKey {
 };
 
 struct SolverContact {
-    ContactKey key;
     BodyId a = 0, b = 0;       // pushing a along +normal separates them
+    Index faceA = 0, faceB = 0, massB = kNoMass;  // the contact's (its key with a and b)
     Vec3 ra, rb;               // from each body's centre of mass to the point (world)
     Vec3 normal, tangent1, tangent2;
     double depth = 0.0;
@@ -65,6 +65,8 @@ struct SolverContact {
     double bounceThreshold = 1e-9;  // approach speed below which it does not bounce
     double staticFriction = 0.0, kineticFriction = 0.0, restitution = 0.0;
 };
+
+inline ContactKey keyOf(const SolverContact& c) { return {c.a, c.b, c.faceA, c.faceB, c.massB}; }
 
 struct ContactSolver {
     std::vector<SolverContact> contacts;

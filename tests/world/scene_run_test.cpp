@@ -70,9 +70,11 @@ duration = 0.4
 
 Scene exampleScene(const std::string& file) { return loadScene(std::string(FLEXFIT_EXAMPLES_DIR) + "/" + file); }
 
+// The steps `seconds` of the scene take.
+int stepsFor(const SceneRun& run, double seconds) { return int(std::lround(seconds / run.scene().world.timeStep)); }
+
 void runFor(SceneRun& run, double seconds) {
-    const int steps = int(std::lround(seconds / run.scene().world.timeStep));
-    for (int i = 0; i < steps; ++i) run.step();
+    for (int i = 0, steps = stepsFor(run, seconds); i < steps; ++i) run.step();
 }
 
 BodyId partNamed(const Scene& scene, std::string_view name) {
@@ -445,8 +447,7 @@ struct RunHashes {
 RunHashes runHashed(SceneRun& run, double seconds) {
     const World& w = run.world();
     detail::Fnv1a path;
-    const int steps = int(std::lround(seconds / run.scene().world.timeStep));
-    for (int i = 0; i < steps; ++i) {
+    for (int i = 0, steps = stepsFor(run, seconds); i < steps; ++i) {
         run.step();
         const std::uint64_t contacts = w.contacts().size();
         path.mix(&contacts, sizeof contacts);
