@@ -17,11 +17,7 @@ bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y())
 // A double is not finite when its exponent bits are all set (inf, nan): then adding one to the
 // exponent field carries into the sign bit. Or-ed over many values, bit 63 says whether any was.
 // Adding more (`carry`) flags smaller exponents too: a position beyond the model's bound.
-constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL, kExponentOne = std::uint64_t(1) << 52;
-inline std::uint64_t beyondBit(double x, std::uint64_t carry) { return (std::bit_cast<std::uint64_t>(x) & kExponent) + carry; }
-inline std::uint64_t beyondBit(const Vec3& v, std::uint64_t carry) {
-    return beyondBit(v.x(), carry) | beyondBit(v.y(), carry) | beyondBit(v.z(), carry);
-}
+constexpr std::uint64_t kExponentOne = std::uint64_t(1) << 52;
 inline std::uint64_t nonFiniteBit(double x) { return beyondBit(x, kExponentOne); }
 inline std::uint64_t nonFiniteBit(const Vec3& v) { return beyondBit(v, kExponentOne); }
 
@@ -65,8 +61,6 @@ Vec3 boundOrigin(const PartState& state, double positionBound) {
 bool allWithin(std::span<const Vec3> values, const Vec3& origin, double bound) {
     return noneBeyond(beyondBits(values, origin, carryBeyond(bound)));
 }
-
-std::uint64_t beyondBits(const Vec3& value, const Vec3& origin, std::uint64_t carry) { return beyondBit(value - origin, carry); }
 
 std::uint64_t beyondBits(std::span<const Vec3> values, const Vec3& origin, std::uint64_t carry) {
     if (values.empty()) return 0;

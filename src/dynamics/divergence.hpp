@@ -5,6 +5,8 @@
 #include "flexfit/active_region.hpp"
 #include "flexfit/simulation.hpp"
 
+#include <bit>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <span>
@@ -27,9 +29,20 @@ std::uint64_t carryBeyond(double bound);
 // Where a part's position bound is measured from: mass 0's position (a spread); zero for no
 // bound, so that finite is enough (x - x0 of two finite values may overflow).
 Vec3 boundOrigin(const PartState& state, double positionBound);
-// The or of every coordinate's bits, less the origin's: of many values, of one.
+// A double is not finite when its exponent bits are all set (inf, nan): then adding one to the
+// exponent field carries into the sign bit. Or-ed over many values, bit 63 says whether any was.
+// Adding more (`carry`) flags smaller exponents too: a position beyond the model's bound.
+inline constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL;
+inline std::uint64_t beyondBit(double x, std::uint64_t carry) { return (std::bit_cast<std::uint64_t>(x) & kExponent) + carry; }
+inline std::uint64_t beyondBit(const Vec3& v, std::uint64_t carry) {
+    return beyondBit(v.x(), carry) | beyondBit(v.y(), carry) | beyondBit(v.z(), carry);
+}
+// The or of every coordinate's bits, less the origin's: of many values (a vectorised pass),
+// of one (inline: the region step checks its loose masses one at a time).
 std::uint64_t beyondBits(std::span<const Vec3> values, const Vec3& origin, std::uint64_t carry);
-std::uint64_t beyondBits(const Vec3& value, const Vec3& origin, std::uint64_t carry);
+inline std::uint64_t beyondBits(const Vec3& value, const Vec3& origin, std::uint64_t carry) {
+    return beyondBit(value - origin, carry);
+}
 inline bool noneBeyond(std::uint64_t bits) { return (bits >> 63) == 0; }
 // True when every coordinate of the masses' positions, velocities and pending forces is
 // finite, and every position within `positionBound` of mass 0's (as allWithin).

@@ -63,6 +63,8 @@ struct PositionCheck {
     void add(const PartState& state, std::size_t first, std::size_t count) {
         bits |= beyondBits(std::span<const Vec3>(state.positions).subspan(first, count), origin, carry);
     }
+    // The bits of one mass (the region step's loose masses: no setup of the many-value pass).
+    void add(const PartState& state, std::size_t mass) { bits |= beyondBits(state.positions[mass], origin, carry); }
     bool passed() const { return covered && noneBeyond(bits); }
 };
 

@@ -37,13 +37,14 @@ void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const 
         detail::integrateMass(model, p, state, 0);
     }
     check->fixOrigin(state);
-    if (massZeroFirst) check->add(state, 0, octetZero ? 8 : 1);
+    if (octetZero) check->add(state, 0, 8);
+    else if (massZeroFirst) check->add(state, 0);
     detail::integrateOctets(model, p, octets, state, kernel, check);
     detail::integrateOctets(model, p, octetsAfter, state, kernel, check);
     for (Index i : region.looseMasses()) {
         if (i == 0 && massZeroFirst) continue;
         detail::integrateMass(model, p, state, i);
-        check->add(state, i, 1);
+        check->add(state, i);
     }
     check->covered = true;
 }
