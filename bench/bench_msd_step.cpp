@@ -74,7 +74,7 @@ flexfit::SimulationSettings benchSettings() {
 
 // Share of the model's springs in spring blocks (0 for the naive reference, which has none).
 double blockedShare(const flexfit::PartModel& model) {
-    return double(flexfit::SpringBlocks::kWidth * model.springBlocks->blockCount()) / double(model.springCount());
+    return double(model.springBlocks->blockedSprings()) / double(model.springCount());
 }
 
 void setCounters(benchmark::State& state, std::size_t springs, double inBlocks) {

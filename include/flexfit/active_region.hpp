@@ -74,7 +74,8 @@ private:
         IndexSet vector;                  // (groups) those with at least `minimum`
         IndexSet loose;                   // (members)
         void reset(std::size_t groups, std::size_t members, std::uint8_t minimumMembers);
-        // `group` is kNoGroup for a member of no group; memberOf(group, i) is its i-th member.
+        // `group` is kNoGroup for a member of no group; memberOf(group, i) is its i-th member, or
+        // kNoGroup for an empty place (a spring block's empty lane).
         // Called after the member joined or left; inRegion(m) says whether m is in the region.
         template <class MemberOf>
         void join(Index member, Index group, MemberOf memberOf);
@@ -85,7 +86,7 @@ private:
     void springJoins(Index spring);
     void springLeaves(Index spring);
     Index blockOf(Index spring) const;                 // its block, or kNoGroup
-    Index springOfBlock(Index block, Index i) const;   // lane i's spring
+    Index springOfBlock(Index block, Index i) const;   // lane i's spring, or kNoGroup (empty)
     Index octetOf(Index mass) const { return mass < coverCount_.size() / 8 * 8 ? mass / 8 : kNoGroup; }
 
     const PartModel* model_ = nullptr;

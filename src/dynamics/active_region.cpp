@@ -20,7 +20,8 @@ void ActiveRegion::VectorGroups::join(Index member, Index group, MemberOf member
     }
     if (count[group] > minimum) return;  // the group already runs in the vector kernel
     vector.insert(group);  // it reached the minimum: its members in the region leave the loose list
-    for (Index i = 0; i < 8; ++i) loose.erase(memberOf(group, i));
+    for (Index i = 0; i < 8; ++i)
+        if (const Index m = memberOf(group, i); m != kNoGroup) loose.erase(m);
 }
 
 template <class MemberOf, class InRegion>
@@ -32,7 +33,7 @@ void ActiveRegion::VectorGroups::leave(Index member, Index group, MemberOf membe
     if (count[group] >= minimum) return;  // it still runs in the vector kernel
     vector.erase(group);  // below the minimum: its members still in the region are loose again
     for (Index i = 0; i < 8; ++i)
-        if (inRegion(memberOf(group, i))) loose.insert(memberOf(group, i));
+        if (const Index m = memberOf(group, i); m != kNoGroup && inRegion(m)) loose.insert(m);
 }
 
 namespace {
@@ -86,6 +87,9 @@ void ActiveRegion::springLeaves(Index e) {
                            [this](Index spring) { return movingEnds_[spring] != 0; });
 }
 
-Index ActiveRegion::springOfBlock(Index block, Index i) const { return blocks_->laneSpring[SpringBlocks::kWidth * block + i]; }
+Index ActiveRegion::springOfBlock(Index block, Index i) const {
+    const Index spring = blocks_->laneSpring[SpringBlocks::kWidth * block + i];
+    return spring == SpringBlocks::kNoLane ? kNoGroup : spring;
+}
 
 }  // namespace flexfit

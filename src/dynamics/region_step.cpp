@@ -97,14 +97,15 @@ bool fullStepCostsLess(const PartModel& model, const RegionWork& work) {
     // the nearest caches, fitted as a ramp over the mass count (576 to 7,349 masses measured).
     const double regionSpring = 5.0 + 3.0 * std::min(1.0, double(model.massCount()) / 7000.0);
     constexpr double kRegionBlockLane = 2.7, kRegionMass = 2.0;
-    constexpr double kBlockSpring = 2.8, kListedSpring = 6.0, kPutBack = 0.3;
+    constexpr double kBlockLane = 2.8, kListedSpring = 6.0, kPutBack = 0.3;
     // No margin: near the crossover the two cost the same. (In a world the full step's
     // streaming also evicts what the collision stages keep in cache: measured on the haptic
     // scene, ~35 % of the springs, no difference either way.)
     const double region = regionSpring * double(work.looseSprings) + kRegionBlockLane * double(work.blockLanes) +
                           kRegionMass * double(work.movingMasses);
-    const std::size_t blocked = model.springBlocks->blockCount() * SpringBlocks::kWidth;
-    const double full = kBlockSpring * double(blocked) + kListedSpring * double(model.springCount() - blocked) +
+    const SpringBlocks& blocks = *model.springBlocks;
+    const double full = kBlockLane * double(blocks.blockCount() * SpringBlocks::kWidth) +
+                        kListedSpring * double(blocks.remainder.size()) +
                         kPutBack * double(model.massCount() - std::min(work.movingMasses, model.massCount()));
     return full < region;
 }

@@ -200,7 +200,7 @@ std::shared_ptr<PartModel> buildInGivenOrder(TriMesh mesh, const PartModelSettin
     for (Index a : model->springA) ++model->springAdr[a + 1];
     for (std::size_t v = 0; v < vertices; ++v) model->springAdr[v + 1] += model->springAdr[v];
     model->springBlocks = std::make_shared<const SpringBlocks>(
-        buildSpringBlocks(model->springA, model->springB, model->restLength, model->stiffness, model->damping));
+        buildSpringBlocks(model->springA, model->springB, model->restLength, model->stiffness, model->damping, vertices));
     model->mesh = std::move(mesh);
     return model;
 }
@@ -230,7 +230,7 @@ std::shared_ptr<PartModel> renumberedForLocality(const PartModel& given, const P
         s.springMaterials.clear();  // per-spring constants go in below, by edge
         return s;
     }());
-    if (model->springBlocks->blockCount() <= given.springBlocks->blockCount()) return nullptr;
+    if (model->springBlocks->blockedSprings() <= given.springBlocks->blockedSprings()) return nullptr;
     if (!settings.springMaterials.empty()) {
         const std::vector<Index> edgeOf = renumberedEdges(given.topology, model->topology, newIndex);
         for (std::size_t e = 0; e < edgeOf.size(); ++e) renumbered.springMaterials[edgeOf[e]] = settings.springMaterials[e];

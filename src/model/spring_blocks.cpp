@@ -6,28 +6,26 @@
 namespace flexfit {
 namespace {
 
-void appendBlock(SpringBlocks& blocks, std::span<const std::size_t> lanes, std::span<const Index> springA,
-                 std::span<const Index> springB, std::span<const double> restLength, std::span<const double> stiffness,
-                 std::span<const double> damping) {
-    blocks.first.push_back(springA[lanes[0]]);
-    blocks.offset.push_back(springB[lanes[0]] - springA[lanes[0]]);
-    for (std::size_t e : lanes) {
-        blocks.laneOfSpring[e] = Index(blocks.laneSpring.size());
-        blocks.laneSpring.push_back(Index(e));
-        blocks.restLength.push_back(restLength[e]);
-        blocks.stiffness.push_back(stiffness[e]);
-        blocks.damping.push_back(damping[e]);
-    }
+// Lane i of a new block: spring e, or an empty lane (zero constants) for e == kNoSpring.
+constexpr std::size_t kNoSpring = ~std::size_t(0);
+void appendLane(SpringBlocks& blocks, std::size_t e, std::span<const double> restLength, std::span<const double> stiffness,
+                std::span<const double> damping) {
+    const bool empty = e == kNoSpring;
+    if (!empty) blocks.laneOfSpring[e] = Index(blocks.laneSpring.size());
+    blocks.laneSpring.push_back(empty ? SpringBlocks::kNoLane : Index(e));
+    blocks.restLength.push_back(empty ? 0.0 : restLength[e]);
+    blocks.stiffness.push_back(empty ? 0.0 : stiffness[e]);
+    blocks.damping.push_back(empty ? 0.0 : damping[e]);
 }
 
 }  // namespace
 
 SpringBlocks buildSpringBlocks(std::span<const Index> springA, std::span<const Index> springB,
                                std::span<const double> restLength, std::span<const double> stiffness,
-                               std::span<const double> damping) {
+                               std::span<const double> damping, std::size_t massCount) {
     constexpr std::size_t W = SpringBlocks::kWidth;
     const std::size_t springs = springA.size();
-    // Springs by (offset, a): each offset's runs of consecutive a become contiguous.
+    // Springs by (offset, a): each offset's springs with nearby first masses become contiguous.
     std::vector<std::size_t> order(springs);
     std::iota(order.begin(), order.end(), std::size_t{0});
     auto key = [&](std::size_t e) { return std::pair(springB[e] - springA[e], springA[e]); };
@@ -35,21 +33,25 @@ SpringBlocks buildSpringBlocks(std::span<const Index> springA, std::span<const I
 
     SpringBlocks blocks;
     blocks.laneOfSpring.assign(springs, SpringBlocks::kNoLane);
-    std::vector<bool> blocked(springs, false);
     for (std::size_t start = 0; start < springs;) {
-        std::size_t end = start + 1;
-        while (end < springs && key(order[end]).first == key(order[start]).first &&
-               key(order[end]).second == key(order[end - 1]).second + 1)
-            ++end;
-        for (std::size_t s = start; s + W <= end; s += W) {
-            const std::span<const std::size_t> lanes(order.data() + s, W);
-            appendBlock(blocks, lanes, springA, springB, restLength, stiffness, damping);
-            for (std::size_t e : lanes) blocked[e] = true;
+        const auto [offset, a0] = key(order[start]);
+        std::size_t end = start + 1;  // the springs of this offset with first masses a0 .. a0 + 7
+        while (end < springs && key(order[end]).first == offset && key(order[end]).second < a0 + W) ++end;
+        const bool fits = std::size_t(a0) + W + offset <= massCount;  // every lane's ends are masses
+        if (end - start < SpringBlocks::kMinimumLanes || !fits) {
+            ++start;  // order[start] stays in the remainder
+            continue;
+        }
+        blocks.first.push_back(a0);
+        blocks.offset.push_back(offset);
+        for (std::size_t i = 0, next = start; i < W; ++i) {
+            const bool present = next < end && key(order[next]).second == a0 + i;
+            appendLane(blocks, present ? order[next++] : kNoSpring, restLength, stiffness, damping);
         }
         start = end;
     }
     for (std::size_t e = 0; e < springs; ++e)
-        if (!blocked[e]) blocks.remainder.push_back(Index(e));
+        if (blocks.laneOfSpring[e] == SpringBlocks::kNoLane) blocks.remainder.push_back(Index(e));
     return blocks;
 }
 

@@ -1,17 +1,23 @@
 // Spring blocks: the full step's vector layout of a model's springs (a diagonal format).
 //
-// A block is 8 springs (a0 + i, a0 + i + offset), i = 0..7: the same offset b - a, consecutive
+// A block is 8 lanes (a0 + i, a0 + i + offset), i = 0..7: the same offset b - a, consecutive
 // first masses. Its 8 first ends and its 8 second ends are each 24 contiguous doubles of the
 // state, so a block loads with 3 + 3 contiguous vector loads per array and needs no gather.
 // Meshes whose vertices come in rows (the torus, UV-sphere and heart generators, many parametric
-// or scanned surfaces) put nearly all springs in a few offsets: the heart 97% of its springs in
-// blocks, torus2 94%, torus1 88%, a 16 x 16 UV sphere 80%. The springs that fit no block are the
-// remainder: the vector kernels load each end's x y z as one vector and transpose 4 springs to
-// lanes (block_step_x86.cpp), nearly as fast as blocks on this machine (the heart's remainder
-// kernel alone: 1.3x its block kernel's time), so meshes in any vertex order (files as exporters
-// write them, icospheres in subdivision order) need no blocks to be fast. A model keeps every
-// block it finds: even at 43 % of the springs (the shuffled heart renumbered breadth-first)
-// blocks plus remainder beat the remainder alone (91 against 108 us a step).
+// or scanned surfaces) put nearly all springs in a few offsets. Irregular meshes renumbered by
+// fronts (vertex_order.hpp) line their fronts up only in short runs: a block then takes the
+// springs of one offset whose first masses fall in a0..a0+7 when there are at least
+// kMinimumLanes of them, and its other lanes are empty. An empty lane has zero constants and
+// evaluates to a zero force (+-0: the kernels' length test keeps 1/0 out), which changes no bit
+// of a force sum: the sums start at +0, and adding or subtracting +-0 changes no value but -0,
+// which such a sum never is (x - x is +0 when rounding to nearest). A block costs about the same
+// whatever its lanes hold, so a block of 5 springs still beats 5 listed ones: with at least 5 of 8
+// (against whole blocks only), Wuson in locality order puts 71 % of its springs in blocks (33 %)
+// and its full step ran 1.24x faster, the remeshed Wuson 1.52x (bench/results/masked_blocks_1206.csv;
+// 4 and 6 of 8 measured within noise of 5 in a scratch run).
+// The springs that fit no block are the remainder: the vector kernels load each end's x y z as
+// one vector and transpose 8 (AVX-512) or 4 (AVX2) springs to lanes (block_step_x86.cpp), so
+// meshes in any vertex order need no blocks to be correct, only to be fast.
 //
 // Without AVX2 (or off x86-64) the scalar kernel runs: about the naive reference's speed. It is
 // kept so that every CPU gives the same bits.
@@ -35,19 +41,22 @@ namespace flexfit {
 
 struct SpringBlocks {
     static constexpr int kWidth = 8;
+    static constexpr std::size_t kMinimumLanes = 5;  // springs a block holds at least
 
     std::vector<Index> first;   // (B) a0
     std::vector<Index> offset;  // (B) b - a of all its springs, >= 1
     // (8B) constants of lane i of block q at 8q + i.
     std::vector<double> restLength, stiffness, damping;
     std::vector<Index> remainder;  // springs in no block, ascending
-    // Lane 8q + i of block q is spring laneSpring[8q + i]; laneOfSpring[e] is its lane, or
-    // kNoLane for a remainder spring (the active region tracks its blocks with them).
+    // Lane 8q + i of block q is spring laneSpring[8q + i], or kNoLane when empty; laneOfSpring[e]
+    // is spring e's lane, or kNoLane for a remainder spring (the active region tracks its blocks
+    // with them).
     static constexpr Index kNoLane = ~Index(0);
     std::vector<Index> laneSpring;    // (8B)
     std::vector<Index> laneOfSpring;  // (E)
 
     std::size_t blockCount() const { return first.size(); }
+    std::size_t blockedSprings() const { return laneOfSpring.size() - remainder.size(); }
     bool empty() const { return first.empty(); }
     // Whether block q continues the offset-1 row of block q - 1.
     bool continuesRow(std::size_t q) const {
@@ -55,11 +64,13 @@ struct SpringBlocks {
     }
 };
 
-// Groups springs (a = springA[e] < springB[e], per-spring constants) into blocks: by offset in
-// increasing order, then by a; each maximal run of consecutive a gives floor(run / 8) blocks.
-// Every other spring goes to the remainder (all of them when no run reaches 8).
+// Groups springs (a = springA[e] < springB[e] < massCount, per-spring constants) into blocks:
+// by offset in increasing order, then by a; from each offset's lowest first mass a0 not yet
+// placed, the springs with first masses a0..a0+7 become a block when there are at least
+// kMinimumLanes of them and the block's lanes end at masses (a0 + 7 + offset < massCount).
+// Every other spring goes to the remainder (all of them when no block forms).
 SpringBlocks buildSpringBlocks(std::span<const Index> springA, std::span<const Index> springB,
                                std::span<const double> restLength, std::span<const double> stiffness,
-                               std::span<const double> damping);
+                               std::span<const double> damping, std::size_t massCount);
 
 }  // namespace flexfit

@@ -31,8 +31,8 @@ bool isPermutation(std::vector<Index> p) {
 double blockedShare(const TriMesh& mesh) {
     const Topology t = buildTopology(mesh.faces, mesh.vertices.size());
     const std::vector<double> ones(t.edgeCount(), 1.0);
-    const SpringBlocks blocks = buildSpringBlocks(t.edgeA, t.edgeB, ones, ones, ones);
-    return double(SpringBlocks::kWidth * blocks.blockCount()) / double(t.edgeCount());
+    const SpringBlocks blocks = buildSpringBlocks(t.edgeA, t.edgeB, ones, ones, ones, mesh.vertices.size());
+    return double(blocks.blockedSprings()) / double(t.edgeCount());
 }
 
 TEST(LocalityOrder, IsAPermutationOnAnyMesh) {
