@@ -190,9 +190,18 @@ struct RegionWork {
 // plus 0.3 ns per mass put back. Fitted 2026-12-05 to bench_zone_coverage's records on three
 // machines (AMD EPYC with AVX2, two Intel Xeons with AVX-512), torus1, torus2, the heart, the
 // shuffled heart, the same renumbered for locality and a 24,576-mass torus: wherever one path
-// was 10 % cheaper on every record, the rule picks it (tests/dynamics/region_step_test.cpp).
-// The cheaper estimate wins: near the crossover both cost the same. On CPUs without AVX2 both
-// steps run scalar, at 2-3 times these costs in about the same ratios.
+// was 10 % cheaper on every record, it picked it. On the same Intel machine on 2026-12-06 evening
+// the full step ran 1.2-1.5x faster against the region step than on 12-05 (torus1's whole step
+// 3.0 against 5.0 us, its region steps alike): the region steps the rule took between 30 and 66 %
+// coverage then cost 1.05-1.20x the whole model. So the region step is taken only where its
+// estimate is at most 0.62 of the full step's (about the two records' ratio of full-step speeds):
+// it takes the full step for torus1 at 32 % coverage (estimated 0.63; the region step cost 1.06-
+// 1.09x that evening, 0.70x on 12-05) and still the region step for the heart at 44-47 %
+// (estimated 0.61; 0.73-0.79x). Taking the full step costs the whole model plus the put-back,
+// which read up to 1.06x on the heart that evening (1.02x on 12-05)
+// (bench/results/zone_coverage_1206.csv; tests/dynamics/region_step_test.cpp pins the rule
+// against both records). On CPUs without AVX2 both steps run scalar, at 2-3 times these costs
+// in about the same ratios.
 bool fullStepCostsLess(const PartModel& model, const RegionWork& work);
 
 // Total kinetic + spring + anchor potential energy (no gravity), and linear momentum.
