@@ -199,8 +199,9 @@ struct RegionWork {
 // 1.09x that evening, 0.70x on 12-05) and still the region step for the heart at 44-47 %
 // (estimated 0.61; 0.73-0.79x). Taking the full step costs the whole model plus the put-back,
 // which read up to 1.06x on the heart that evening (1.02x on 12-05)
-// (bench/results/zone_coverage_1206.csv; tests/dynamics/region_step_test.cpp pins the rule
-// against both records). On CPUs without AVX2 both steps run scalar, at 2-3 times these costs
+// (bench/results/zone_coverage_1206.csv). tests/dynamics/region_step_test.cpp checks the rule
+// against both records where they agree: any share from about 0.45 to 0.75 passes it (the rule
+// of 12-05, share 1, fails), and 0.62 itself rests on the two rows quoted above. On CPUs without AVX2 both steps run scalar, at 2-3 times these costs
 // in about the same ratios.
 bool fullStepCostsLess(const PartModel& model, const RegionWork& work);
 

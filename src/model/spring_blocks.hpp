@@ -8,9 +8,11 @@
 // fronts (vertex_order.hpp) line their fronts up only in short runs: a block then takes the
 // springs of one offset whose first masses fall in a0..a0+7 when there are at least
 // kMinimumLanes of them, and its other lanes are empty. An empty lane has zero constants and
-// evaluates to a zero force (+-0: the kernels' length test keeps 1/0 out), which changes no bit
-// of a force sum: the sums start at +0, and adding or subtracting +-0 changes no value but -0,
-// which such a sum never is (x - x is +0 when rounding to nearest). A block costs about the same
+// evaluates to a zero force (+-0: the kernels' length test keeps 1/0 out; NaN only where its
+// masses' values already overflow), and every kernel evaluates it alike, so all three still give
+// the same bits. Against the same springs listed instead, adding +-0 changes at most the sign of
+// a zero sum (a sum starts at +0 and x - x is +0, but a denormal result flushed to zero keeps
+// its sign: FlushDenormals). A block costs about the same
 // whatever its lanes hold, so a block of 5 springs still beats 5 listed ones: with at least 5 of 8
 // (against whole blocks only), Wuson in locality order puts 71 % of its springs in blocks (33 %)
 // and its full step ran 1.24x faster, the remeshed Wuson 1.52x (bench/results/masked_blocks_1206.csv;

@@ -1,6 +1,7 @@
 // stepFullModel against independent references: the analytic damped oscillator, conservation
 // laws, and the thesis-style naive implementation (tests/support/naive_msd.hpp).
 #include "flexfit/flexfit.hpp"
+#include "model/spring_blocks.hpp"
 #include "strings.hpp"
 #include "golden.hpp"
 #include "naive_from_mesh.hpp"
@@ -8,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <random>
@@ -371,6 +373,8 @@ TEST(MsdStep, GoldenHashOfTheFullStepInEveryKernel) {
     const auto heart = buildPartModel(makeHeart());
     const auto shuffled = buildPartModel(flexfit::testing::shuffledVertices(makeTorus2(), 11));
     ASSERT_TRUE(torus2->hasSpringBlocks());
+    const std::vector<Index>& lanes = torus2->springBlocks->laneSpring;  // empty lanes run in every kernel too
+    ASSERT_NE(std::find(lanes.begin(), lanes.end(), SpringBlocks::kNoLane), lanes.end());
     ASSERT_FALSE(shuffled->hasSpringBlocks());  // every spring listed
     const std::vector<FullStepCase> cases = {
         {"torus2 blocks, constraint", torus2, SimulationSettings{}, 0x42bd4ed08cd96601ull},
