@@ -3,6 +3,7 @@
 #include "dynamics/flush_denormals.hpp"
 #include "dynamics/full_step.hpp"
 #include "flexfit/flexfit.hpp"
+#include "model/spring_blocks.hpp"
 #include "golden.hpp"
 #include "naive_from_mesh.hpp"
 #include "shuffled_mesh.hpp"
@@ -68,6 +69,7 @@ void documentedBlockForces(const SpringBlocks& blocks, const std::vector<Vec3>& 
     auto force = [&](std::size_t q, Index i) {
         const Index a = blocks.first[q] + i, b = a + blocks.offset[q];
         const std::size_t lane = W * q + i;
+        if (!blocks.laneSpring.empty() && blocks.laneSpring[lane] == SpringBlocks::kNoLane) return Vec3(Vec3::Zero());  // an empty lane
         return detail::springForceOnFirst(blocks.stiffness[lane], blocks.damping[lane], blocks.restLength[lane], x[a],
                                           x[b], v[a], v[b]);
     };
@@ -247,6 +249,39 @@ TEST(BlockStep, HandMadeBlocksFollowTheDocumentedOrderInEveryKernel) {
     RecordProperty("kernels", kernels);
     if (!detail::blockKernelAvailable(BlockKernel::Avx512))
         std::cout << "note: no AVX-512 on this CPU, its kernel was not compared\n";
+}
+
+// Blocks with empty lanes, the row block's last one ending at the last mass, over arrays of
+// exactly the model's masses (the sanitizers check that no kernel reads or writes past them):
+// every kernel gives the springs' forces in the documented order, the empty lanes adding nothing
+// to pending forces that are not zero.
+TEST(BlockStep, BlocksWithEmptyLanesEndingAtTheLastMassInEveryKernel) {
+    std::vector<Index> a, b;
+    for (Index first = 4; first <= 10; ++first) a.push_back(first), b.push_back(first + 1);  // row: lanes 4..10, 11 empty
+    for (Index first : {0u, 1u, 2u, 3u, 5u}) a.push_back(first), b.push_back(first + 3);    // offset 3: lanes 4, 6, 7 empty
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<double> rest, k, c;
+    for (std::size_t e = 0; e < a.size(); ++e) rest.push_back(1.0 + 0.5 * u(rng)), k.push_back(2.0 + u(rng)), c.push_back(0.1 + 0.05 * u(rng));
+    const std::size_t masses = 13;
+    const SpringBlocks blocks = buildSpringBlocks(a, b, rest, k, c, masses);
+    ASSERT_EQ(blocks.blockCount(), 2u);
+    ASSERT_EQ(blocks.first[0] + SpringBlocks::kWidth + blocks.offset[0], masses);  // the row block reaches mass 12
+    ASSERT_EQ(std::count(blocks.laneSpring.begin(), blocks.laneSpring.end(), SpringBlocks::kNoLane), 4);
+    std::vector<Vec3> x(masses), v(masses), f0(masses);
+    for (std::size_t m = 0; m < masses; ++m) {
+        x[m] = Vec3(double(m) + 0.3 * u(rng), u(rng), u(rng));
+        v[m] = Vec3(u(rng), u(rng), u(rng));
+        f0[m] = Vec3(u(rng), u(rng), u(rng));
+    }
+    std::vector<Vec3> expected = f0;
+    documentedBlockForces(blocks, x, v, expected);
+    for (BlockKernel kernel : kAllKernels) {
+        if (!detail::blockKernelAvailable(kernel)) continue;
+        std::vector<Vec3> f = f0;
+        detail::blockForces(blocks, x.data()->data(), v.data()->data(), f.data()->data(), kernel);
+        EXPECT_TRUE(sameBits(f, expected)) << detail::toString(kernel);
+    }
 }
 
 // holdAtRest: masses with cover count 0 back to rest with zero velocity, the others untouched,
