@@ -201,8 +201,8 @@ struct RegionWork {
 // which read up to 1.06x on the heart that evening (1.02x on 12-05)
 // (bench/results/zone_coverage_1206.csv). tests/dynamics/region_step_test.cpp checks the rule
 // against both records where they agree: any share from about 0.45 to 0.75 passes it (the rule
-// of 12-05, share 1, fails), and 0.62 itself rests on the two rows quoted above. On CPUs without AVX2 both steps run scalar, at 2-3 times these costs
-// in about the same ratios.
+// of 12-05, share 1, fails), and 0.62 itself rests on the two rows quoted above. On CPUs
+// without AVX2 both steps run scalar, at 2-3 times these costs in about the same ratios.
 bool fullStepCostsLess(const PartModel& model, const RegionWork& work);
 
 // Total kinetic + spring + anchor potential energy (no gravity), and linear momentum.

@@ -14,9 +14,7 @@ namespace {
 
 bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
 
-// A double is not finite when its exponent bits are all set (inf, nan): then adding one to the
-// exponent field carries into the sign bit. Or-ed over many values, bit 63 says whether any was.
-// Adding more (`carry`) flags smaller exponents too: a position beyond the model's bound.
+// beyondBit (divergence.hpp) with the smallest carry: inf and nan only.
 constexpr std::uint64_t kExponentOne = std::uint64_t(1) << 52;
 inline std::uint64_t nonFiniteBit(double x) { return beyondBit(x, kExponentOne); }
 inline std::uint64_t nonFiniteBit(const Vec3& v) { return beyondBit(v, kExponentOne); }

@@ -100,9 +100,9 @@ bool fullStepCostsLess(const PartModel& model, const RegionWork& work) {
     constexpr double kBlockLane = 2.8, kListedSpring = 6.0, kPutBack = 0.3;
     // The region step only where it is estimated at most kRegionShare of the full step: the two
     // paths' relative speed moves with the machine's state (simulation.hpp), and taking the
-    // full step wrongly costs its put-back (up to 1.06x), taking the region step wrongly up to 1.5x. (In a
-    // world the full step's streaming also evicts what the collision stages keep in cache:
-    // measured on the haptic scene, ~35 % of the springs, no difference either way.)
+    // full step wrongly costs its put-back (up to 1.06x), taking the region step wrongly up to
+    // 1.5x. (In a world the full step's streaming also evicts what the collision stages keep in
+    // cache: measured on the haptic scene, ~35 % of the springs, no difference either way.)
     constexpr double kRegionShare = 0.62;
     const double region = regionSpring * double(work.looseSprings) + kRegionBlockLane * double(work.blockLanes) +
                           kRegionMass * double(work.movingMasses);

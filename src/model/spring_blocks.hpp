@@ -12,11 +12,11 @@
 // masses' values already overflow), and every kernel evaluates it alike, so all three still give
 // the same bits. Against the same springs listed instead, adding +-0 changes at most the sign of
 // a zero sum (a sum starts at +0 and x - x is +0, but a denormal result flushed to zero keeps
-// its sign: FlushDenormals). A block costs about the same
-// whatever its lanes hold, so a block of 5 springs still beats 5 listed ones: with at least 5 of 8
-// (against whole blocks only), Wuson in locality order puts 71 % of its springs in blocks (33 %)
-// and its full step ran 1.24x faster, the remeshed Wuson 1.52x (bench/results/masked_blocks_1206.csv;
-// 4 and 6 of 8 measured within noise of 5 in a scratch run).
+// its sign: FlushDenormals). A block costs about the same whatever its lanes hold, so a block of
+// 5 springs still beats 5 listed ones: with at least 5 of 8 (against whole blocks only), Wuson
+// in locality order puts 71 % of its springs in blocks (33 %) and its full step ran 1.24x
+// faster, the remeshed Wuson 1.52x (bench/results/masked_blocks_1206.csv; 4 and 6 of 8
+// measured within noise of 5 in a scratch run).
 // The springs that fit no block are the remainder: the vector kernels load each end's x y z as
 // one vector and transpose 8 (AVX-512) or 4 (AVX2) springs to lanes (block_step_x86.cpp), so
 // meshes in any vertex order need no blocks to be correct, only to be fast.

@@ -90,6 +90,36 @@ void documentedBlockForces(const SpringBlocks& blocks, const std::vector<Vec3>& 
     }
 }
 
+// Positions about one apart along x (mass m near x = m), random velocities and pending forces:
+// the state the hand-made block tests start from.
+struct BlockInputs {
+    std::vector<Vec3> x, v, f0;
+};
+BlockInputs randomBlockInputs(std::size_t masses, std::mt19937& rng) {
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    BlockInputs in{std::vector<Vec3>(masses), std::vector<Vec3>(masses), std::vector<Vec3>(masses)};
+    for (std::size_t m = 0; m < masses; ++m) {
+        in.x[m] = Vec3(double(m) + 0.3 * u(rng), u(rng), u(rng));
+        in.v[m] = Vec3(u(rng), u(rng), u(rng));
+        in.f0[m] = Vec3(u(rng), u(rng), u(rng));
+    }
+    return in;
+}
+
+// Each available kernel's block forces added to the pending forces, against `expected` bit for
+// bit; how many kernels ran.
+int expectEveryKernelGives(const SpringBlocks& blocks, const BlockInputs& in, const std::vector<Vec3>& expected) {
+    int kernels = 0;
+    for (BlockKernel kernel : kAllKernels) {
+        if (!detail::blockKernelAvailable(kernel)) continue;
+        std::vector<Vec3> f = in.f0;
+        detail::blockForces(blocks, in.x.data()->data(), in.v.data()->data(), f.data()->data(), kernel);
+        EXPECT_TRUE(sameBits(f, expected)) << detail::toString(kernel);
+        ++kernels;
+    }
+    return kernels;
+}
+
 SimulationSettings settingsFor(RestorationMethod method, Integrator integrator) {
     SimulationSettings s;
     s.gravity = Vec3(0, -9.81, 0);
@@ -229,24 +259,11 @@ TEST(BlockStep, HandMadeBlocksFollowTheDocumentedOrderInEveryKernel) {
         }
     }
     const std::size_t masses = 110;
-    std::vector<Vec3> x(masses), v(masses), f0(masses);
-    for (std::size_t m = 0; m < masses; ++m) {
-        x[m] = Vec3(double(m) + 0.3 * u(rng), u(rng), u(rng));
-        v[m] = Vec3(u(rng), u(rng), u(rng));
-        f0[m] = Vec3(u(rng), u(rng), u(rng));
-    }
-    x[44] = x[41];  // lane 1 of the offset-3 block at 40: a zero-length spring
-    std::vector<Vec3> expected = f0;
-    documentedBlockForces(blocks, x, v, expected);
-    int kernels = 0;
-    for (BlockKernel kernel : kAllKernels) {
-        if (!detail::blockKernelAvailable(kernel)) continue;
-        std::vector<Vec3> f = f0;
-        detail::blockForces(blocks, x.data()->data(), v.data()->data(), f.data()->data(), kernel);
-        EXPECT_TRUE(sameBits(f, expected)) << detail::toString(kernel);
-        ++kernels;
-    }
-    RecordProperty("kernels", kernels);
+    BlockInputs in = randomBlockInputs(masses, rng);
+    in.x[44] = in.x[41];  // lane 1 of the offset-3 block at 40: a zero-length spring
+    std::vector<Vec3> expected = in.f0;
+    documentedBlockForces(blocks, in.x, in.v, expected);
+    RecordProperty("kernels", expectEveryKernelGives(blocks, in, expected));
     if (!detail::blockKernelAvailable(BlockKernel::Avx512))
         std::cout << "note: no AVX-512 on this CPU, its kernel was not compared\n";
 }
@@ -268,20 +285,10 @@ TEST(BlockStep, BlocksWithEmptyLanesEndingAtTheLastMassInEveryKernel) {
     ASSERT_EQ(blocks.blockCount(), 2u);
     ASSERT_EQ(blocks.first[0] + SpringBlocks::kWidth + blocks.offset[0], masses);  // the row block reaches mass 12
     ASSERT_EQ(std::count(blocks.laneSpring.begin(), blocks.laneSpring.end(), SpringBlocks::kNoLane), 4);
-    std::vector<Vec3> x(masses), v(masses), f0(masses);
-    for (std::size_t m = 0; m < masses; ++m) {
-        x[m] = Vec3(double(m) + 0.3 * u(rng), u(rng), u(rng));
-        v[m] = Vec3(u(rng), u(rng), u(rng));
-        f0[m] = Vec3(u(rng), u(rng), u(rng));
-    }
-    std::vector<Vec3> expected = f0;
-    documentedBlockForces(blocks, x, v, expected);
-    for (BlockKernel kernel : kAllKernels) {
-        if (!detail::blockKernelAvailable(kernel)) continue;
-        std::vector<Vec3> f = f0;
-        detail::blockForces(blocks, x.data()->data(), v.data()->data(), f.data()->data(), kernel);
-        EXPECT_TRUE(sameBits(f, expected)) << detail::toString(kernel);
-    }
+    BlockInputs in = randomBlockInputs(masses, rng);
+    std::vector<Vec3> expected = in.f0;
+    documentedBlockForces(blocks, in.x, in.v, expected);
+    expectEveryKernelGives(blocks, in, expected);
 }
 
 // holdAtRest: masses with cover count 0 back to rest with zero velocity, the others untouched,
