@@ -61,8 +61,6 @@ py::array vertexRows(const PartModel& model, const std::vector<Vec3>& perMass, p
     return a;
 }
 
-// The same for a world's body; an unknown body passes through for the C++ call to refuse.
-Index massOfBody(const World& w, BodyId id, Index vertex) { return id < w.bodyCount() ? w.part(id).model().massOf(vertex) : vertex; }
 
 template <class Enum>
 Enum enumFrom(const std::string& text, const char* what) {
@@ -567,14 +565,14 @@ PYBIND11_MODULE(_flexfit, m) {
         .def("centre_of_mass", &World::centreOfMass, py::arg("id"), "World position of a body's centre of mass.")
         .def("pose", [](const World& w, BodyId id) { return poseDict(w.part(id).pose()); }, py::arg("id"), "A body's pose: {'position', 'rotation_wxyz'}.")
         .def("apply_force", &World::applyForce, py::arg("id"), py::arg("force"), "A force at the centre of mass for the next step.")
-        .def("apply_mass_force", [](World& w, BodyId id, Index mass, const Vec3& force) { w.applyMassForce(id, massOfBody(w, id, mass), force); },
+        .def("apply_mass_force", [](World& w, BodyId id, Index mass, const Vec3& force) { w.applyMassForce(id, mass, force); },
              py::arg("id"), py::arg("mass"), py::arg("force"), "A world-frame force on one mass.")
-        .def("kick_mass", [](World& w, BodyId id, Index mass, const Vec3& change) { w.kickMass(id, massOfBody(w, id, mass), change); },
+        .def("kick_mass", [](World& w, BodyId id, Index mass, const Vec3& change) { w.kickMass(id, mass, change); },
              py::arg("id"), py::arg("mass"), py::arg("velocity_change"),
              "A velocity change on one mass of a deforming part; on a rigid dynamic body, the same momentum as an impulse.")
         .def("set_velocity", &World::setVelocity, py::arg("id"), py::arg("linear"), py::arg("angular") = Vec3::Zero(),
              "Sets a dynamic body's velocity (world frame; rad/s for the angular one).")
-        .def("open_zone", [](World& w, BodyId id, Index mass, int level) { return w.openZone(id, ZoneSeed::mass(massOfBody(w, id, mass)), level); }, py::arg("id"),
+        .def("open_zone", [](World& w, BodyId id, Index mass, int level) { return w.openZone(id, ZoneSeed::mass(mass), level); }, py::arg("id"),
              py::arg("mass"), py::arg("level"), "Opens a zone on a body's part around a mass (ahead of a contact); returns its id.")
         .def("grab", [](World& w, BodyId id, double frequency, double stiffness, double damping, double angularStiffness, double angularDamping) {
             GrabSettings g;

@@ -361,7 +361,8 @@ void App::handleInput() {
     if (selection_ && direction.squaredNorm() > 0 && forceTarget_ == 1)
         session_->setFaceForce(selection_->body, selection_->face, forceMagnitude_ * direction.normalized());
     else if (selection_ && direction.squaredNorm() > 0)
-        session_->setMassForce(selection_->body, selection_->mass, forceMagnitude_ * direction.normalized());
+        session_->setMassForce(selection_->body, session_->world().part(selection_->body).model().vertexOf(selection_->mass),
+                               forceMagnitude_ * direction.normalized());
     else
         session_->clearMassForce();
 }

@@ -297,7 +297,7 @@ void Session::release() { world().release(); }
 
 std::optional<BodyId> Session::grabbed() const { return world().grabbed(); }
 
-void Session::setMassForce(BodyId body, Index mass, const Vec3& worldForce) { massForce_ = MassForce{body, mass, false, worldForce}; }
+void Session::setMassForce(BodyId body, Index vertex, const Vec3& worldForce) { massForce_ = MassForce{body, vertex, false, worldForce}; }
 void Session::setFaceForce(BodyId body, Index face, const Vec3& worldForce) { massForce_ = MassForce{body, face, true, worldForce}; }
 
 }  // namespace flexfit::viewer

@@ -173,9 +173,9 @@ public:
     void rotateGrabbed(const Vec3& axis, double angle);
     void release();
     std::optional<BodyId> grabbed() const;
-    // A force on a selected mass or face (spread over its 3 masses), applied at every step
-    // until cleared.
-    void setMassForce(BodyId body, Index mass, const Vec3& worldForce);
+    // A force on a selected mass (named by the user's vertex, World::applyMassForce) or face
+    // (spread over its 3 masses), applied at every step until cleared.
+    void setMassForce(BodyId body, Index vertex, const Vec3& worldForce);
     void setFaceForce(BodyId body, Index face, const Vec3& worldForce);
     void clearMassForce() { massForce_.reset(); }
 
@@ -187,7 +187,7 @@ private:
     Vec3 grabOffset_ = Vec3::Zero();  // grabbed point in the body's frame
     struct MassForce {
         BodyId body;
-        Index index;  // a mass, or a face when onFace
+        Index index;  // a user's vertex, or a face when onFace
         bool onFace;
         Vec3 force;
     };

@@ -108,7 +108,8 @@ public:
     // Changes a part's settings while the world runs (Part::setSettings; its contact stiffness
     // follows). Throws InputError for a missing body or invalid settings.
     void setPartSettings(BodyId id, const PartSettings& settings);
-    // Opens a zone on a body's part (Part::openZone), e.g. to deform it ahead of a contact.
+    // Opens a zone on a body's part (Part::openZone), e.g. to deform it ahead of a contact. A
+    // mass seed names the user's vertex, as below.
     ZoneId openZone(BodyId id, ZoneSeed seed, int level);
     // The stiffness a deformable part opposes to contacts: its mean spring stiffness plus its
     // restoration's (k_a for anchors, c m / h^2 for the constraint at the world's step h). It
@@ -133,15 +134,17 @@ public:
     const Pose& grabTarget() const;
     const Coupling& coupling() const;
     // A world-frame force for the next step on one mass, or spread over a face's three masses.
-    // Throws InputError for an index out of range. Masses are the model's (a model renumbered
-    // for locality: PartModel::massOf of the mesh vertex).
-    void applyMassForce(BodyId id, Index mass, const Vec3& worldForce);
+    // Throws InputError for an index out of range. Here, in kickMass and in openZone a mass is
+    // named by the user's vertex index, whatever order the model keeps its masses in (the file's
+    // vertex when the read welded or removed some, else the given mesh's: PartModel::massOf),
+    // as scenes and the Python module name it; faces keep their indices in every order.
+    void applyMassForce(BodyId id, Index vertex, const Vec3& worldForce);
     void applyFaceForce(BodyId id, Index face, const Vec3& worldForce);
     // A velocity kick on one mass (Part::kickMass) of a deforming part; on a part that does not
     // deform, the same momentum (the mass's share, m_i dv) as an impulse at that mass on the
     // rigid body (static and kinematic bodies ignore it). Throws InputError for an index out of
     // range or a non-finite change.
-    void kickMass(BodyId id, Index mass, const Vec3& worldVelocityChange);
+    void kickMass(BodyId id, Index vertex, const Vec3& worldVelocityChange);
 
     // Assembly rules (assembly.hpp), checked in the assembly stage of every step. When a rule
     // triggers, its primary stops being driven (it becomes kinematic), is brought to its final
@@ -191,6 +194,9 @@ public:
 
 private:
     void checkBody(BodyId id, const char* what) const;
+    // The mass of a body's user vertex; InputError when it has none.
+    Index massOfVertex(BodyId id, Index vertex, const char* what) const;
+    void applyForceOnMass(BodyId id, Index mass, const Vec3& worldForce);
     std::unique_ptr<detail::WorldData> data_;
 };
 

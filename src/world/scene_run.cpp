@@ -29,16 +29,6 @@ SceneRun::SceneRun(const Scene& scene) : scene_(scene), world_(std::make_unique<
     world_->prepare();
 }
 
-namespace {
-
-// A scene's mass index names the user's vertex (the file's: PartModel::massOf); one out of range
-// (a scene built in code) is refused there with a file numbering, else by the world.
-Index massOfVertexOf(const World& world, BodyId body, Index vertex) {
-    return body < world.bodyCount() ? world.part(body).model().massOf(vertex) : vertex;
-}
-
-}  // namespace
-
 bool SceneRun::finished() const { return world_->time() >= scene_.duration - 0.5 * scene_.world.timeStep; }
 
 // Actions start at the first step whose start time reaches theirs; an action with a duration
@@ -68,7 +58,7 @@ void SceneRun::start(const SceneAction& a) {
         case Kind::Release: world_->release(); return;
         case Kind::Velocity: world_->setVelocity(a.body, a.linear, a.angular); return;
         case Kind::Kick:
-            for (Index m : a.masses) world_->kickMass(a.body, massOfVertexOf(*world_, a.body, m), a.linear);
+            for (Index m : a.masses) world_->kickMass(a.body, m, a.linear);
             return;
         case Kind::Move:
             // A snap may have taken the part from the operator: the move is then void.
@@ -83,7 +73,7 @@ void SceneRun::apply(const SceneAction& a, const Pose& moveStart, double t) {
     using Kind = SceneAction::Kind;
     if (a.kind == Kind::Push) world_->applyForce(a.body, a.force);
     if (a.kind == Kind::Force) {
-        for (Index m : a.masses) world_->applyMassForce(a.body, massOfVertexOf(*world_, a.body, m), a.force);
+        for (Index m : a.masses) world_->applyMassForce(a.body, m, a.force);
         for (Index f : a.faces) world_->applyFaceForce(a.body, f, a.force);
     }
     if (a.kind == Kind::Move && world_->grabbed() == a.body) {

@@ -100,6 +100,7 @@ double World::contactStiffness(BodyId id) const {
 
 ZoneId World::openZone(BodyId id, ZoneSeed seed, int level) {
     checkBody(id, "zone");
+    if (seed.kind == ZoneSeed::Kind::Mass) seed.index = massOfVertex(id, seed.index, "zone");
     return data_->bodies.parts[id]->openZone(seed, level);
 }
 
@@ -146,23 +147,29 @@ std::optional<BodyId> World::grabbed() const { return data_->op.grabbed; }
 const Pose& World::grabTarget() const { return data_->op.target; }
 const Coupling& World::coupling() const { return data_->op.coupling; }
 
-void World::applyMassForce(BodyId id, Index mass, const Vec3& worldForce) {
-    checkBody(id, "force");
+Index World::massOfVertex(BodyId id, Index vertex, const char* what) const {
+    checkBody(id, what);
+    const PartModel& model = data_->bodies.parts[id]->model();
+    const Index mass = model.massOf(vertex);  // throws for a file vertex without a mass
+    if (mass >= model.massCount())
+        throw InputError(kSource, 0, std::string(what) + ": vertex " + std::to_string(vertex) + " out of range for body " + std::to_string(id));
+    return mass;
+}
+
+void World::applyMassForce(BodyId id, Index vertex, const Vec3& worldForce) { applyForceOnMass(id, massOfVertex(id, vertex, "force"), worldForce); }
+
+void World::applyForceOnMass(BodyId id, Index mass, const Vec3& worldForce) {
     Part& part = *data_->bodies.parts[id];
-    if (mass >= part.model().massCount())
-        throw InputError(kSource, 0, "force: mass " + std::to_string(mass) + " out of range for body " + std::to_string(id));
     if (part.deforms())
         part.applyForce(mass, worldForce);
     else
         applyForceAt(id, worldForce, part.worldPosition(mass));
 }
 
-void World::kickMass(BodyId id, Index mass, const Vec3& worldVelocityChange) {
-    checkBody(id, "kick");
-    Part& part = *data_->bodies.parts[id];
-    if (mass >= part.model().massCount())
-        throw InputError(kSource, 0, "kick: mass " + std::to_string(mass) + " out of range for body " + std::to_string(id));
+void World::kickMass(BodyId id, Index vertex, const Vec3& worldVelocityChange) {
+    const Index mass = massOfVertex(id, vertex, "kick");
     if (!worldVelocityChange.allFinite()) throw InputError(kSource, 0, "kick on body " + std::to_string(id) + " must be finite");
+    Part& part = *data_->bodies.parts[id];
     if (part.deforms()) {
         part.kickMass(mass, worldVelocityChange);
         return;
@@ -180,7 +187,7 @@ void World::applyFaceForce(BodyId id, Index face, const Vec3& worldForce) {
     const auto& faces = data_->bodies.parts[id]->model().mesh.faces;
     if (face >= faces.size())
         throw InputError(kSource, 0, "force: face " + std::to_string(face) + " out of range for body " + std::to_string(id));
-    for (Index m : faces[face]) applyMassForce(id, m, worldForce / 3.0);
+    for (Index m : faces[face]) applyForceOnMass(id, m, worldForce / 3.0);
 }
 
 // --- Assembly ---

@@ -2,6 +2,7 @@
 // are deterministic, a deformable rim stops or yields to a ball by its stiffness, settings
 // change while it runs, and its calls refuse what does not exist; the default per-step
 // restoration at another time step is reported in warnings().
+#include "shuffled_mesh.hpp"
 #include "test_bodies.hpp"
 #include "flexfit/flexfit.hpp"
 
@@ -280,4 +281,42 @@ TEST(World, CallsRefuseBodiesThatDoNotExist) {
     EXPECT_THROW(world.setVelocity(0, Vec3(INFINITY, 0, 0), Vec3::Zero()), InputError);
     world.step();
     EXPECT_TRUE(world.body(0).linearVelocity.allFinite());
+}
+
+// World calls name a mass by the user's vertex: a model renumbered for locality and the same
+// shuffled mesh in its given order, loaded at the same vertices, move alike (up to the
+// summation order), a deforming part and a rigid dynamic body.
+TEST(World, MassLoadsNameTheUsersVertexInEveryVertexOrder) {
+    const TriMesh shuffled = shuffledVertices(makeTorus(3.0, 1.0, 24, 16), 7);
+    const Vec3 force(0.2, -0.1, 0.05), kick(0.0, 0.5, 0.0);
+    std::vector<Vec3> shapes[2];
+    Pose ballPoses[2];
+    for (const VertexOrder order : {VertexOrder::AsGiven, VertexOrder::Locality}) {
+        PartModelSettings settings;
+        settings.vertexOrder = order;
+        const auto model = buildPartModel(shuffled, settings);
+        ASSERT_EQ(model->renumbered(), order == VertexOrder::Locality);
+        World world;
+        const BodyId part = world.add(model, PartSettings{}, BodySettings{}, Pose{});
+        const BodyId ball = world.add(model, rigidPart(), dynamicBody(), at(Vec3(20, 0, 0)));
+        world.openZone(part, ZoneSeed::mass(11), 2);
+        EXPECT_TRUE(world.part(part).isMoving(model->massOf(11)));
+        world.kickMass(part, 200, kick);
+        world.kickMass(ball, 200, kick);
+        for (int i = 0; i < 60; ++i) {
+            world.applyMassForce(part, 37, force);
+            world.applyMassForce(ball, 37, force);
+            world.step();
+        }
+        const int k = order == VertexOrder::Locality;
+        world.part(part).vertexWorldPositions(shapes[k]);
+        ballPoses[k] = world.part(ball).pose();
+        EXPECT_THROW(world.applyMassForce(part, Index(shuffled.vertices.size()), force), InputError);
+        EXPECT_THROW(world.kickMass(ball, Index(shuffled.vertices.size()), kick), InputError);
+    }
+    for (const Index v : {37u, 200u}) EXPECT_GT((shapes[0][v] - shuffled.vertices[v]).norm(), 1e-4) << "vertex " << v << " was loaded";
+    for (std::size_t v = 0; v < shuffled.vertices.size(); ++v) EXPECT_NEAR((shapes[1][v] - shapes[0][v]).norm(), 0.0, 1e-12) << v;
+    EXPECT_NEAR((ballPoses[1].translation - ballPoses[0].translation).norm(), 0.0, 1e-12);
+    EXPECT_NEAR(ballPoses[1].rotation.angularDistance(ballPoses[0].rotation), 0.0, 1e-12);
+    EXPECT_GT(ballPoses[0].rotation.angularDistance(Eigen::Quaterniond::Identity()), 1e-4) << "the loads turned the body";
 }
