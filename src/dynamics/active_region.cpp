@@ -46,7 +46,7 @@ ActiveRegion::ActiveRegion(const PartModel& model)
       movingEnds_(model.springCount(), 0),
       masses_(model.massCount()),
       springs_(model.springCount()) {
-    octets_.reset(model.massCount() / 8, model.massCount(), 8);
+    octets_.reset(model.massCount() / 8, model.massCount(), kMinimumOctetMasses);
     if (!model.hasSpringBlocks()) return;
     blocks_ = model.springBlocks.get();
     blockGroups_.reset(blocks_->blockCount(), model.springCount(), kMinimumBlockSprings);

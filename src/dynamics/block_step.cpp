@@ -148,16 +148,24 @@ void listedSpringForces(const PartModel& model, std::span<const Index> springs, 
     }
 }
 
-void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
-                     BlockKernel kernel, PositionCheck* check) {
+void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,
+                     const std::uint16_t* held, PartState& state, BlockKernel kernel, PositionCheck* check) {
 #if defined(FLEXFIT_X86_KERNELS)
-    if (kernel == BlockKernel::Avx512) return integrateOctetsAvx512(model, update, octets, state, check);
-    if (kernel == BlockKernel::Avx2) return integrateOctetsAvx2(model, update, octets, state, check);
+    if (kernel == BlockKernel::Avx512) return integrateOctetsAvx512(model, update, octets, held, state, check);
+    if (kernel == BlockKernel::Avx2) return integrateOctetsAvx2(model, update, octets, held, state, check);
 #endif
     (void)check;
     (void)kernel;
     for (const Index octet : octets)
-        for (std::size_t i = 8 * std::size_t(octet); i < 8 * std::size_t(octet) + 8; ++i) integrateMass(model, update, state, i);
+        for (std::size_t i = 8 * std::size_t(octet); i < 8 * std::size_t(octet) + 8; ++i) {
+            if (held == nullptr || held[i] != 0) {
+                integrateMass(model, update, state, i);
+                continue;
+            }
+            state.positions[i] = model.restPositions[i];
+            state.velocities[i] = Vec3::Zero();
+            state.forces[i] = Vec3::Zero();
+        }
 }
 
 void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, PartState& state, BlockKernel kernel) {

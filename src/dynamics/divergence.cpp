@@ -97,7 +97,7 @@ bool regionFinite(const PartState& state, const ActiveRegion& region, bool veloc
     const Vec3 origin = boundOrigin(state, positionBound);
     const Origin24 origin24(origin), zero24(Vec3::Zero());
     std::uint64_t lanes[8] = {};
-    for (const Index octet : region.fullOctets()) {
+    for (const Index octet : region.vectorOctets()) {
         orBeyondBits24(state.positions.data()->data() + 24 * std::size_t(octet), origin24, carry, lanes);
         if (velocitiesToo) orBeyondBits24(state.velocities.data()->data() + 24 * std::size_t(octet), zero24, kExponentOne, lanes);
     }

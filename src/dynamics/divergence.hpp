@@ -74,7 +74,7 @@ void checkMassesFinite(const PartModel& model, const SimulationSettings& setting
                        std::span<const Index> masses, std::optional<BodyId> body, double time);
 void checkAllMassesFinite(const PartModel& model, const SimulationSettings& settings, const PartState& state,
                           std::optional<BodyId> body, double time);
-// checkMassesFinite over a region's moving masses after stepActiveRegion: its whole octets in
+// checkMassesFinite over a region's moving masses after stepActiveRegion: its vector octets in
 // contiguous passes, its other masses gathered, over their positions (and velocities with
 // explicit Euler) only, as checkAllMassesFinite: the step consumed their forces, and a
 // non-finite force or velocity has made the position non-finite in the same step.

@@ -100,10 +100,12 @@ void listedSpringForces(const PartModel& model, std::span<const Index> springs, 
 inline constexpr std::size_t kListChunk = 256;
 
 // Integrates the masses of the given octets (masses 8k..8k+7, each once) as integrateScalar
-// would, mass by mass: the same bits in every kernel. With `check` (its origin fixed), the
-// vector kernels or the new positions' beyond-bits into it; the scalar kernel does not.
-void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
-                     BlockKernel kernel, PositionCheck* check = nullptr);
+// would, mass by mass: the same bits in every kernel. The masses whose `held` count is 0 are
+// put at rest instead (position rest, velocity and force zero: where a region's masses that do
+// not move already are). With `check` (its origin fixed), the vector kernels or the new
+// positions' beyond-bits into it; the scalar kernel does not.
+void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,
+                     const std::uint16_t* held, PartState& state, BlockKernel kernel, PositionCheck* check = nullptr);
 
 // The vector kernels (block_step_x86.cpp). Forces of all blocks into f (3 doubles per mass).
 void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* v, double* f);
@@ -125,9 +127,9 @@ void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> ve
                            const double* x, const double* v, double* f);
 void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                              const double* x, const double* v, double* f);
-void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
+void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, const std::uint16_t* held, PartState& state,
                          PositionCheck* check = nullptr);
-void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, PartState& state,
+void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, const std::uint16_t* held, PartState& state,
                            PositionCheck* check = nullptr);
 // holdAtRest for masses [0, n), n the largest multiple of 8; returns n.
 std::size_t holdAtRestAvx512(const PartModel& model, const std::uint16_t* cover, PartState& state);

@@ -13,24 +13,26 @@ namespace flexfit {
 
 namespace {
 
-// The moving masses: body forces, integration, restoration; pending forces consumed. Whole
-// octets by the vector kernel, then the others one at a time (each mass alone: same bits). With
+// The moving masses: body forces, integration, restoration; pending forces consumed. The
+// region's vector octets by the vector kernel (their masses that do not move put back where they
+// are, at rest), then the others one at a time (each mass alone: same bits). With
 // `check`, mass 0 first when it moves (its octet, or itself), which fixes the origin; then every
 // other mass checked as it is written. Masses are independent here: the order changes no bit.
 void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const ActiveRegion& region, PartState& state,
                      detail::PositionCheck* check) {
     const detail::BlockKernel kernel = detail::fullStepKernel();
-    std::span<const Index> octets = region.fullOctets().members(), octetsAfter;
+    std::span<const Index> octets = region.vectorOctets().members(), octetsAfter;
+    const std::uint16_t* held = region.coverCounts().data();
     if (check == nullptr || kernel == detail::BlockKernel::Scalar) {
-        detail::integrateOctets(model, p, octets, state, kernel);
+        detail::integrateOctets(model, p, octets, held, state, kernel);
         for (Index i : region.looseMasses()) detail::integrateMass(model, p, state, i);
         return;
     }
     const bool massZeroFirst = check->fromMassZero() && region.moves(0);
-    const bool octetZero = massZeroFirst && region.fullOctets().contains(0);
+    const bool octetZero = massZeroFirst && region.vectorOctets().contains(0);
     if (octetZero) {  // octet 0 alone, then the octets before and after it in the list
-        const std::size_t slot = region.fullOctets().slotOf(0);
-        detail::integrateOctets(model, p, octets.subspan(slot, 1), state, kernel);
+        const std::size_t slot = region.vectorOctets().slotOf(0);
+        detail::integrateOctets(model, p, octets.subspan(slot, 1), held, state, kernel);
         octetsAfter = octets.subspan(slot + 1);
         octets = octets.first(slot);
     } else if (massZeroFirst) {
@@ -39,8 +41,8 @@ void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const 
     check->fixOrigin(state);
     if (octetZero) check->add(state, 0, 8);
     else if (massZeroFirst) check->add(state, 0);
-    detail::integrateOctets(model, p, octets, state, kernel, check);
-    detail::integrateOctets(model, p, octetsAfter, state, kernel, check);
+    detail::integrateOctets(model, p, octets, held, state, kernel, check);
+    detail::integrateOctets(model, p, octetsAfter, held, state, kernel, check);
     for (Index i : region.looseMasses()) {
         if (i == 0 && massZeroFirst) continue;
         detail::integrateMass(model, p, state, i);

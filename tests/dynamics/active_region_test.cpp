@@ -131,10 +131,11 @@ TEST(ActiveRegion, VectorBlocksAndLooseSpringsPartitionTheComputedSprings) {
     EXPECT_GT(fullSeen, 20u);       // and with all 8
 }
 
-// The octets, against brute force: whole octets are those whose 8 masses all move; loose masses
-// are the moving masses in none (the last V mod 8 masses are always loose). A mesh whose mass
-// count is not a multiple of 8, covered and uncovered in runs so octets form and break up.
-TEST(ActiveRegion, FullOctetsAndLooseMassesPartitionTheMovingMasses) {
+// The octets, against brute force: vector octets are those with at least kMinimumOctetMasses
+// of their 8 masses moving; loose masses are the moving masses in none (the last V mod 8 masses
+// are always loose). A mesh whose mass count is not a multiple of 8, covered and uncovered in
+// runs so octets form and break up.
+TEST(ActiveRegion, VectorOctetsAndLooseMassesPartitionTheMovingMasses) {
     const auto model = buildPartModel(makeIcoSphere(1.0, 2));  // 162 masses: 20 octets and 2 more
     ActiveRegion region(*model);
     std::vector<int> covers(model->massCount(), 0);
@@ -146,13 +147,13 @@ TEST(ActiveRegion, FullOctetsAndLooseMassesPartitionTheMovingMasses) {
         for (Index m = 0; m < model->massCount(); ++m)
             if (covers[m] > 0) loose.insert(m);
         for (Index o = 0; o < model->massCount() / 8; ++o) {
-            bool all = true;
-            for (Index m = 8 * o; m < 8 * o + 8; ++m) all = all && covers[m] > 0;
-            if (!all) continue;
+            std::size_t moving = 0;
+            for (Index m = 8 * o; m < 8 * o + 8; ++m) moving += covers[m] > 0;
+            if (moving < ActiveRegion::kMinimumOctetMasses) continue;
             whole.insert(o);
             for (Index m = 8 * o; m < 8 * o + 8; ++m) loose.erase(m);
         }
-        const auto w = region.fullOctets().members(), l = region.looseMasses().members();
+        const auto w = region.vectorOctets().members(), l = region.looseMasses().members();
         ASSERT_EQ(std::set<Index>(w.begin(), w.end()), whole) << "op " << op;
         ASSERT_EQ(w.size(), whole.size());
         ASSERT_EQ(std::set<Index>(l.begin(), l.end()), loose) << "op " << op;

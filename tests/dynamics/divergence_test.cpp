@@ -115,9 +115,10 @@ TEST(Divergence, TheLikelyCauseComesFromTheStabilityBound) {
     EXPECT_TRUE(contains(step, bound.str())) << step;
 }
 
-// The region check (whole octets contiguously, other masses gathered) runs right after a region
+// The region check (vector octets contiguously, other masses gathered) runs right after a region
 // step and reads positions (and velocities with explicit Euler) only: a bad velocity or pending
-// force before the step must still be found after it, in an octet mass and in a loose one,
+// force before the step must still be found after it, in an octet mass (of a whole octet and of
+// one in part) and in a loose one,
 // under each integrator (implicit Euler once dropped a NaN force silently: its solve gave a zero
 // velocity change for a non-finite right-hand side); a bad position is found without a step; it never looks outside the
 // region.
@@ -125,8 +126,9 @@ TEST(Divergence, RegionCheckFindsWhatTheMassByMassTestFinds) {
     const auto model = buildPartModel(makeTorus1());
     ActiveRegion region(*model);
     for (Index m = 0; m < 16; ++m) region.cover(m);  // octets 0 and 1
+    for (Index m = 16; m < 16 + ActiveRegion::kMinimumOctetMasses; ++m) region.cover(m);  // octet 2, in part
     region.cover(100);                               // a loose mass
-    ASSERT_EQ(region.fullOctets().size(), 2u);
+    ASSERT_EQ(region.vectorOctets().size(), 3u);
     ASSERT_EQ(region.looseMasses().size(), 1u);
     SimulationSettings semiImplicit, explicitEuler, implicitEuler;
     explicitEuler.integrator = Integrator::ExplicitEuler;
@@ -147,7 +149,7 @@ TEST(Divergence, RegionCheckFindsWhatTheMassByMassTestFinds) {
     EXPECT_EQ(throwsFor(semiImplicit, [](PartState&) {}), "");
     EXPECT_TRUE(finds(throwsFor(semiImplicit, [&](PartState& s) { s.positions[9].y() = nan; }, false), "position of mass 9"));
     for (const SimulationSettings* settings : {&semiImplicit, &explicitEuler, &implicitEuler})
-        for (Index mass : {Index(12), Index(100)}) {
+        for (Index mass : {Index(12), Index(17), Index(100)}) {
             // The bad value spreads along the springs within the step: the first bad mass is named.
             const std::string of = "is not finite";
             const std::string byVelocity = throwsFor(*settings, [&](PartState& s) { s.velocities[mass].x() = nan; });
