@@ -61,7 +61,6 @@ py::array vertexRows(const PartModel& model, const std::vector<Vec3>& perMass, p
     return a;
 }
 
-
 template <class Enum>
 Enum enumFrom(const std::string& text, const char* what) {
     const std::optional<Enum> value = parseName<Enum>(text);

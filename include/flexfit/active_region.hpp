@@ -12,9 +12,9 @@
 // kernels run: the spring blocks (the full step's vector layout, on models that have them) with
 // at least kMinimumBlockSprings of their springs computed (a block holds 5 to 8), and the octets
 // of masses 8k..8k+7 with at least kMinimumOctetMasses moving (the kernel puts the others back at
-// rest, where they are: the same bits as leaving them). The block kernel evaluates all 8 lanes of a block and adds
-// each force only to the ends that move: a spring that is not computed has no moving end, so it
-// adds nothing, and an empty lane's force is +-0 (spring_blocks.hpp).
+// rest, where they are: the same bits as leaving them). The block kernel evaluates all 8 lanes
+// of a block and adds each force only to the ends that move: a spring that is not computed has
+// no moving end, so it adds nothing, and an empty lane's force is +-0 (spring_blocks.hpp).
 // A block costs about 20 ns however many of its springs are computed (the kernels are bound by
 // each lane's square root and division). The minimum was measured, 2 to 5 against 8 (whole
 // blocks only), on torus1, torus2, the heart and the renumbered shuffled heart at levels 4-16:

@@ -777,12 +777,12 @@ std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, Pa
         integrate512(model, update, state, nullptr, first, groups, held, c);
     });
 }
-void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, const std::uint16_t* held,
-                         PartState& state, PositionCheck* check) {
+void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,
+                         const std::uint16_t* held, PartState& state, PositionCheck* check) {
     integrate256(model, update, state, octets.data(), 0, 2 * octets.size(), held, check);
 }
-void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, const std::uint16_t* held,
-                           PartState& state, PositionCheck* check) {
+void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,
+                           const std::uint16_t* held, PartState& state, PositionCheck* check) {
     integrate512(model, update, state, octets.data(), 0, octets.size(), held, check);
 }
 void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,

@@ -127,10 +127,10 @@ void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> ve
                            const double* x, const double* v, double* f);
 void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                              const double* x, const double* v, double* f);
-void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, const std::uint16_t* held, PartState& state,
-                         PositionCheck* check = nullptr);
-void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets, const std::uint16_t* held, PartState& state,
-                           PositionCheck* check = nullptr);
+void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,
+                         const std::uint16_t* held, PartState& state, PositionCheck* check = nullptr);
+void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,
+                           const std::uint16_t* held, PartState& state, PositionCheck* check = nullptr);
 // holdAtRest for masses [0, n), n the largest multiple of 8; returns n.
 std::size_t holdAtRestAvx512(const PartModel& model, const std::uint16_t* cover, PartState& state);
 

@@ -1,7 +1,7 @@
 // The world (src/world/world.cpp): its profile partitions every step among the stages, runs
 // are deterministic, a deformable rim stops or yields to a ball by its stiffness, settings
 // change while it runs, and its calls refuse what does not exist; the default per-step
-// restoration at another time step is reported in warnings().
+// restoration at another time step is reported in warnings(); mass loads name the user's vertices.
 #include "shuffled_mesh.hpp"
 #include "test_bodies.hpp"
 #include "flexfit/flexfit.hpp"
