@@ -20,11 +20,22 @@ import statistics
 import subprocess
 
 
+def run_report(binary, pattern, *flags):
+    """One run of a benchmark binary as a JSON report: 3 repetitions, 0.2 s minimum, aggregates only."""
+    return subprocess.run([binary, f"--benchmark_filter={pattern}", "--benchmark_repetitions=3", "--benchmark_min_time=0.2",
+                           *flags, "--benchmark_report_aggregates_only=true", "--benchmark_format=json"],
+                          capture_output=True, text=True, check=True).stdout
+
+
+def median_rows(report):
+    """The median rows (dicts, with their counters) of a benchmark JSON report."""
+    return [bm for bm in json.loads(report)["benchmarks"] if bm.get("aggregate_name") == "median"]
+
+
 def medians(report):
     """(run_name, label, real time in ns) of each median row of a benchmark JSON report."""
-    for bm in json.loads(report)["benchmarks"]:
-        if bm.get("aggregate_name") == "median":
-            yield bm["run_name"], bm.get("label", ""), bm["real_time"] * {"ns": 1, "us": 1e3, "ms": 1e6}[bm["time_unit"]]
+    for bm in median_rows(report):
+        yield bm["run_name"], bm.get("label", ""), bm["real_time"] * {"ns": 1, "us": 1e3, "ms": 1e6}[bm["time_unit"]]
 
 
 def table(times, labels, builds, reference, rounds):
@@ -58,10 +69,7 @@ def main():
     times, labels = collections.defaultdict(list), {}
     for r in range(args.rounds):
         for name, path in builds if r % 2 == 0 else builds[::-1]:
-            report = subprocess.run([path, f"--benchmark_filter={args.filter}", "--benchmark_repetitions=3",
-                                     "--benchmark_min_time=0.2", "--benchmark_enable_random_interleaving=true",
-                                     "--benchmark_report_aggregates_only=true", "--benchmark_format=json"],
-                                    capture_output=True, text=True, check=True).stdout
+            report = run_report(path, args.filter, "--benchmark_enable_random_interleaving=true")
             for run_name, label, ns in medians(report):
                 times[(name, run_name)].append(ns)
                 labels[run_name] = label

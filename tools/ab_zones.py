@@ -14,16 +14,9 @@ spring against the whole model's (region_over_whole / coverage).
 import argparse
 import collections
 import csv
-import json
 import statistics
-import subprocess
 
-
-def run(binary, pattern):
-    out = subprocess.run([binary, f"--benchmark_filter={pattern}", "--benchmark_repetitions=3",
-                          "--benchmark_report_aggregates_only=true", "--benchmark_min_time=0.2",
-                          "--benchmark_format=json"], capture_output=True, text=True, check=True).stdout
-    return [bm for bm in json.loads(out)["benchmarks"] if bm.get("aggregate_name") == "median"]
+from ab_bench import median_rows, run_report
 
 
 def main():
@@ -39,7 +32,7 @@ def main():
     info = {}
     for r in range(args.rounds):
         for build in (["before", "after"] if r % 2 == 0 else ["after", "before"]):
-            for bm in run(builds[build], args.filter):
+            for bm in median_rows(run_report(builds[build], args.filter)):
                 values[(bm["run_name"], build, "region")].append(bm["region_over_whole"])
                 values[(bm["run_name"], build, "chosen")].append(bm["chosen_over_whole"])
                 info[bm["run_name"]] = (bm["label"], bm["coverage"])

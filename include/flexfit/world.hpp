@@ -195,7 +195,7 @@ public:
 private:
     void checkBody(BodyId id, const char* what) const;
     // The mass of a body's user vertex; InputError when it has none.
-    Index massOfVertex(BodyId id, Index vertex, const char* what) const;
+    Index massOfUserVertex(BodyId id, Index vertex, const char* what) const;
     void applyForceOnMass(BodyId id, Index mass, const Vec3& worldForce);
     std::unique_ptr<detail::WorldData> data_;
 };

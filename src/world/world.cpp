@@ -100,7 +100,7 @@ double World::contactStiffness(BodyId id) const {
 
 ZoneId World::openZone(BodyId id, ZoneSeed seed, int level) {
     checkBody(id, "zone");
-    if (seed.kind == ZoneSeed::Kind::Mass) seed.index = massOfVertex(id, seed.index, "zone");
+    if (seed.kind == ZoneSeed::Kind::Mass) seed.index = massOfUserVertex(id, seed.index, "zone");
     return data_->bodies.parts[id]->openZone(seed, level);
 }
 
@@ -147,7 +147,7 @@ std::optional<BodyId> World::grabbed() const { return data_->op.grabbed; }
 const Pose& World::grabTarget() const { return data_->op.target; }
 const Coupling& World::coupling() const { return data_->op.coupling; }
 
-Index World::massOfVertex(BodyId id, Index vertex, const char* what) const {
+Index World::massOfUserVertex(BodyId id, Index vertex, const char* what) const {
     checkBody(id, what);
     const PartModel& model = data_->bodies.parts[id]->model();
     const Index mass = model.massOf(vertex);  // throws for a file vertex without a mass
@@ -156,7 +156,9 @@ Index World::massOfVertex(BodyId id, Index vertex, const char* what) const {
     return mass;
 }
 
-void World::applyMassForce(BodyId id, Index vertex, const Vec3& worldForce) { applyForceOnMass(id, massOfVertex(id, vertex, "force"), worldForce); }
+void World::applyMassForce(BodyId id, Index vertex, const Vec3& worldForce) {
+    applyForceOnMass(id, massOfUserVertex(id, vertex, "force"), worldForce);
+}
 
 void World::applyForceOnMass(BodyId id, Index mass, const Vec3& worldForce) {
     Part& part = *data_->bodies.parts[id];
@@ -167,7 +169,7 @@ void World::applyForceOnMass(BodyId id, Index mass, const Vec3& worldForce) {
 }
 
 void World::kickMass(BodyId id, Index vertex, const Vec3& worldVelocityChange) {
-    const Index mass = massOfVertex(id, vertex, "kick");
+    const Index mass = massOfUserVertex(id, vertex, "kick");
     if (!worldVelocityChange.allFinite()) throw InputError(kSource, 0, "kick on body " + std::to_string(id) + " must be finite");
     Part& part = *data_->bodies.parts[id];
     if (part.deforms()) {
