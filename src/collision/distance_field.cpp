@@ -73,6 +73,7 @@ SignedDistanceField::SignedDistanceField(const TriMesh& mesh, const Topology& to
 
     setUpGrid(fine_, cellSize > 0.0 ? cellSize : 0.125 * edgeSum / double(3 * faces_.size()), std::size_t(1) << 21);
     fillBand(fine_, kBandCells);
+    markOutside(fine_, kBandCells);
     setUpGrid(coarse_, 8.0 * fine_.cell, std::size_t(1) << 15);
     std::vector<std::size_t> every(coarse_.values.size());
     std::iota(every.begin(), every.end(), std::size_t(0));
@@ -120,6 +121,38 @@ void SignedDistanceField::fillBand(Grid& grid, int cells) const {
     fillNodes(grid, nodes);
 }
 
+// The nodes left out of the band lie more than `cells` cells from every face's box, so their
+// distance exceeds that; their sign is found without a query: those joined to the grid's
+// border through nodes out of the band (6-neighbours) lie outside the mesh, since a path that
+// crossed the surface would pass through the band. They stay NaN with the sign bit clear; the
+// others (inside, or outside in a pocket the band closes off) NaN with it set, which
+// lowerBound reads as "no bound".
+void SignedDistanceField::markOutside(Grid& grid, int cells) {
+    grid.unfilledReach = double(cells) * grid.cell;
+    const float inside = std::copysign(std::numeric_limits<float>::quiet_NaN(), -1.0f);
+    const float outside = std::copysign(std::numeric_limits<float>::quiet_NaN(), 1.0f);
+    for (float& v : grid.values)
+        if (std::isnan(v)) v = inside;
+    const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
+    std::vector<std::array<int, 3>> open;
+    const auto reach = [&](int i, int j, int k) {
+        if (i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz) return;
+        float& v = grid.node(i, j, k);
+        if (!std::isnan(v) || !std::signbit(v)) return;
+        v = outside;
+        open.push_back({i, j, k});
+    };
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i)
+                if (i == 0 || j == 0 || k == 0 || i == nx - 1 || j == ny - 1 || k == nz - 1) reach(i, j, k);
+    while (!open.empty()) {
+        const auto [i, j, k] = open.back();
+        open.pop_back();
+        reach(i - 1, j, k), reach(i + 1, j, k), reach(i, j - 1, k), reach(i, j + 1, k), reach(i, j, k - 1), reach(i, j, k + 1);
+    }
+}
+
 // Each node's value is its exact distance alone (query() only reads the mesh and its
 // hierarchy), so the nodes are computed on every usable core, in chunks, each into its own
 // float: the same grid on any number of cores. ~1 M band nodes at 1-3 us each made a field
@@ -163,24 +196,29 @@ SignedDistanceField::Sample SignedDistanceField::query(const Vec3& p) const {
     return s;
 }
 
-SignedDistanceField::Interpolated SignedDistanceField::sample(Grid& grid, const Vec3& p) const {
+SignedDistanceField::Cell SignedDistanceField::cellAt(Grid& grid, const Vec3& p, bool fillMissing) const {
     const Vec3 g = (p - grid.box.min) / grid.cell;
     int base[3];
-    double t[3];
+    Cell cell;
     for (int d = 0; d < 3; ++d) {
         // Clamped as a double first: a far or non-finite point must not overflow the int.
         base[d] = int(std::clamp(std::floor(g[d]), 0.0, double(grid.dims[std::size_t(d)] - 2)));
-        t[d] = std::clamp(g[d] - base[d], 0.0, 1.0);
+        cell.t[d] = std::clamp(g[d] - base[d], 0.0, 1.0);
     }
     const std::size_t sx = 1, sy = std::size_t(grid.dims[0]), sz = sy * std::size_t(grid.dims[1]);
     const float* c = &grid.node(base[0], base[1], base[2]);
-    // The 8 corners, x fastest; a corner not yet computed is filled first.
+    // The 8 corners, x fastest.
     const std::size_t offset[8] = {0, sx, sy, sx + sy, sz, sz + sx, sz + sy, sz + sx + sy};
-    double v[8];
     for (int n = 0; n < 8; ++n) {
-        if (std::isnan(c[offset[n]])) fill(grid, base[0] + (n & 1), base[1] + ((n >> 1) & 1), base[2] + ((n >> 2) & 1));
-        v[n] = c[offset[n]];
+        if (fillMissing && std::isnan(c[offset[n]])) fill(grid, base[0] + (n & 1), base[1] + ((n >> 1) & 1), base[2] + ((n >> 2) & 1));
+        cell.v[n] = c[offset[n]];
     }
+    return cell;
+}
+
+SignedDistanceField::Interpolated SignedDistanceField::interpolate(const Cell& cell, double cellSize, bool withGradient) {
+    const double(&v)[8] = cell.v;
+    const double(&t)[3] = cell.t;
     const double x0 = 1.0 - t[0], y0 = 1.0 - t[1], z0 = 1.0 - t[2];
     // Along x, then y, then z.
     const double a00 = x0 * v[0] + t[0] * v[1], a10 = x0 * v[2] + t[0] * v[3];
@@ -188,11 +226,28 @@ SignedDistanceField::Interpolated SignedDistanceField::sample(Grid& grid, const 
     const double b0 = y0 * a00 + t[1] * a10, b1 = y0 * a01 + t[1] * a11;
     Interpolated out;
     out.distance = z0 * b0 + t[2] * b1;
+    if (!withGradient) return out;
     const double dx00 = v[1] - v[0], dx10 = v[3] - v[2], dx01 = v[5] - v[4], dx11 = v[7] - v[6];
-    out.gradient.x() = (z0 * (y0 * dx00 + t[1] * dx10) + t[2] * (y0 * dx01 + t[1] * dx11)) / grid.cell;
-    out.gradient.y() = (z0 * (a10 - a00) + t[2] * (a11 - a01)) / grid.cell;
-    out.gradient.z() = (b1 - b0) / grid.cell;
+    out.gradient.x() = (z0 * (y0 * dx00 + t[1] * dx10) + t[2] * (y0 * dx01 + t[1] * dx11)) / cellSize;
+    out.gradient.y() = (z0 * (a10 - a00) + t[2] * (a11 - a01)) / cellSize;
+    out.gradient.z() = (b1 - b0) / cellSize;
     return out;
+}
+
+SignedDistanceField::Interpolated SignedDistanceField::sample(Grid& grid, const Vec3& p) const {
+    return interpolate(cellAt(grid, p, true), grid.cell, true);
+}
+
+double SignedDistanceField::lowerBound(Grid& grid, const Vec3& p) const {
+    Cell cell = cellAt(grid, p, false);
+    for (double& v : cell.v) {
+        if (!std::isnan(v)) continue;
+        if (std::signbit(v)) return -std::numeric_limits<double>::infinity();  // maybe inside: no bound
+        v = grid.unfilledReach;
+    }
+    // Each product has a weight >= 0 and each rounding is monotonic: a lower corner value never
+    // raises the result.
+    return interpolate(cell, grid.cell, false).distance;
 }
 
 SignedDistanceField::Interpolated SignedDistanceField::sample(const Vec3& p) const { return sample(fine_, p); }
@@ -405,7 +460,7 @@ FLEXFIT_AVX512 std::size_t sampleEights(const Vec3& min, const std::array<int, 3
 // by the factor 1 + 1e-9.
 std::pair<Vec3, double> SignedDistanceField::clampedInto(const Grid& grid, const Vec3& p) {
     const Vec3 clamped = p.cwiseMax(grid.box.min).cwiseMin(grid.box.max);
-    return {clamped, (p - clamped).norm()};
+    return {clamped, clamped == p ? 0.0 : (p - clamped).norm()};
 }
 
 double SignedDistanceField::clearReach(const Grid& grid, double radius, double outside, double slack) {
@@ -421,7 +476,7 @@ bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
         const auto [clamped, outside] = clampedInto(coarse_, centre);
         if (outside > radius) return true;  // wholly outside the grid, where nothing is sampled
         const double gap = std::sqrt(3.0) * (coarse_.cell + fine_.cell);
-        const double coarse = sample(coarse_, clamped).distance;
+        const double coarse = lowerBound(coarse_, clamped);  // every coarse node is computed: the sample itself
         if (coarse > clearReach(coarse_, radius, outside, gap)) return true;
         // The fine sample exceeds the coarse one by at most `gap` and both grids' rounding.
         // Where even that cannot clear the ball, the answer is no without the fine sample: at
@@ -433,7 +488,7 @@ bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
     }
     const auto [clamped, outside] = clampedInto(fine_, centre);
     if (outside > radius) return true;
-    return sample(fine_, clamped).distance > clearReach(fine_, radius, outside, 0.0);
+    return lowerBound(fine_, clamped) > clearReach(fine_, radius, outside, 0.0);
 }
 
 namespace detail {
@@ -480,6 +535,26 @@ void SignedDistanceField::sampleMany(std::span<const Vec3> points, std::span<Int
     }
 #endif
     for (; i < points.size(); ++i) out[i] = sample(fine_, points[i]);
+}
+
+void SignedDistanceField::sampleLowerBounds(std::span<const Vec3> points, std::span<double> out) const {
+    if (out.size() < points.size())
+        throw std::invalid_argument("signed distance field: sampleLowerBounds needs an output per point (" + std::to_string(points.size()) +
+                                    " points, " + std::to_string(out.size()) + " outputs)");
+    thread_local std::vector<Interpolated> samples;
+    samples.resize(points.size());
+    std::size_t i = 0;
+#if defined(FLEXFIT_SDF_AVX2)
+    const auto one = [&](std::size_t k) { samples[k].distance = lowerBound(fine_, points[k]); };
+    if (detail::vectorSamplingEnabled()) {
+        const std::span<Interpolated> all = samples;
+        const std::size_t eights = detail::eightLaneSamplingEnabled() ? sampleEights(fine_.box.min, fine_.dims, fine_.cell, fine_.values.data(), points, all, one) : 0;
+        i = eights + sampleFours(fine_.box.min, fine_.dims, fine_.cell, fine_.values.data(), points.subspan(eights), all.subspan(eights),
+                                 [&](std::size_t k) { one(eights + k); });
+    }
+#endif
+    for (; i < points.size(); ++i) samples[i].distance = lowerBound(fine_, points[i]);
+    for (std::size_t k = 0; k < points.size(); ++k) out[k] = samples[k].distance;
 }
 
 }  // namespace flexfit

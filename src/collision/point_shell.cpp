@@ -166,32 +166,38 @@ std::size_t walkRestPoints(const SignedDistanceField& field, const Bvh<Aabb>& re
 }
 
 // The coherent query's rest-mass list: a margin of kMarginCells cells of the field; a new
-// list's walk starts once B's rest sphere has moved kShellWalkStart of the margin, and goes on
-// 1 / kShellWalkShare of the last walk's nodes (at least kShellMinWalkNodes) per query, or more
-// when the last query's motion says the old list runs out sooner: the rest of the last walk's
-// nodes spread over the queries it still covers but one (walkBudget). A walk the motion still
-// outruns (an acceleration, or more than about 0.3 of the margin a query) is finished inside
-// one query (walksAtOnce counts them).
-// Measured on the ball-torus haptic scene: a walk of ~8,000 nodes costs ~750 us; the ball
-// leaves a margin in ~35 steps. With the fixed share alone, every walk of that scene after the
-// first was outrun and finished at once (265 to 2,200 nodes in one step); with the budget none
-// is (walksAtOnce, printed while measuring), though the scene's in-contact tail did not
-// measurably change (bench/results/walk_budget.csv: p99 318 -> 326 us, 10 alternating rounds):
-// those finishes cost less than the step's own variation.
+// list's walk starts once B's rest sphere has moved kShellWalkStart of the margin. While B
+// moves, each query walks the rest of the last walk's nodes spread over kShellWalkSpread of the
+// queries the old list still covers at the last query's motion but one, or over
+// kShellWalkShare queries where that is more (at least kShellMinWalkNodes); at rest, 1 /
+// kShellWalkShare of them (walkBudget). A walk the motion
+// still outruns (an acceleration, or more than about 0.3 of the margin a query) is finished
+// inside one query (walksAtOnce counts them).
+// Measured on the ball-torus haptic scene: a walk of ~7,400 nodes costs ~45 ns a node; the
+// ball leaves a margin in ~35 steps. With a fixed share alone, every walk of that scene after
+// the first was outrun and finished at once (265 to 2,200 nodes in one step). With the share as
+// a floor under the spread (before 2026-12-07), each walk took 16 queries, half of the contact
+// steps walked ~460 nodes each (~22 us), and those steps were the whole in-contact tail; spread
+// over 2/3 of the list's life, walks follow one another, nearly every step walks ~210 nodes,
+// and the tail fell (bench/results/walk_spread_1207.csv). Two thirds, not all, leaves a third of
+// the list's life for an acceleration before a walk must finish at once.
 constexpr double kMarginCells = 2.0;
 constexpr double kShellWalkStart = 0.4;
 constexpr std::size_t kShellWalkShare = 16;
 constexpr std::size_t kShellMinWalkNodes = 128;
+constexpr double kShellWalkSpread = 2.0 / 3.0;
 
-// Nodes for this query's slice of the walk under way: the share, or the rest of the last walk's
-// nodes over the queries the list still covers at `speed` (motion a query) but one.
+// Nodes for this query's slice of the walk under way: at rest the share; moving, the rest of
+// the last walk's nodes over kShellWalkSpread of the queries the list still covers at `speed`
+// (motion a query) but one, or over kShellWalkShare of them (all but one when fewer): never a
+// larger slice than the share or the list's remaining queries ask.
 std::size_t walkBudget(const PointShellCoherence& c, double motion, double speed) {
-    const std::size_t share = std::max(kShellMinWalkNodes, c.traversalCost / kShellWalkShare);
-    if (!(speed > 0.0)) return share;
+    if (!(speed > 0.0)) return std::max(kShellMinWalkNodes, c.traversalCost / kShellWalkShare);
     const double covered = (c.margin - motion) / speed;  // queries the list still covers
     if (!(covered >= 2.0)) return std::numeric_limits<std::size_t>::max();  // the last one: finish
     const std::size_t left = c.traversalCost > c.walk.nodes ? c.traversalCost - c.walk.nodes : 0;
-    return std::max(share, std::size_t(std::ceil(double(left) / (covered - 1.0))));
+    const double queries = std::max(kShellWalkSpread * (covered - 1.0), std::min(covered - 1.0, double(kShellWalkShare)));
+    return std::max(kShellMinWalkNodes, std::size_t(std::ceil(double(left) / queries)));
 }
 
 void startWalk(PointShellCoherence::Walk& w, const RelativePose& pose, double margin) {
@@ -204,14 +210,15 @@ void startWalk(PointShellCoherence::Walk& w, const RelativePose& pose, double ma
 }
 
 // Advances the walk by up to `budget` nodes; true when it is complete. Each listed mass keeps
-// the distance its rest position samples at the walk's pose (infinity outside the grid).
-// The leaves in the grid are sampled together after the slice (sampleMany: 4 a vector, the
-// same values as one at a time).
+// the distance its rest position samples at the walk's pose (infinity outside the grid), or a
+// lower bound of it where the field's cell is not computed (sampleLowerBounds: a walk computes
+// no node; a listed mass is only skipped on its distance, so a lower bound skips less, never
+// wrongly). The leaves in the grid are sampled together after the slice (4 or 8 a vector).
 bool advanceWalk(PointShellCoherence::Walk& w, const SignedDistanceField& field, const Bvh<Aabb>& restPoints, std::size_t budget,
                  QueryStats& stats) {
     thread_local std::vector<std::size_t> slots;  // into w.masses
     thread_local std::vector<Vec3> points;
-    thread_local std::vector<SignedDistanceField::Interpolated> samples;
+    thread_local std::vector<double> samples;
     slots.clear();
     points.clear();
     const std::size_t visited = walkRestPoints(field, restPoints, w.pose, w.margin, w.stack, budget, [&](Index m) {
@@ -224,8 +231,8 @@ bool advanceWalk(PointShellCoherence::Walk& w, const SignedDistanceField& field,
         w.masses.push_back({m, std::numeric_limits<double>::infinity()});
     });
     samples.resize(points.size());
-    field.sampleMany(points, samples);
-    for (std::size_t k = 0; k < slots.size(); ++k) w.masses[slots[k]].second = samples[k].distance;
+    field.sampleLowerBounds(points, samples);
+    for (std::size_t k = 0; k < slots.size(); ++k) w.masses[slots[k]].second = samples[k];
     w.nodes += visited;
     stats.volumeTests += visited;
     return w.stack.empty();

@@ -286,3 +286,73 @@ TEST(SignedDistanceField, OneCoreBuildsTheSameFieldAsAll) {
 }
 #endif
 
+
+namespace {
+
+struct BoundCounts {
+    std::size_t exact = 0, below = 0, unbounded = 0;
+};
+
+// Lower bounds (sampleLowerBounds, and clearOf through them) of points spread over the field's
+// grid, against the exact samples of the same points taken afterwards from the same field
+// (which computes the nodes they need), and against a second field's bounds point by point.
+BoundCounts lowerBoundsAgainstSamples(const TriMesh& mesh, double cell, double spread) {
+    const SignedDistanceField field = fieldOf(mesh, cell), pointByPoint = fieldOf(mesh, cell);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-spread, spread);
+    std::vector<Vec3> points;
+    while (points.size() < 4000) {
+        const Vec3 p(u(rng), u(rng), u(rng));
+        if (field.inGrid(p)) points.push_back(p);
+    }
+    const std::size_t built = field.computedNodes();
+    std::vector<double> bounds(points.size());
+    field.sampleLowerBounds(points, bounds);
+    std::vector<bool> cleared(points.size());
+    for (std::size_t k = 0; k < points.size(); ++k) cleared[k] = field.clearOf(points[k], 0.05 * double(k % 10));
+    EXPECT_EQ(field.computedNodes(), built) << "neither computes a node";
+    BoundCounts counts;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+        const double s = field.sample(points[k]).distance;
+        EXPECT_LE(bounds[k], s) << points[k].transpose();
+        std::vector<double> one(1);
+        pointByPoint.sampleLowerBounds(std::span<const Vec3>(&points[k], 1), one);
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(one[0]), std::bit_cast<std::uint64_t>(bounds[k])) << points[k].transpose();
+        if (cleared[k]) {
+            EXPECT_GT(s, 0.0) << "cleared a ball whose centre samples <= 0: " << points[k].transpose();
+        }
+        counts.exact += bounds[k] == s;
+        counts.unbounded += std::isinf(bounds[k]);
+        counts.below += bounds[k] < s && !std::isinf(bounds[k]);
+    }
+    EXPECT_GT(field.computedNodes(), built);
+    return counts;
+}
+
+// A sphere of 5 cells' edges whose core lies beyond the band (no bound there: it may be inside),
+// and a torus whose hole and surroundings lie beyond it (outside, reached from the grid's border
+// along the axis: a finite bound).
+void expectLowerBoundsBelowTheSamples() {
+    const BoundCounts sphere = lowerBoundsAgainstSamples(makeIcoSphere(2.0, 2), 0.1, 2.2);
+    EXPECT_GT(sphere.exact, 1000u) << "in the band: the sample itself";
+    EXPECT_GT(sphere.unbounded, 20u) << "deep inside: no bound";
+    EXPECT_GT(sphere.below, 20u) << "the grid's corners: a finite bound";
+    const BoundCounts torus = lowerBoundsAgainstSamples(makeTorus(2.0, 0.8, 32, 12), 0.08, 3.0);
+    EXPECT_GT(torus.exact, 1000u);
+    EXPECT_GT(torus.below, 200u) << "around the tube and in its hole: a finite bound";
+}
+
+}  // namespace
+
+TEST(SignedDistanceField, LowerBoundsStayBelowTheSamplesAndComputeNoNode) {
+    expectLowerBoundsBelowTheSamples();
+}
+
+TEST(SignedDistanceField, LowerBoundsFourLaneAndScalarPathsAgree) {
+    {
+        const detail::ScopedFourLaneSampling four;
+        expectLowerBoundsBelowTheSamples();
+    }
+    const detail::ScopedScalarSampling scalar;
+    expectLowerBoundsBelowTheSamples();
+}

@@ -107,6 +107,37 @@ TEST(PointShellCoherent, AWalkKeepsAheadOfASteadyMotion) {
     EXPECT_LT(largestSlice * 2, largestWalk) << largestSlice << " nodes in one query, walks up to " << largestWalk;
 }
 
+TEST(PointShellCoherent, ASlowMotionSpreadsEachWalkOverMoreQueriesThanTheShare) {
+    // A ball sliding slowly over a fine torus (a margin every ~66 queries): each walk is spread
+    // over 2/3 of the queries its list still covers, more than the 16 of the share at rest, so
+    // a walking query walks far less than 1/16 of a list (the in-contact tail of the haptic
+    // scene was such slices); none is finished at once, and the contacts stay the full query's.
+    BallOverTorus s;
+    s.torus = Part(buildPartModel(makeTorus(1.0, 0.35, 192, 64)));
+    s.collider = PartCollider(s.torus, BoundingVolumeKind::Aabb);
+    s.collider.buildRestPointTree(s.torus);
+    PointShellCoherence coherence;
+    std::size_t contacts = 0, walked = 0, walkingQueries = 0, largestWalk = 0;
+    for (int step = 0; step < 400; ++step) {
+        s.ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(-0.2 + 0.001 * step, 0.5, 0.1)});
+        QueryStats stats;
+        const std::vector<Contact> got = s.coherent(coherence, stats);
+        if (step % 10 == 0) expectSameContacts(got, s.full(), step);
+        contacts += got.size();
+        if (step > 0 && stats.volumeTests > 0) {
+            walked += stats.volumeTests;
+            ++walkingQueries;
+        }
+        largestWalk = std::max(largestWalk, coherence.traversalCost);
+    }
+    EXPECT_GT(contacts, 0u);
+    EXPECT_GT(coherence.traversals, 4u) << "the motion needs new lists";
+    EXPECT_EQ(coherence.walksAtOnce, 0u);
+    // The share would walk 1/16 of a list a query; spread, a walking query walks under 1/24.
+    ASSERT_GT(walkingQueries, 0u);
+    EXPECT_LT(24 * walked / walkingQueries, largestWalk) << walked / walkingQueries << " nodes a walking query, walks up to " << largestWalk;
+}
+
 TEST(PointShellCoherent, MovingMassesOutsideTheGridAreSampledOnceTheBallComes) {
     // A zone moves masses of the tube far below the ball, outside its field's grid;
     // the ball then comes down and presses them: the coherent query must sample them again
