@@ -143,6 +143,8 @@ private:
     // and gives minus infinity when it may lie inside: markOutside).
     double lowerBound(Grid& grid, const Vec3& p) const;
     static void markOutside(Grid& grid, int cells);
+    template <class One>
+    void sampleEach(std::span<const Vec3> points, std::span<Interpolated> out, One one) const;
     // p clamped into the grid's box, and how far p is from it.
     static std::pair<Vec3, double> clampedInto(const Grid& grid, const Vec3& p);
     static double clearReach(const Grid& grid, double radius, double outside, double slack);

@@ -521,39 +521,35 @@ ScopedFourLaneSampling::ScopedFourLaneSampling() { fourLaneSamplingScopes.fetch_
 ScopedFourLaneSampling::~ScopedFourLaneSampling() { fourLaneSamplingScopes.fetch_sub(1, std::memory_order_relaxed); }
 }  // namespace detail
 
-void SignedDistanceField::sampleMany(std::span<const Vec3> points, std::span<Interpolated> out) const {
-    if (out.size() < points.size())
-        throw std::invalid_argument("signed distance field: sampleMany needs an output per point (" + std::to_string(points.size()) +
-                                    " points, " + std::to_string(out.size()) + " outputs)");
+// The points' samples into `out`, each lane by the vector kernels where every corner of its
+// group is computed, else one(k) for point k (also for the points the kernels leave over).
+template <class One>
+void SignedDistanceField::sampleEach(std::span<const Vec3> points, std::span<Interpolated> out, One one) const {
     std::size_t i = 0;
 #if defined(FLEXFIT_SDF_AVX2)
-    const auto one = [&](std::size_t k) { out[k] = sample(fine_, points[k]); };
     if (detail::vectorSamplingEnabled()) {
         const std::size_t eights = detail::eightLaneSamplingEnabled() ? sampleEights(fine_.box.min, fine_.dims, fine_.cell, fine_.values.data(), points, out, one) : 0;
         i = eights + sampleFours(fine_.box.min, fine_.dims, fine_.cell, fine_.values.data(), points.subspan(eights), out.subspan(eights),
                                  [&](std::size_t k) { one(eights + k); });
     }
 #endif
-    for (; i < points.size(); ++i) out[i] = sample(fine_, points[i]);
+    for (; i < points.size(); ++i) one(i);
+}
+
+void SignedDistanceField::sampleMany(std::span<const Vec3> points, std::span<Interpolated> out) const {
+    if (out.size() < points.size())
+        throw std::invalid_argument("signed distance field: sampleMany needs an output per point (" + std::to_string(points.size()) +
+                                    " points, " + std::to_string(out.size()) + " outputs)");
+    sampleEach(points, out, [&](std::size_t k) { out[k] = sample(fine_, points[k]); });
 }
 
 void SignedDistanceField::sampleLowerBounds(std::span<const Vec3> points, std::span<double> out) const {
     if (out.size() < points.size())
         throw std::invalid_argument("signed distance field: sampleLowerBounds needs an output per point (" + std::to_string(points.size()) +
                                     " points, " + std::to_string(out.size()) + " outputs)");
-    thread_local std::vector<Interpolated> samples;
+    thread_local std::vector<Interpolated> samples;  // the kernels' lanes (their gradients unused)
     samples.resize(points.size());
-    std::size_t i = 0;
-#if defined(FLEXFIT_SDF_AVX2)
-    const auto one = [&](std::size_t k) { samples[k].distance = lowerBound(fine_, points[k]); };
-    if (detail::vectorSamplingEnabled()) {
-        const std::span<Interpolated> all = samples;
-        const std::size_t eights = detail::eightLaneSamplingEnabled() ? sampleEights(fine_.box.min, fine_.dims, fine_.cell, fine_.values.data(), points, all, one) : 0;
-        i = eights + sampleFours(fine_.box.min, fine_.dims, fine_.cell, fine_.values.data(), points.subspan(eights), all.subspan(eights),
-                                 [&](std::size_t k) { one(eights + k); });
-    }
-#endif
-    for (; i < points.size(); ++i) samples[i].distance = lowerBound(fine_, points[i]);
+    sampleEach(points, std::span<Interpolated>(samples), [&](std::size_t k) { samples[k].distance = lowerBound(fine_, points[k]); });
     for (std::size_t k = 0; k < points.size(); ++k) out[k] = samples[k].distance;
 }
 

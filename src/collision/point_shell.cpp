@@ -170,16 +170,16 @@ std::size_t walkRestPoints(const SignedDistanceField& field, const Bvh<Aabb>& re
 // moves, each query walks the rest of the last walk's nodes spread over kShellWalkSpread of the
 // queries the old list still covers at the last query's motion but one, or over
 // kShellWalkShare queries where that is more (at least kShellMinWalkNodes); at rest, 1 /
-// kShellWalkShare of them (walkBudget). A walk the motion
-// still outruns (an acceleration, or more than about 0.3 of the margin a query) is finished
-// inside one query (walksAtOnce counts them).
+// kShellWalkShare of them (walkBudget). A walk the motion still outruns (an acceleration, or
+// more than about 0.3 of the margin a query) is finished inside one query (walksAtOnce counts
+// them).
 // Measured on the ball-torus haptic scene: a walk of ~7,400 nodes costs ~45 ns a node; the
 // ball leaves a margin in ~35 steps. With a fixed share alone, every walk of that scene after
 // the first was outrun and finished at once (265 to 2,200 nodes in one step). With the share as
 // a floor under the spread (before 2026-12-07), each walk took 16 queries, half of the contact
 // steps walked ~460 nodes each (~22 us), and those steps were the whole in-contact tail; spread
 // over 2/3 of the list's life, walks follow one another, nearly every step walks ~210 nodes,
-// and the tail fell (bench/results/walk_spread_1207.csv). Two thirds, not all, leaves a third of
+// and the tail fell (bench/results/tail_repeats_haptic_1207.csv). Two thirds, not all, leaves a third of
 // the list's life for an acceleration before a walk must finish at once.
 constexpr double kMarginCells = 2.0;
 constexpr double kShellWalkStart = 0.4;
