@@ -564,9 +564,9 @@ PYBIND11_MODULE(_flexfit, m) {
         .def("centre_of_mass", &World::centreOfMass, py::arg("id"), "World position of a body's centre of mass.")
         .def("pose", [](const World& w, BodyId id) { return poseDict(w.part(id).pose()); }, py::arg("id"), "A body's pose: {'position', 'rotation_wxyz'}.")
         .def("apply_force", &World::applyForce, py::arg("id"), py::arg("force"), "A force at the centre of mass for the next step.")
-        .def("apply_mass_force", [](World& w, BodyId id, Index mass, const Vec3& force) { w.applyMassForce(id, mass, force); },
+        .def("apply_mass_force", &World::applyMassForce,
              py::arg("id"), py::arg("mass"), py::arg("force"), "A world-frame force on one mass.")
-        .def("kick_mass", [](World& w, BodyId id, Index mass, const Vec3& change) { w.kickMass(id, mass, change); },
+        .def("kick_mass", &World::kickMass,
              py::arg("id"), py::arg("mass"), py::arg("velocity_change"),
              "A velocity change on one mass of a deforming part; on a rigid dynamic body, the same momentum as an impulse.")
         .def("set_velocity", &World::setVelocity, py::arg("id"), py::arg("linear"), py::arg("angular") = Vec3::Zero(),

@@ -97,8 +97,10 @@ void SignedDistanceField::setUpGrid(Grid& grid, double cell, std::size_t maxNode
     grid.cell = cell;
     for (int d = 0; d < 3; ++d) grid.box.max[d] = grid.box.min[d] + cell * (grid.dims[std::size_t(d)] - 1);
     grid.roundingReach = 1e-6 * (grid.box.max - grid.box.min).norm();
+    // Not computed yet, and "maybe inside" (the sign bit set) until markOutside says otherwise:
+    // lowerBound gives no bound for such a node on any grid.
     grid.values.assign(std::size_t(grid.dims[0]) * std::size_t(grid.dims[1]) * std::size_t(grid.dims[2]),
-                       std::numeric_limits<float>::quiet_NaN());
+                       std::copysign(std::numeric_limits<float>::quiet_NaN(), -1.0f));
 }
 
 // The nodes within `cells` of a face's box, marked first, then computed together.
@@ -124,15 +126,12 @@ void SignedDistanceField::fillBand(Grid& grid, int cells) const {
 // The nodes left out of the band lie more than `cells` cells from every face's box, so their
 // distance exceeds that; their sign is found without a query: those joined to the grid's
 // border through nodes out of the band (6-neighbours) lie outside the mesh, since a path that
-// crossed the surface would pass through the band. They stay NaN with the sign bit clear; the
-// others (inside, or outside in a pocket the band closes off) NaN with it set, which
-// lowerBound reads as "no bound".
+// crossed the surface would pass through the band. They become NaN with the sign bit clear;
+// the others (inside, or outside in a pocket the band closes off) keep setUpGrid's NaN with it
+// set, which lowerBound reads as "no bound".
 void SignedDistanceField::markOutside(Grid& grid, int cells) {
     grid.unfilledReach = double(cells) * grid.cell;
-    const float inside = std::copysign(std::numeric_limits<float>::quiet_NaN(), -1.0f);
     const float outside = std::copysign(std::numeric_limits<float>::quiet_NaN(), 1.0f);
-    for (float& v : grid.values)
-        if (std::isnan(v)) v = inside;
     const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
     std::vector<std::array<int, 3>> open;
     const auto reach = [&](int i, int j, int k) {
@@ -476,7 +475,7 @@ bool SignedDistanceField::clearOf(const Vec3& centre, double radius) const {
         const auto [clamped, outside] = clampedInto(coarse_, centre);
         if (outside > radius) return true;  // wholly outside the grid, where nothing is sampled
         const double gap = std::sqrt(3.0) * (coarse_.cell + fine_.cell);
-        const double coarse = lowerBound(coarse_, clamped);  // every coarse node is computed: the sample itself
+        const double coarse = lowerBound(coarse_, clamped);  // every coarse node is computed when built: the sample itself
         if (coarse > clearReach(coarse_, radius, outside, gap)) return true;
         // The fine sample exceeds the coarse one by at most `gap` and both grids' rounding.
         // Where even that cannot clear the ball, the answer is no without the fine sample: at
