@@ -14,6 +14,11 @@ stage columns, as tools/ab_stages.py). Reports:
 - top_repeat_pct: of each run's slowest 1 % of steps, the share (%) that are among the slowest
   1 % of the next run (mean over consecutive pairs), beside top_chance_pct, the share expected
   if the slow steps fell at random (1 % of the steps): near chance, the tail is the machine's.
+- where the floor's tail goes: over the floor's slowest 1 % of steps (tail_*) and the steps
+  ranked 45-55 % in it (mid_*), the mean of each step's fastest narrow phase, contact response
+  and zone dynamics over the runs (`*_us`), its contacts and the zones it opened (the rise of
+  metrics.csv's zone count from the step before; both the same in every run). A tail above the
+  middle by more contacts is the work's size; by zones opened, the zones' bookkeeping.
 
   tools/tail_repeats.py --flexfit new=build/release/apps/flexfit/flexfit \
       --flexfit 6d7824d=/tmp/base/build/apps/flexfit/flexfit \
@@ -31,20 +36,49 @@ from ab_stages import percentile, step_us  # nearest rank, as every other table 
 from results_table import alternating_runs, report
 
 COLUMNS = ["measured_p50", "measured_p99", "measured_max", "floor_p50", "floor_p99", "floor_max", "top_repeat_pct", "top_chance_pct"]
+# A step's figures for the tail's composition: the stages' metrics.csv columns, then the counts.
+STAGES = {"narrow_us": "us_narrow_phase", "response_us": "us_contact_response", "zone_dynamics_us": "us_zone_dynamics"}
+COUNTS = ["contacts", "zones_opened"]
+COMPOSITION = [f"{band}_{k}" for band in ("tail", "mid") for k in [*COUNTS, *STAGES]]
+
+
+def contact_steps(metrics):
+    """Every in-contact step of one run, in step order: World::step's time ("step_us"), the
+    stages of STAGES, its contacts and the zones it opened."""
+    with open(metrics) as f:
+        rows = list(csv.DictReader(f))
+    steps, zones = [], 0
+    for r in rows:
+        opened, zones = max(0, int(r.get("zones", 0)) - zones), int(r.get("zones", 0))
+        if float(r["contacts"]) > 0:
+            steps.append({"step_us": step_us(r), "contacts": float(r["contacts"]), "zones_opened": float(opened)}
+                         | {k: float(r[c]) for k, c in STAGES.items() if c in r})
+    return steps
 
 
 def contact_step_times(metrics):
     """World::step's time of every in-contact step of one run, in step order."""
-    with open(metrics) as f:
-        rows = [r for r in csv.DictReader(f) if float(r["contacts"]) > 0]
-    if not rows:
-        return []
-    return [step_us(r) for r in rows]
+    return [s["step_us"] for s in contact_steps(metrics)]
 
 
 def run(flexfit, scene, out):
     done = subprocess.run([flexfit, "run", scene, "--out", out, "--no-progress"], capture_output=True, text=True, check=True)
-    return contact_step_times(Path(out) / "metrics.csv"), re.search(r"state hash (\w+)", done.stdout).group(1)
+    steps = contact_steps(Path(out) / "metrics.csv")
+    return [s["step_us"] for s in steps], re.search(r"state hash (\w+)", done.stdout).group(1), steps
+
+
+def composition(floor, stages):
+    """The tail_* and mid_* columns: `floor` each step's fastest time, `stages` each run's
+    contact_steps (the stages at their fastest over the runs, the counts from the first run)."""
+    order = sorted(range(len(floor)), key=lambda s: floor[s])
+    bands = {"tail": sorted(slowest(floor)), "mid": order[int(0.45 * len(order)):max(int(0.45 * len(order)) + 1, int(0.55 * len(order)))]}
+    out = {}
+    for band, chosen in bands.items():
+        for k in COUNTS:
+            out[f"{band}_{k}"] = statistics.mean(stages[0][s][k] for s in chosen)
+        for k in STAGES:
+            out[f"{band}_{k}"] = statistics.mean(min(run[s][k] for run in stages) for s in chosen) if k in stages[0][0] else ""
+    return out
 
 
 def ranks(values):
@@ -59,21 +93,23 @@ def slowest(times, share=0.01):
 
 
 def summary(scene, name, runs):
-    hashes = sorted({h for _, h in runs})
-    lengths = {len(t) for t, _ in runs}
+    hashes = sorted({r[1] for r in runs})
+    lengths = {len(r[0]) for r in runs}
     if len(hashes) != 1 or len(lengths) != 1:
         raise SystemExit(f"{scene}, {name}: the runs differ (state hashes {hashes}, contact steps {sorted(lengths)}): not one trajectory")
-    times = [t for t, _ in runs]
+    times = [r[0] for r in runs]
     steps = len(times[0])
     row = {"scene": Path(scene).stem, "build": name, "runs": len(runs), "contact_steps": steps}
+    with_stages = all(len(r) > 2 for r in runs)  # run()'s; a caller may give the times alone
     if steps == 0:  # no contact: no contact tail
-        return row | {k: "" for k in COLUMNS} | {"state_hash": hashes[0]}
+        return row | {k: "" for k in COLUMNS} | ({k: "" for k in COMPOSITION} if with_stages else {}) | {"state_hash": hashes[0]}
     measured = [statistics.median(ranks(t)[i] for t in times) for i in range(3)]
-    floor = ranks([min(t[s] for t in times) for s in range(steps)])
+    floor = [min(t[s] for t in times) for s in range(steps)]
     tops = [slowest(t) for t in times]
     repeat = statistics.mean(len(a & b) / len(a) for a, b in zip(tops, tops[1:])) if len(tops) > 1 else float("nan")
-    values = [*measured, *floor, 100.0 * repeat, 100.0 * len(tops[0]) / steps]
-    return row | dict(zip(COLUMNS, values)) | {"state_hash": hashes[0]}
+    values = [*measured, *ranks(floor), 100.0 * repeat, 100.0 * len(tops[0]) / steps]
+    parts = composition(floor, [r[2] for r in runs]) if with_stages else {}
+    return row | dict(zip(COLUMNS, values)) | parts | {"state_hash": hashes[0]}
 
 
 def main():
@@ -86,7 +122,7 @@ def main():
     if args.runs < 2:
         raise SystemExit("give --runs 2 or more: the floor and the repeats compare runs")
     builds = [tuple(b.split("=", 1)) for b in args.flexfit]
-    results = alternating_runs(builds, args.scene, args.runs, run)  # (scene, build) -> [(times, hash)]
+    results = alternating_runs(builds, args.scene, args.runs, run)  # (scene, build) -> [(times, hash, steps)]
     report([summary(scene, name, results[(scene, name)]) for scene in args.scene for name, _ in builds], args.csv)
 
 

@@ -111,6 +111,30 @@ def test_tail_repeats_tells_a_slow_step_of_every_run_from_stalls_that_move():
     assert tail_repeats.summary("s.toml", "a", [([], "h"), ([], "h")])["floor_p99"] == ""
 
 
+def test_tail_repeats_composes_the_floor_tail_from_each_steps_fastest_stages(tmp_path):
+    import tail_repeats
+    # 100 steps: step 7 is the slowest in both runs (its narrow phase), so it alone is the floor's
+    # slowest 1 %; the middle band (ranks 45-55 %) holds ordinary steps.
+    def steps(narrow_at_7, extra):
+        out = []
+        for s in range(100):
+            narrow = narrow_at_7 if s == 7 else 10.0 + 0.01 * s + extra
+            out.append({"step_us": narrow + 20.0, "narrow_us": narrow, "response_us": 5.0 + extra, "zone_dynamics_us": 3.0,
+                        "contacts": 900.0 if s == 7 else 100.0, "zones_opened": 2.0 if s == 7 else 0.0})
+        return out
+    runs = [steps(80.0, 0.0), steps(60.0, 1.0)]  # run 2 slower everywhere: the floor takes run 1 but at step 7
+    row = tail_repeats.summary("s.toml", "a", [([x["step_us"] for x in r], "h", r) for r in runs])
+    assert (row["tail_contacts"], row["tail_zones_opened"], row["tail_narrow_us"], row["tail_response_us"]) == (900.0, 2.0, 60.0, 5.0)
+    assert (row["mid_contacts"], row["mid_zones_opened"], row["mid_zone_dynamics_us"]) == (100.0, 0.0, 3.0)
+    assert 10.0 < row["mid_narrow_us"] < 11.0
+    # From metrics.csv: the zones a step opened are the rise of the zone count, in-contact steps only.
+    metrics = tmp_path / "metrics.csv"
+    metrics.write_text("time,contacts,zones,us_narrow_phase,us_contact_response,us_zone_dynamics,us_world_step\n"
+                       "0.001,0,0,1,1,1,4\n0.002,3,2,2,2,2,7\n0.003,4,5,3,3,3,10\n0.004,2,1,1,1,1,4\n")
+    read = tail_repeats.contact_steps(metrics)
+    assert [(x["step_us"], x["contacts"], x["zones_opened"], x["narrow_us"]) for x in read] == [(7.0, 3.0, 2.0, 2.0), (10.0, 4.0, 3.0, 3.0), (4.0, 2.0, 0.0, 1.0)]
+
+
 def test_tail_repeats_reads_the_step_timer_or_older_builds_stage_sums(tmp_path):
     import tail_repeats
     timed = tmp_path / "timed.csv"
