@@ -32,7 +32,7 @@ py::array rowsView(const double* data, std::size_t n, std::size_t width, py::han
     return a;
 }
 
-py::array vec3View(const std::vector<Vec3>& v, py::handle owner) {
+py::array vec3View(std::span<const Vec3> v, py::handle owner) {
     static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is three packed doubles");
     return rowsView(v.empty() ? nullptr : v.front().data(), v.size(), 3, owner);
 }
@@ -52,7 +52,7 @@ py::array_t<double> vec3Copy(const std::vector<Vec3>& v) {
 // Per-mass rows in the user's vertex order: a read-only view of the state when the masses are
 // the vertices, else a read-only copy. A file vertex the repair removed reads its file position
 // (part frame, `positions`) or zero.
-py::array vertexRows(const PartModel& model, const std::vector<Vec3>& perMass, py::handle owner, bool positions) {
+py::array vertexRows(const PartModel& model, std::span<const Vec3> perMass, py::handle owner, bool positions) {
     if (model.massesAreVertices()) return vec3View(perMass, owner);
     std::vector<Vec3> rows;
     inVertexOrder<Vec3>(model, perMass, rows, [&](Index v) { return positions ? model.file->vertices.positions[v] : Vec3(Vec3::Zero()); });

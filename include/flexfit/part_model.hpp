@@ -108,9 +108,9 @@ struct PartModel {
     Topology topology;
 
     // Masses (V).
-    std::vector<Vec3> restPositions;   // (V) part frame; same as mesh.vertices
-    std::vector<double> mass;          // (V) kg, > 0
-    std::vector<double> inverseMass;   // (V) 1/kg
+    Vec3Array restPositions;           // (V) part frame; same as mesh.vertices
+    std::vector<double, CacheAlignedAllocator<double>> mass;  // (V) kg, > 0
+    std::vector<double, CacheAlignedAllocator<double>> inverseMass;  // (V) 1/kg
 
     // Springs (E): one per unique edge, and with a shell material's bending springs one across
     // each interior edge; sorted by (springA, springB), so a bending spring's index is not an edge's.

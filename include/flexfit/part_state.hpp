@@ -10,11 +10,11 @@
 namespace flexfit {
 
 struct PartState {
-    std::vector<Vec3> positions;   // (V) part frame
-    std::vector<Vec3> velocities;  // (V)
+    Vec3Array positions;   // (V) part frame
+    Vec3Array velocities;  // (V)
     // (V) external forces pending for the next step: add to them (or pass PointLoads) before a
     // step; the step consumes them and leaves them zero.
-    std::vector<Vec3> forces;
+    Vec3Array forces;
     double time = 0.0;             // s
     std::uint64_t stepCount = 0;
 

@@ -99,8 +99,8 @@ void PartCollider::updateDisplacementBound(const Part& part) {
     // running maxima, not one: the loop waited on each max's latency (max is exact, so the
     // same value in any order; a NaN never wins, as before).
     const std::span<const Index> moving = part.movingMasses();
-    const std::vector<Vec3>& positions = part.state().positions;
-    const std::vector<Vec3>& rest = part.model().restPositions;
+    const Vec3Array& positions = part.state().positions;
+    const Vec3Array& rest = part.model().restPositions;
     const auto squaredMove = [&](Index m) { return (positions[m] - rest[m]).squaredNorm(); };
     std::array<double, 4> largest2{};
     std::size_t i = 0;

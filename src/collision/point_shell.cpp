@@ -258,7 +258,7 @@ FLEXFIT_AVX2_LANES std::size_t sampleMovedFours(std::span<const Index> moving, c
                                                 const PointShellCoherence& c, SampleMoved& sampleMoved) {
     using namespace detail::lanes;
     const Lanes3 translation = broadcast(bInA.translation);
-    const std::vector<Vec3>& positions = b.state().positions;
+    const Vec3Array& positions = b.state().positions;
     const std::size_t n = moving.size() / 4 * 4;
     for (std::size_t i = 0; i < n; i += 4) {
         const Index* four = &moving[i];

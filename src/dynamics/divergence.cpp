@@ -118,7 +118,7 @@ std::optional<std::string> nonFiniteMass(const PartState& state, Index m) {
 }
 
 std::string outlyingMass(const PartState& state, double positionBound) {
-    const std::vector<Vec3>& x = state.positions;
+    const Vec3Array& x = state.positions;
     if (x.empty()) return "the part has no masses";  // not reached after a failed check
     // The pair the check tripped on: mass 0 and the finite mass farthest from it along an axis.
     Index m = 0;

@@ -162,9 +162,10 @@ std::shared_ptr<PartModel> buildInGivenOrder(TriMesh mesh, const PartModelSettin
     if (shell) checkShell(*shell, settings);
 
     model->name = mesh.name;
-    model->restPositions = mesh.vertices;
-    if (shell) model->mass = lumpedMasses(mesh, *shell);
-    else model->mass = settings.vertexMasses.empty() ? std::vector<double>(vertices, settings.vertexMass) : settings.vertexMasses;
+    model->restPositions.assign(mesh.vertices.begin(), mesh.vertices.end());
+    const std::vector<double> masses =
+        shell ? lumpedMasses(mesh, *shell) : settings.vertexMasses.empty() ? std::vector<double>(vertices, settings.vertexMass) : settings.vertexMasses;
+    model->mass.assign(masses.begin(), masses.end());
     model->inverseMass.resize(vertices);
     for (std::size_t v = 0; v < vertices; ++v) model->inverseMass[v] = 1.0 / model->mass[v];
 
@@ -264,7 +265,7 @@ std::shared_ptr<const FileNumbering> fileNumbering(const FileVertices& file, con
 }
 
 // PartModel::positionBound: 1e6 times the rest shape's diagonal (infinite for a shape of no extent).
-double divergenceBound(const std::vector<Vec3>& rest) {
+double divergenceBound(std::span<const Vec3> rest) {
     const double extent = rest.empty() ? 0.0 : Aabb::around(rest).size();
     const double bound = 1e6 * extent;
     return extent > 0.0 && std::isfinite(bound) ? bound : std::numeric_limits<double>::infinity();

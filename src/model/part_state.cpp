@@ -6,7 +6,7 @@ namespace flexfit {
 
 PartState PartState::atRest(const PartModel& model) {
     PartState state;
-    state.positions = model.restPositions;
+    state.positions.assign(model.restPositions.begin(), model.restPositions.end());
     state.velocities.assign(model.massCount(), Vec3::Zero());
     state.forces.assign(model.massCount(), Vec3::Zero());
     return state;

@@ -35,7 +35,7 @@ struct BruteForce {
 
 BruteForce bruteForce(const Part& a, const Part& b, BoundingVolumeKind ka, BoundingVolumeKind kb, ExactTest test) {
     // Box leaves bound the face sphere for the sphere test, the triangle otherwise.
-    auto box = [test](const std::vector<Vec3>& p, const Face& f) {
+    auto box = [test](std::span<const Vec3> p, const Face& f) {
         return test == ExactTest::SphereTriangle ? faceSphereBox(p, f) : faceBox(p, f);
     };
     const Eigen::Matrix3d ra = a.pose().rotation.toRotationMatrix(), rb = b.pose().rotation.toRotationMatrix();

@@ -16,7 +16,7 @@ std::shared_ptr<const PartModel> triangle() {
 
 TEST(Activity, CountsSpringsBeyondThreshold) {
     const auto model = triangle();  // springs (0,1) L=1, (0,2) L=1, (1,2) L=sqrt 2
-    std::vector<Vec3> x = model->restPositions;
+    std::vector<Vec3> x(model->restPositions.begin(), model->restPositions.end());
     EXPECT_EQ(countActiveSprings(*model, x, 0.01), 0u);
     x[1].x() = 1.02;  // (0,1) +0.02; (1,2) changes by about 0.014
     const double d12 = (x[1] - x[2]).norm() - std::sqrt(2.0);

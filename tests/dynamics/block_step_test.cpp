@@ -54,7 +54,7 @@ PartState runBlocks(const PartModel& model, const SimulationSettings& settings, 
 }
 
 // Bit for bit (memcmp: +0 and -0 differ, equal NaNs match).
-bool sameBits(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+bool sameBits(std::span<const Vec3> a, std::span<const Vec3> b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;
 }
 

@@ -48,7 +48,7 @@ std::set<Index> ringByExpansion(const PartModel& model, std::set<Index> region, 
     return region;
 }
 
-double maxRelativeDifference(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+double maxRelativeDifference(std::span<const Vec3> a, std::span<const Vec3> b) {
     double scale = 0.0, diff = 0.0;
     for (std::size_t i = 0; i < a.size(); ++i) {
         scale = std::max(scale, a[i].norm());

@@ -96,7 +96,7 @@ TEST(PartModel, DefaultsAndRestLengths) {
     EXPECT_EQ(model->massCount(), 576u);
     EXPECT_EQ(model->springCount(), 1728u);
     EXPECT_EQ(model->faceCount(), 1152u);
-    EXPECT_EQ(model->restPositions, mesh.vertices);
+    EXPECT_EQ(std::vector<Vec3>(model->restPositions.begin(), model->restPositions.end()), mesh.vertices);
     EXPECT_EQ(model->mesh.vertices, mesh.vertices);
     EXPECT_EQ(model->mesh.faces, mesh.faces);
     EXPECT_EQ(model->springA, model->topology.edgeA);
@@ -152,8 +152,8 @@ TEST(PartModel, PerVertexMassesAndPerSpringMaterials) {
     settings.material = Material::rigid();  // ignored: per-spring materials win
     for (int e = 0; e < 6; ++e) settings.springMaterials.push_back({0.5 + e, 0.25 * e});
     const auto model = buildPartModel(tetrahedron(), settings);
-    EXPECT_EQ(model->mass, settings.vertexMasses);
-    EXPECT_EQ(model->inverseMass, (std::vector<double>{1.0, 0.5, 0.25, 2.0}));
+    EXPECT_EQ(std::vector<double>(model->mass.begin(), model->mass.end()), settings.vertexMasses);
+    EXPECT_EQ(std::vector<double>(model->inverseMass.begin(), model->inverseMass.end()), (std::vector<double>{1.0, 0.5, 0.25, 2.0}));
     for (std::size_t e = 0; e < 6; ++e) {
         EXPECT_EQ(model->stiffness[e], 0.5 + double(e)) << e;
         EXPECT_EQ(model->damping[e], 0.25 * double(e)) << e;
@@ -572,7 +572,7 @@ TEST(PartModel, SharedByTwoStates) {
     EXPECT_EQ(stateHash(a), stateHash(b));
 
     // States are independent of each other and of the model.
-    const std::vector<Vec3> rest = model->restPositions;
+    const Vec3Array rest = model->restPositions;
     a.positions[3] += Vec3(0.5, 0.0, 0.0);
     a.velocities[7] = Vec3(1.0, 2.0, 3.0);
     a.time = 0.25;

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <numeric>
 
 #include <algorithm>
@@ -194,4 +195,16 @@ TEST(SpringBlocks, ContinuesRowOnlyForAdjacentOffsetOneBlocks) {
     EXPECT_FALSE(b.continuesRow(2));  // a gap
     EXPECT_FALSE(b.continuesRow(3));  // another offset
     EXPECT_FALSE(b.continuesRow(4));  // offset 2 continues no row
+}
+
+// The block kernels load each block's 8 lanes of constants as one vector: each array starts on
+// a cache line, so block q's lanes are one line (PartState's test says why it matters).
+TEST(SpringBlocks, EachBlocksConstantsAreOneCacheLine) {
+    for (const TriMesh& mesh : {makeTorus1(), makeTorus2(), makeHeart(), makeIcoSphere(1.0, 2)}) {
+        const auto model = buildPartModel(mesh);
+        const SpringBlocks& blocks = *model->springBlocks;
+        ASSERT_GT(blocks.blockCount(), 0u) << mesh.name;
+        for (const auto* lanes : {&blocks.restLength, &blocks.stiffness, &blocks.damping})
+            EXPECT_EQ(reinterpret_cast<std::uintptr_t>(lanes->data()) % 64, 0u) << mesh.name;
+    }
 }

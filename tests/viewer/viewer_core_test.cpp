@@ -139,7 +139,7 @@ TEST(ShowPart, ADrawnMeshIsWhatIsShown) {
     Part plain(buildPartModel(makeIcoSphere(1.0, 1)));
     const std::vector<Vec3> normals = SurfaceNormals::computeAll(plain);
     showPart(plain, normals, massColours, shown);
-    EXPECT_EQ(shown.positions, plain.state().positions);
+    EXPECT_EQ(shown.positions, std::vector<Vec3>(plain.state().positions.begin(), plain.state().positions.end()));
     EXPECT_EQ(shown.normals, normals);
     EXPECT_EQ(shown.colours, massColours);
 }
