@@ -40,8 +40,9 @@ struct CacheAlignedAllocator {
     template <class U>
     bool operator==(const CacheAlignedAllocator<U>&) const noexcept { return true; }
 };
-// A part's per-mass 3-vectors (PartState), each array starting on a cache line.
+// Per-mass arrays the kernels stream (PartState, PartModel's masses), each starting on a cache line.
 using Vec3Array = std::vector<Vec3, CacheAlignedAllocator<Vec3>>;
+using DoubleArray = std::vector<double, CacheAlignedAllocator<double>>;
 using Face = std::array<Index, 3>;
 // A body's id in a world: its index, 0, 1, 2, ... in the order added (body.hpp).
 using BodyId = std::uint32_t;

@@ -109,8 +109,8 @@ struct PartModel {
 
     // Masses (V).
     Vec3Array restPositions;           // (V) part frame; same as mesh.vertices
-    std::vector<double, CacheAlignedAllocator<double>> mass;  // (V) kg, > 0
-    std::vector<double, CacheAlignedAllocator<double>> inverseMass;  // (V) 1/kg
+    DoubleArray mass;                  // (V) kg, > 0
+    DoubleArray inverseMass;           // (V) 1/kg
 
     // Springs (E): one per unique edge, and with a shell material's bending springs one across
     // each interior edge; sorted by (springA, springB), so a bending spring's index is not an edge's.

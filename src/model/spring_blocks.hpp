@@ -48,7 +48,7 @@ struct SpringBlocks {
     std::vector<Index> first;   // (B) a0
     std::vector<Index> offset;  // (B) b - a of all its springs, >= 1
     // (8B) constants of lane i of block q at 8q + i.
-    std::vector<double, CacheAlignedAllocator<double>> restLength, stiffness, damping;  // read 8 lanes at a time
+    DoubleArray restLength, stiffness, damping;  // read 8 lanes at a time
     std::vector<Index> remainder;  // springs in no block, ascending
     // Lane 8q + i of block q is spring laneSpring[8q + i], or kNoLane when empty; laneOfSpring[e]
     // is spring e's lane, or kNoLane for a remainder spring (the active region tracks its blocks
