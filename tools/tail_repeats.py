@@ -49,7 +49,8 @@ def contact_steps(metrics):
         rows = list(csv.DictReader(f))
     steps, zones = [], 0
     for r in rows:
-        opened, zones = max(0, int(r.get("zones", 0)) - zones), int(r.get("zones", 0))
+        count = int(r.get("zones", 0))
+        opened, zones = max(0, count - zones), count
         if float(r["contacts"]) > 0:
             steps.append({"step_us": step_us(r), "contacts": float(r["contacts"]), "zones_opened": float(opened)}
                          | {k: float(r[c]) for k, c in STAGES.items() if c in r})
@@ -71,7 +72,8 @@ def composition(floor, stages):
     """The tail_* and mid_* columns: `floor` each step's fastest time, `stages` each run's
     contact_steps (the stages at their fastest over the runs, the counts from the first run)."""
     order = sorted(range(len(floor)), key=lambda s: floor[s])
-    bands = {"tail": sorted(slowest(floor)), "mid": order[int(0.45 * len(order)):max(int(0.45 * len(order)) + 1, int(0.55 * len(order)))]}
+    low, high = int(0.45 * len(order)), int(0.55 * len(order))
+    bands = {"tail": sorted(slowest(floor)), "mid": order[low:max(low + 1, high)]}  # at least one middle step
     out = {}
     for band, chosen in bands.items():
         for k in COUNTS:
