@@ -247,8 +247,9 @@ void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField
 // Temporal coherence of a point-shell pair (queryPointShellCoherent). Starts empty.
 struct PointShellCoherence {
     // A walk of B's rest-point tree at a fixed relative pose with the field's reach grown by a
-    // margin: the leaves it reached, in its order, with the distance each rest position samples
-    // there (infinity outside the grid). Resumable: `stack` holds what is left.
+    // margin: the leaves it reached, in its order, with the distance (or a lower bound of it)
+    // each rest position samples there; only those in the grid whose distance does not stay
+    // clear over the margin. Resumable: `stack` holds what is left.
     struct Walk {
         std::vector<std::int32_t> stack;
         std::vector<std::pair<Index, double>> masses;
@@ -285,7 +286,9 @@ struct PointShellCoherence {
 // skipped while it stays that close to its last sample, and a mass at rest while B's rest
 // sphere (restSphereB, B's frame) has moved less than that in A's frame since the traversal
 // that listed it. The rest masses come from a walk of the rest-point tree with the field's
-// reach grown by a margin of 2 cells; the next list's walk starts when B's rest sphere has
+// reach grown by a margin of 2 cells (subtrees of up to 8 masses listed whole, then each mass
+// kept only where its sample can reach the surface within the margin); the next list's walk
+// starts when B's rest sphere has
 // moved 0.4 of the margin and is spread over the following queries (1/16 of a walk each),
 // so a query pays a whole walk only when the motion outruns the margin. A haptic tool held
 // still or sliding then samples only the masses near its surface, with no traversal spikes.

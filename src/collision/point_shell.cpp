@@ -141,26 +141,34 @@ private:
 
 // Walks B's rest-point tree depth first from `stack` (the root to begin), at most `budget`
 // nodes: leaf(mass) for each leaf reached whose rest position may sample <= 0 when moved by up
-// to `margin` from where `pose` puts it (the field's Lipschitz bound prunes the others). The
-// walk can stop and resume: it depends only on the pose, the margin and the stack. Returns
-// the nodes visited.
+// to `margin` from where `pose` puts it (the field's Lipschitz bound prunes the others). A
+// subtree of at most `bucket` leaves that is not pruned is not descended: each of its leaves is
+// reached, in the same order, and the caller prunes them on their own samples (the walk's
+// nodes near the leaves prune few, and a sample 8 a vector costs a fraction of a node's test).
+// Each leaf so reached counts as a node. The walk can stop and resume: it depends only on the
+// pose, the margin and the stack. Returns the nodes visited.
 template <class Leaf>
 std::size_t walkRestPoints(const SignedDistanceField& field, const Bvh<Aabb>& restPoints, const RelativePose& pose, double margin,
-                           std::vector<std::int32_t>& stack, std::size_t budget, Leaf leaf) {
+                           std::vector<std::int32_t>& stack, std::size_t budget, std::size_t bucket, Leaf leaf) {
     const auto& nodes = restPoints.nodes();
     std::size_t visited = 0;
     while (!stack.empty() && visited < budget) {
-        const auto& node = nodes[std::size_t(stack.back())];
+        const std::int32_t n = stack.back();
+        const auto& node = nodes[std::size_t(n)];
         stack.pop_back();
         ++visited;
         if (node.isLeaf()) {
             leaf(node.item);
             continue;
         }
-        if (!field.clearOf(pose.apply(node.volume.centre()), node.volume.halfExtents().norm() + margin)) {
-            stack.push_back(node.right);
-            stack.push_back(node.left);
+        if (field.clearOf(pose.apply(node.volume.centre()), node.volume.halfExtents().norm() + margin)) continue;
+        if (restPoints.itemCount(n) <= bucket) {
+            for (std::int32_t k = n + 1; k < restPoints.subtreeEnd(n); ++k)
+                if (nodes[std::size_t(k)].isLeaf()) leaf(nodes[std::size_t(k)].item), ++visited;
+            continue;
         }
+        stack.push_back(node.right);
+        stack.push_back(node.left);
     }
     return visited;
 }
@@ -180,12 +188,18 @@ std::size_t walkRestPoints(const SignedDistanceField& field, const Bvh<Aabb>& re
 // steps walked ~460 nodes each (~22 us), and those steps were the whole in-contact tail; spread
 // over 2/3 of the list's life, walks follow one another, nearly every step walks ~210 nodes,
 // and the tail fell (bench/results/tail_repeats_haptic_1207.csv). Two thirds, not all, leaves a third of
-// the list's life for an acceleration before a walk must finish at once.
+// the list's life for an acceleration before a walk must finish at once. Listing subtrees of up
+// to kShellWalkBucket masses whole (walkRestPoints) took the haptic scene's walking from 9.8 to
+// about 7 us a contact step (4 and 16 within noise of 8; 32 slower), and its list 1,559 -> 1,539
+// samples a step.
 constexpr double kMarginCells = 2.0;
 constexpr double kShellWalkStart = 0.4;
 constexpr std::size_t kShellWalkShare = 16;
 constexpr std::size_t kShellMinWalkNodes = 128;
 constexpr double kShellWalkSpread = 2.0 / 3.0;
+// The walk's buckets: subtrees of at most this many masses, listed whole and pruned by their
+// samples (walkRestPoints).
+constexpr std::size_t kShellWalkBucket = 8;
 
 // Nodes for this query's slice of the walk under way: at rest the share; moving, the rest of
 // the last walk's nodes over kShellWalkSpread of the queries the list still covers at `speed`
@@ -210,29 +224,33 @@ void startWalk(PointShellCoherence::Walk& w, const RelativePose& pose, double ma
 }
 
 // Advances the walk by up to `budget` nodes; true when it is complete. Each listed mass keeps
-// the distance its rest position samples at the walk's pose (infinity outside the grid), or a
-// lower bound of it where the field's cell is not computed (sampleLowerBounds: a walk computes
-// no node; a listed mass is only skipped on its distance, so a lower bound skips less, never
-// wrongly). The leaves in the grid are sampled together after the slice (4 or 8 a vector).
+// the distance its rest position samples at the walk's pose, or a lower bound of it where the
+// field's cell is not computed (sampleLowerBounds: a walk computes no node; a listed mass is
+// only skipped on its distance, so a lower bound skips less, never wrongly). The leaves in the
+// grid are sampled together after the slice (4 or 8 a vector); a leaf outside the grid, or
+// whose distance stays clear over the walk's margin, is not listed: the list is used only
+// while B has moved less than the margin, over which such a mass is skipped (the same contacts,
+// in the same order, as listing it).
 bool advanceWalk(PointShellCoherence::Walk& w, const SignedDistanceField& field, const Bvh<Aabb>& restPoints, std::size_t budget,
                  QueryStats& stats) {
-    thread_local std::vector<std::size_t> slots;  // into w.masses
+    thread_local std::vector<Index> reached;  // in the grid, in walk order
     thread_local std::vector<Vec3> points;
     thread_local std::vector<double> samples;
-    slots.clear();
+    reached.clear();
     points.clear();
-    const std::size_t visited = walkRestPoints(field, restPoints, w.pose, w.margin, w.stack, budget, [&](Index m) {
+    const std::size_t visited = walkRestPoints(field, restPoints, w.pose, w.margin, w.stack, budget, kShellWalkBucket, [&](Index m) {
         const Vec3 p = w.pose.apply(restPoints.leafVolume(m).centre());
         ++stats.exactTests;
         if (field.inGrid(p)) {
-            slots.push_back(w.masses.size());
+            reached.push_back(m);
             points.push_back(p);
         }
-        w.masses.push_back({m, std::numeric_limits<double>::infinity()});
     });
     samples.resize(points.size());
     field.sampleLowerBounds(points, samples);
-    for (std::size_t k = 0; k < slots.size(); ++k) w.masses[slots[k]].second = samples[k];
+    const double clearOverMargin = field.clearDistance(w.margin);
+    for (std::size_t k = 0; k < reached.size(); ++k)
+        if (!(samples[k] > clearOverMargin)) w.masses.push_back({reached[k], samples[k]});
     w.nodes += visited;
     stats.volumeTests += visited;
     return w.stack.empty();
@@ -287,7 +305,7 @@ void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField
     // The masses at rest, through the tree of rest positions (their current positions).
     if (!restPointsB.empty()) {
         std::vector<std::int32_t> stack(1, 0);
-        stats.volumeTests += walkRestPoints(fieldA, restPointsB, bInA, 0.0, stack, std::numeric_limits<std::size_t>::max(), [&](Index m) {
+        stats.volumeTests += walkRestPoints(fieldA, restPointsB, bInA, 0.0, stack, std::numeric_limits<std::size_t>::max(), 1, [&](Index m) {
             if (!b.isMoving(m)) sampler.queue(m, sampler.pointOf(m));
         });
     }

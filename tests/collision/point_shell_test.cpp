@@ -180,6 +180,34 @@ TEST(PointShellCoherent, ABallHeldStillSamplesOnlyTheMassesNearIt) {
     EXPECT_LT(last.exactTests, first.exactTests / 2) << last.exactTests << " samples against " << first.exactTests;
 }
 
+TEST(PointShellCoherent, AWalkListsOnlyTheRestMassesThatCanTouchWithinItsMargin) {
+    // The walk lists small subtrees whole and prunes their masses on their own samples: the
+    // list keeps no mass outside the grid or clear of the surface over the margin (those the
+    // query would skip while the list is used), and still every mass that a brute-force sample
+    // at the list's pose finds within the margin of the surface.
+    BallOverTorus s;
+    s.ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(1.0, 0.8, 0.0)});
+    PointShellCoherence coherence;
+    QueryStats stats;
+    ASSERT_FALSE(s.coherent(coherence, stats).empty());
+    ASSERT_TRUE(coherence.valid);
+    const double clear = s.field.clearDistance(coherence.margin);
+    std::set<Index> listed;
+    for (const auto& [m, distance] : coherence.restMasses) {
+        EXPECT_LE(distance, clear) << "mass " << m;
+        listed.insert(m);
+    }
+    std::size_t near = 0;
+    for (Index m = 0; m < s.torus.model().massCount(); ++m) {
+        const Vec3 p = coherence.pose.apply(s.torus.model().restPositions[m]);
+        if (!s.field.inGrid(p) || s.field.sample(p).distance > coherence.margin) continue;
+        ++near;
+        EXPECT_TRUE(listed.contains(m)) << "mass " << m << " samples " << s.field.sample(p).distance;
+    }
+    EXPECT_GT(near, 0u);
+    EXPECT_LT(listed.size(), s.torus.model().massCount() / 2);
+}
+
 TEST(PointShell, ContactsFourAtATimeEqualOneAtATime) {
     // The AVX2 paths (samples, contacts and the coherent query's skip test 4 at a time)
     // against one at a time (ScopedScalarSampling, ScopedScalarLanes), bit for bit, by the full and the coherent
