@@ -326,11 +326,19 @@ FLEXFIT_AVX2 bool sampleFour(const GridLanes& g, const Vec3* p, SignedDistanceFi
     const __m128i sy = g.dx, sz = _mm_mullo_epi32(g.dx, g.dy), sx = _mm_set1_epi32(1);
     const __m128i offset[8] = {_mm_setzero_si128(), sx, sy, _mm_add_epi32(sx, sy), sz, _mm_add_epi32(sz, sx), _mm_add_epi32(sz, sy),
                                _mm_add_epi32(_mm_add_epi32(sz, sx), sy)};
+    // Corners n and n + 1 (x and x + 1) are adjacent floats: one 64-bit gather fetches both,
+    // half the elements of gathering each (the same values, so the same bits).
     Doubles4 v[8];
     __m256d unknown = zero;
-    for (int n = 0; n < 8; ++n) {
-        v[n] = _mm256_cvtps_pd(_mm_i32gather_ps(g.values, _mm_add_epi32(node, offset[n]), 4));
-        unknown = _mm256_or_pd(unknown, _mm256_cmp_pd(v[n], v[n], _CMP_UNORD_Q));
+    const __m256i evensThenOdds = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+    for (int n = 0; n < 8; n += 2) {
+        const __m256 pairs = _mm256_permutevar8x32_ps(
+            _mm256_castpd_ps(_mm256_mask_i32gather_pd(zero, reinterpret_cast<const double*>(g.values), _mm_add_epi32(node, offset[n]),
+                                                      _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), 4)),
+            evensThenOdds);
+        v[n] = _mm256_cvtps_pd(_mm256_castps256_ps128(pairs));
+        v[n + 1] = _mm256_cvtps_pd(_mm256_extractf128_ps(pairs, 1));
+        unknown = _mm256_or_pd(unknown, _mm256_or_pd(_mm256_cmp_pd(v[n], v[n], _CMP_UNORD_Q), _mm256_cmp_pd(v[n + 1], v[n + 1], _CMP_UNORD_Q)));
     }
     if (_mm256_movemask_pd(unknown) != 0) return false;
     LaneSamples<Doubles4> s;
@@ -408,11 +416,17 @@ FLEXFIT_AVX512 bool sampleEight(const GridLanes8& g, const Vec3* p, SignedDistan
     const __m256i sy = g.dx, sz = _mm256_mullo_epi32(g.dx, g.dy), sx = _mm256_set1_epi32(1);
     const __m256i offset[8] = {_mm256_setzero_si256(), sx, sy, _mm256_add_epi32(sx, sy), sz, _mm256_add_epi32(sz, sx),
                                _mm256_add_epi32(sz, sy), _mm256_add_epi32(_mm256_add_epi32(sz, sx), sy)};
+    // Corners n and n + 1 (x and x + 1) are adjacent floats: one 64-bit gather fetches both,
+    // half the elements of gathering each (the same values, so the same bits).
     Doubles8 v[8];
     __mmask8 unknown = 0;
-    for (int n = 0; n < 8; ++n) {
-        v[n] = _mm512_cvtps_pd(_mm256_i32gather_ps(g.values, _mm256_add_epi32(node, offset[n]), 4));
-        unknown |= _mm512_cmp_pd_mask(v[n], v[n], _CMP_UNORD_Q);
+    const __m512i evens = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 0, 0, 0, 0, 0, 0, 0, 0);
+    const __m512i odds = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 0, 0, 0, 0, 0, 0, 0, 0);
+    for (int n = 0; n < 8; n += 2) {
+        const __m512 pairs = _mm512_castpd_ps(_mm512_i32gather_pd(_mm256_add_epi32(node, offset[n]), g.values, 4));
+        v[n] = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_permutexvar_ps(evens, pairs)));
+        v[n + 1] = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_permutexvar_ps(odds, pairs)));
+        unknown |= _mm512_cmp_pd_mask(v[n], v[n], _CMP_UNORD_Q) | _mm512_cmp_pd_mask(v[n + 1], v[n + 1], _CMP_UNORD_Q);
     }
     if (unknown != 0) return false;
     LaneSamples<Doubles8> s;
