@@ -16,17 +16,22 @@ namespace {
 // Zones at the contacted faces and each mass's deepest push, in first-contact order.
 void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& r) {
     r.pushed.clear();
-    r.pushes.clear();
+    r.pushBodies.clear();
+    r.pushMasses.clear();
+    r.pushDisplacements.clear();
     // Pushes the face's masses, or only `mass` when the contact has one (point shell).
     auto pushFace = [&](BodyId id, Index face, Index mass, const Vec3& displacement) {
         Part& part = *bodies.parts[id];
         part.touchFace(face);
         for (Index m : pressedMasses(part.model().mesh.faces[face], mass)) {
             const Index key = bodies.worldMass(id, m);
-            if (r.pushed.insert(key))
-                r.pushes.push_back({id, m, displacement});
-            else if (Vec3& deepest = r.pushes[r.pushed.slotOf(key)].displacement; displacement.squaredNorm() > deepest.squaredNorm())
+            if (r.pushed.insert(key)) {
+                r.pushBodies.push_back(id);
+                r.pushMasses.push_back(m);
+                r.pushDisplacements.push_back(displacement);
+            } else if (Vec3& deepest = r.pushDisplacements[r.pushed.slotOf(key)]; displacement.squaredNorm() > deepest.squaredNorm()) {
                 deepest = displacement;
+            }
         }
     };
     for (const Contact& c : contacts) {
@@ -41,15 +46,12 @@ void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactRes
 
 // Each body's run of pushes at once (Part::displaceMasses), in order.
 void displacePushedMasses(Bodies& bodies, ContactResponse& r) {
-    for (std::size_t begin = 0, end = 0; begin < r.pushes.size(); begin = end) {
-        const BodyId body = r.pushes[begin].body;
-        r.runMasses.clear();
-        r.runDisplacements.clear();
-        for (end = begin; end < r.pushes.size() && r.pushes[end].body == body; ++end) {
-            r.runMasses.push_back(r.pushes[end].mass);
-            r.runDisplacements.push_back(r.pushes[end].displacement);
-        }
-        bodies.parts[body]->displaceMasses(r.runMasses, r.runDisplacements);
+    const std::span<const Index> masses = r.pushMasses;
+    const std::span<const Vec3> displacements = r.pushDisplacements;
+    for (std::size_t begin = 0, end = 0; begin < masses.size(); begin = end) {
+        const BodyId body = r.pushBodies[begin];
+        for (end = begin + 1; end < masses.size() && r.pushBodies[end] == body;) ++end;
+        bodies.parts[body]->displaceMasses(masses.subspan(begin, end - begin), displacements.subspan(begin, end - begin));
     }
 }
 
@@ -232,9 +234,9 @@ void sizeResponseScratch(const Bodies& bodies, ContactResponse& r) {
     r.reactionOwner.resize(masses, 0u);
     r.reactionCount.resize(bodies.size(), 0u);
     // Each list holds a mass at most once (per body for the reactions): no step reallocates.
-    r.pushes.reserve(masses);
-    r.runMasses.reserve(masses);
-    r.runDisplacements.reserve(masses);
+    r.pushBodies.reserve(masses);
+    r.pushMasses.reserve(masses);
+    r.pushDisplacements.reserve(masses);
     r.reactions.reserve(masses);
 }
 

@@ -42,16 +42,12 @@ struct ContactResponse {
     std::vector<double> stiffness;  // (nbody) effective contact stiffness
 
     // Scratch, over the world's masses (Bodies::worldMass): the deepest push of each mass, in
-    // first-contact order, and the masses whose reaction a body feels.
-    struct Push {
-        BodyId body;
-        Index mass;
-        Vec3 displacement;
-    };
+    // first-contact order (three lists parallel to pushed's members: a body's run of them goes
+    // to Part::displaceMasses as it is), and the masses whose reaction a body feels.
     IndexSet pushed;
-    std::vector<Push> pushes;  // parallel to pushed's members
-    std::vector<Index> runMasses;         // one body's run of pushes, for Part::displaceMasses
-    std::vector<Vec3> runDisplacements;
+    std::vector<BodyId> pushBodies;
+    std::vector<Index> pushMasses;         // the body's own mass index
+    std::vector<Vec3> pushDisplacements;   // world frame
     IndexSet reacting;
     std::vector<BodyId> reactionOwner;  // (world masses) the body that last counted each
     struct Reaction {
