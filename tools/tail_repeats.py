@@ -13,7 +13,9 @@ stage columns, as tools/ab_stages.py). Reports:
   the tail the work itself sets (a step is slow there only if it was slow in every run);
 - top_repeat_pct: of each run's slowest 1 % of steps, the share (%) that are among the slowest
   1 % of the next run (mean over consecutive pairs), beside top_chance_pct, the share expected
-  if the slow steps fell at random (1 % of the steps): near chance, the tail is the machine's.
+  if the slow steps fell at random (1 % of the steps): near chance, the tail is the machine's
+  (build/release/bench/bench_step_noise reads the same percentiles of a step of constant work,
+  the machine's share of a measured tail at a given step time);
 - where the floor's tail goes: over the floor's slowest 1 % of steps (tail_*) and the steps
   ranked 45-55 % in it (mid_*), the mean of each step's fastest narrow phase, contact response
   and zone dynamics over the runs (`*_us`), its contacts and the zones it opened (the rise of
