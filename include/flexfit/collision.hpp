@@ -288,10 +288,10 @@ struct PointShellCoherence {
 // that listed it. The rest masses come from a walk of the rest-point tree with the field's
 // reach grown by a margin of 2 cells (subtrees of up to 8 masses listed whole, then each mass
 // kept only where its sample can reach the surface within the margin); the next list's walk
-// starts when B's rest sphere has
-// moved 0.4 of the margin and is spread over the following queries (1/16 of a walk each),
-// so a query pays a whole walk only when the motion outruns the margin. A haptic tool held
-// still or sliding then samples only the masses near its surface, with no traversal spikes.
+// starts when B's rest sphere has moved 0.4 of the margin and is spread over the following
+// queries, so a query pays a whole walk only when the motion outruns the margin. A haptic
+// tool held still or sliding then samples only the masses near its surface, with no traversal
+// spikes.
 void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDistanceField& fieldA, std::uint32_t idB, const Part& b,
                              const Bvh<Aabb>& restPointsB, const Sphere& restSphereB, PointShellCoherence& coherence,
                              std::vector<Contact>& contacts, QueryStats& stats);
