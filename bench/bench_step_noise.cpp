@@ -31,7 +31,7 @@ struct Options {
 };
 
 [[noreturn]] void usage(const char* problem) {
-    std::fprintf(stderr, "bench_step_noise: %s\nusage: bench_step_noise [--work-us US > 0] [--runs N >= 1] [--steps N >= 100]\n", problem);
+    std::fprintf(stderr, "bench_step_noise: %s\nusage: bench_step_noise [--work-us US in (0, 1e6)] [--runs N in 1..1000] [--steps N in 100..1e7]\n", problem);
     std::exit(2);
 }
 
@@ -46,12 +46,12 @@ Options parse(int argc, char** argv) {
         if (end == value || *end != '\0') usage("a value that is not a number");
         if (flag == "--work-us" && number > 0.0 && number < 1e6)
             o.workUs = number;
-        else if (flag == "--runs" && number >= 1 && number <= 1000)
+        else if (flag == "--runs" && number >= 1 && number <= 1000 && number == double(int(number)))
             o.runs = int(number);
-        else if (flag == "--steps" && number >= 100 && number <= 1e7)
+        else if (flag == "--steps" && number >= 100 && number <= 1e7 && number == double(int(number)))
             o.steps = int(number);
         else
-            usage("an unknown flag or a value out of range");
+            usage((std::string("unknown flag or value out of range: ") + std::string(flag) + " " + value).c_str());
     }
     return o;
 }
