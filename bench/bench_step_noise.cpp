@@ -14,6 +14,8 @@
 // Prints CSV: the target and calibrated work, measured p50 / p99 (median over the runs of each
 // run's nearest-rank percentile, as tail_repeats' measured_*), floor p50 / p99 and the measured
 // p99 over the floor p99.
+#include "flexfit/profile.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -23,6 +25,8 @@
 #include <vector>
 
 namespace {
+
+using flexfit::nearestRankPercentile;
 
 struct Options {
     double workUs = 100.0;
@@ -82,14 +86,6 @@ int calibrate(std::vector<double>& data, double us, volatile double& sink) {
     return std::max(1, int(us / (fastest / 16.0) + 0.5));
 }
 
-double nearestRank(std::vector<double> values, double percent) {
-    std::sort(values.begin(), values.end());
-    const auto rank = std::size_t(std::max(1.0, percent / 100.0 * double(values.size()) + 0.999999999));
-    return values[std::min(values.size(), rank) - 1];
-}
-
-double median(std::vector<double> values) { return nearestRank(std::move(values), 50.0); }
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -102,12 +98,14 @@ int main(int argc, char** argv) {
         for (double& t : run) t = timedWork(data, rounds, sink);
     std::vector<double> p50s, p99s, floor(std::size_t(o.steps), 1e300);
     for (const auto& run : times) {
-        p50s.push_back(nearestRank(run, 50.0));
-        p99s.push_back(nearestRank(run, 99.0));
+        p50s.push_back(nearestRankPercentile(run, 50.0));
+        p99s.push_back(nearestRankPercentile(run, 99.0));
         for (std::size_t s = 0; s < run.size(); ++s) floor[s] = std::min(floor[s], run[s]);
     }
-    const double floorP99 = nearestRank(floor, 99.0);
+    // The median over the runs of each run's percentile, as tail_repeats' measured_* (odd run counts).
+    const double measuredP50 = nearestRankPercentile(p50s, 50.0), measuredP99 = nearestRankPercentile(p99s, 50.0);
+    const double floorP99 = nearestRankPercentile(floor, 99.0);
     std::printf("work_us,rounds,runs,steps,measured_p50,measured_p99,floor_p50,floor_p99,measured_p99_over_floor_p99\n");
-    std::printf("%.1f,%d,%d,%d,%.1f,%.1f,%.1f,%.1f,%.3f\n", o.workUs, rounds, o.runs, o.steps, median(p50s), median(p99s),
-                nearestRank(floor, 50.0), floorP99, median(p99s) / floorP99);
+    std::printf("%.1f,%d,%d,%d,%.1f,%.1f,%.1f,%.1f,%.3f\n", o.workUs, rounds, o.runs, o.steps, measuredP50, measuredP99,
+                nearestRankPercentile(floor, 50.0), floorP99, measuredP99 / floorP99);
 }

@@ -7,6 +7,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <sstream>
@@ -139,7 +140,7 @@ void run(const ContactOptions& opt) {
                       restoredAt >= 0 ? fmt::format("{:.3f} s ({:.3f} s after the last contact)", restoredAt, restoredAt - lastContact)
                                       : std::string("not within the run"));
     md << fmt::format("| final blue positions equal the rest shape | {} |\n",
-                      std::equal(blue.state().positions.begin(), blue.state().positions.end(), model->restPositions.begin(), model->restPositions.end()) ? "yes, exactly" : "no");
+                      std::ranges::equal(blue.state().positions, model->restPositions) ? "yes, exactly" : "no");
     md << fmt::format("| collision (broad + narrow phase + contact response) per step | {:.1f} µs |\n", perStep * collideSeconds);
     md << fmt::format("| blue zones (dynamics + retirement) per step | {:.1f} µs |\n\n", perStep * stepSeconds);
     md << "The penetration is measured against the analytic torus, so it includes the chord error of the flat faces "

@@ -163,9 +163,14 @@ std::shared_ptr<PartModel> buildInGivenOrder(TriMesh mesh, const PartModelSettin
 
     model->name = mesh.name;
     model->restPositions.assign(mesh.vertices.begin(), mesh.vertices.end());
-    const std::vector<double> masses =
-        shell ? lumpedMasses(mesh, *shell) : settings.vertexMasses.empty() ? std::vector<double>(vertices, settings.vertexMass) : settings.vertexMasses;
-    model->mass.assign(masses.begin(), masses.end());
+    if (shell) {
+        const std::vector<double> lumped = lumpedMasses(mesh, *shell);
+        model->mass.assign(lumped.begin(), lumped.end());
+    } else if (settings.vertexMasses.empty()) {
+        model->mass.assign(vertices, settings.vertexMass);
+    } else {
+        model->mass.assign(settings.vertexMasses.begin(), settings.vertexMasses.end());
+    }
     model->inverseMass.resize(vertices);
     for (std::size_t v = 0; v < vertices; ++v) model->inverseMass[v] = 1.0 / model->mass[v];
 
