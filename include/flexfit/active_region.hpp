@@ -21,8 +21,9 @@
 // with AVX-512, 3-5 made the region step as fast or faster at every partial coverage (5: by
 // 0-14 %), but with AVX2, whose loose springs are relatively cheaper, 2 / 3 / 4 made it up to
 // 1.34 / 1.19 / 1.16x slower at low coverage, and 5 was the smallest within noise of 8 or
-// faster. The step runs the other ("loose") springs and masses one at a time. O(8) more per
-// joining or leaving spring or mass.
+// faster. The step runs the other ("loose") springs by the listed-spring kernel, from their ends
+// and constants kept beside them (looseSpringList), and the loose masses as a list. O(8) more
+// per joining or leaving spring or mass.
 //
 // Known limit: a mass can be covered by at most 65,535 zones at once (the count is 16-bit, to
 // keep the per-mass mask that the region step reads small).
@@ -30,6 +31,7 @@
 
 #include "flexfit/index_set.hpp"
 #include "flexfit/part_model.hpp"
+#include "flexfit/spring_list.hpp"
 
 #include <cstdint>
 #include <span>
@@ -62,7 +64,10 @@ public:
     // computed spring is loose.
     static constexpr std::uint8_t kMinimumBlockSprings = 5;
     const IndexSet& vectorBlocks() const { return blockGroups_.vector; }
-    const IndexSet& looseSprings() const { return blocks_ != nullptr ? blockGroups_.loose : springs_; }
+    const IndexSet& looseSprings() const { return blockGroups_.loose.set; }
+    // The loose springs' ends and constants, slot for slot beside looseSprings() (what the
+    // region step's listed-spring kernels read).
+    const SpringList& looseSpringList() const { return blockGroups_.loose.list; }
     // Octets k (masses 8k..8k+7) with at least kMinimumOctetMasses moving masses, which the
     // vector kernel integrates whole (its other masses held at rest), and the moving masses in no
     // such octet. 3 measured against 1, 2, 4, 6 and 8 (bench/results/vector_octets_1206.csv):
@@ -72,14 +77,26 @@ public:
     const IndexSet& looseMasses() const { return octets_.loose; }
 
 private:
+    // The loose springs: their set, and their ends and constants beside it slot for slot.
+    struct LooseSprings {
+        const PartModel* model = nullptr;
+        IndexSet set;
+        SpringList list;
+        void reset(const PartModel& m);
+        bool contains(Index e) const { return set.contains(e); }
+        void insert(Index e);
+        void erase(Index e);
+    };
     // Members (springs, masses) in groups of 8: which groups have at least `minimum` members in
-    // the region, and which members of the region are in no such group.
+    // the region, and which members of the region are in no such group (`loose`: an IndexSet
+    // of masses, or LooseSprings, which the caller resets).
+    template <class Loose>
     struct VectorGroups {
         std::uint8_t minimum = 8;
         std::vector<std::uint8_t> count;  // (groups) members in the region
         IndexSet vector;                  // (groups) those with at least `minimum`
-        IndexSet loose;                   // (members)
-        void reset(std::size_t groups, std::size_t members, std::uint8_t minimumMembers);
+        Loose loose;                      // (members)
+        void reset(std::size_t groups, std::uint8_t minimumMembers);
         // `group` is kNoGroup for a member of no group; memberOf(group, i) is its i-th member, or
         // kNoGroup for an empty place (a spring block's empty lane).
         // Called after the member joined or left; inRegion(m) says whether m is in the region.
@@ -101,8 +118,8 @@ private:
     IndexSet masses_;                        // (V)
     IndexSet springs_;                       // (E)
     const SpringBlocks* blocks_ = nullptr;   // the model's, when it has any
-    VectorGroups blockGroups_;               // spring blocks (with blocks_)
-    VectorGroups octets_;                    // mass octets
+    VectorGroups<LooseSprings> blockGroups_; // spring blocks (none without blocks_: all loose)
+    VectorGroups<IndexSet> octets_;          // mass octets
 };
 
 }  // namespace flexfit

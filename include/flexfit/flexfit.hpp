@@ -32,6 +32,7 @@
 #include "flexfit/sweep.hpp"
 #include "flexfit/frame_export.hpp"
 #include "flexfit/simulation.hpp"
+#include "flexfit/spring_list.hpp"
 #include "flexfit/topology.hpp"
 #include "flexfit/world.hpp"
 #include "flexfit/world_settings.hpp"

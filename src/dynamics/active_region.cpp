@@ -5,15 +5,32 @@
 
 namespace flexfit {
 
-void ActiveRegion::VectorGroups::reset(std::size_t groups, std::size_t members, std::uint8_t minimumMembers) {
+void ActiveRegion::LooseSprings::reset(const PartModel& m) {
+    model = &m;
+    set.reset(m.springCount());
+    list.clear();
+}
+
+void ActiveRegion::LooseSprings::insert(Index e) {
+    if (set.insert(e)) list.append(*model, e);
+}
+
+void ActiveRegion::LooseSprings::erase(Index e) {
+    if (!set.contains(e)) return;
+    list.moveLastTo(set.slotOf(e));  // as the set's swap-remove moves its last member
+    set.erase(e);
+}
+
+template <class Loose>
+void ActiveRegion::VectorGroups<Loose>::reset(std::size_t groups, std::uint8_t minimumMembers) {
     minimum = minimumMembers;
     count.assign(groups, 0);
     vector.reset(groups);
-    loose.reset(members);
 }
 
+template <class Loose>
 template <class MemberOf>
-void ActiveRegion::VectorGroups::join(Index member, Index group, MemberOf memberOf) {
+void ActiveRegion::VectorGroups<Loose>::join(Index member, Index group, MemberOf memberOf) {
     if (group == kNoGroup || ++count[group] < minimum) {
         loose.insert(member);
         return;
@@ -24,8 +41,9 @@ void ActiveRegion::VectorGroups::join(Index member, Index group, MemberOf member
         if (const Index m = memberOf(group, i); m != kNoGroup) loose.erase(m);
 }
 
+template <class Loose>
 template <class MemberOf, class InRegion>
-void ActiveRegion::VectorGroups::leave(Index member, Index group, MemberOf memberOf, InRegion inRegion) {
+void ActiveRegion::VectorGroups<Loose>::leave(Index member, Index group, MemberOf memberOf, InRegion inRegion) {
     if (group == kNoGroup || count[group]-- < minimum) {
         loose.erase(member);
         return;
@@ -46,10 +64,11 @@ ActiveRegion::ActiveRegion(const PartModel& model)
       movingEnds_(model.springCount(), 0),
       masses_(model.massCount()),
       springs_(model.springCount()) {
-    octets_.reset(model.massCount() / 8, model.massCount(), kMinimumOctetMasses);
-    if (!model.hasSpringBlocks()) return;
-    blocks_ = model.springBlocks.get();
-    blockGroups_.reset(blocks_->blockCount(), model.springCount(), kMinimumBlockSprings);
+    octets_.reset(model.massCount() / 8, kMinimumOctetMasses);
+    octets_.loose.reset(model.massCount());
+    if (model.hasSpringBlocks()) blocks_ = model.springBlocks.get();
+    blockGroups_.reset(blocks_ != nullptr ? blocks_->blockCount() : 0, kMinimumBlockSprings);
+    blockGroups_.loose.reset(model);
 }
 
 bool ActiveRegion::cover(Index mass) {
@@ -71,20 +90,20 @@ bool ActiveRegion::uncover(Index mass) {
 }
 
 Index ActiveRegion::blockOf(Index spring) const {
+    if (blocks_ == nullptr) return kNoGroup;
     const Index lane = blocks_->laneOfSpring[spring];
     return lane == SpringBlocks::kNoLane ? kNoGroup : lane / SpringBlocks::kWidth;
 }
 
 void ActiveRegion::springJoins(Index e) {
     springs_.insert(e);
-    if (blocks_ != nullptr) blockGroups_.join(e, blockOf(e), [this](Index q, Index i) { return springOfBlock(q, i); });
+    blockGroups_.join(e, blockOf(e), [this](Index q, Index i) { return springOfBlock(q, i); });
 }
 
 void ActiveRegion::springLeaves(Index e) {
     springs_.erase(e);
-    if (blocks_ != nullptr)
-        blockGroups_.leave(e, blockOf(e), [this](Index q, Index i) { return springOfBlock(q, i); },
-                           [this](Index spring) { return movingEnds_[spring] != 0; });
+    blockGroups_.leave(e, blockOf(e), [this](Index q, Index i) { return springOfBlock(q, i); },
+                       [this](Index spring) { return movingEnds_[spring] != 0; });
 }
 
 Index ActiveRegion::springOfBlock(Index block, Index i) const {

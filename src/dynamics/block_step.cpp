@@ -128,18 +128,17 @@ void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> vector
     }
 }
 
-void listedSpringForces(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
-                        const double* x, const double* v, double* f, BlockKernel kernel) {
-    std::size_t done = 0;
+void listedSpringForces(const SpringList& springs, const std::uint16_t* cover, const double* x, const double* v,
+                        double* f, BlockKernel kernel) {
 #if defined(FLEXFIT_X86_KERNELS)
-    if (kernel == BlockKernel::Avx512) done = listedSpringForcesAvx512(model, springs, cover, x, v, f);
-    if (kernel == BlockKernel::Avx2) done = listedSpringForcesAvx2(model, springs, cover, x, v, f);
+    if (kernel == BlockKernel::Avx512) return listedSpringForcesAvx512(springs, cover, x, v, f);
+    if (kernel == BlockKernel::Avx2) return listedSpringForcesAvx2(springs, cover, x, v, f);
 #endif
     (void)kernel;
-    for (const Index e : springs.subspan(done)) {
-        const std::size_t a = model.springA[e], b = model.springB[e];
+    for (std::size_t i = 0; i < springs.size(); ++i) {
+        const std::size_t a = springs.springA[i], b = springs.springB[i];
         double g[3];
-        springForce(model.stiffness[e], model.damping[e], model.restLength[e], x + 3 * a, x + 3 * b, v + 3 * a,
+        springForce(springs.stiffness[i], springs.damping[i], springs.restLength[i], x + 3 * a, x + 3 * b, v + 3 * a,
                     v + 3 * b, g);
         if (cover == nullptr || cover[a] != 0)
             for (std::size_t c = 0; c < 3; ++c) f[3 * a + c] += g[c];
@@ -168,6 +167,18 @@ void integrateOctets(const PartModel& model, const MassUpdate& update, std::span
         }
 }
 
+void integrateListed(const PartModel& model, const MassUpdate& update, std::span<const Index> masses, PartState& state,
+                     BlockKernel kernel, PositionCheck* check) {
+#if defined(FLEXFIT_X86_KERNELS)
+    if (kernel == BlockKernel::Avx512) return integrateListedAvx512(model, update, masses, state, check);
+#endif
+    (void)kernel;
+    for (const Index i : masses) {
+        integrateMass(model, update, state, i);
+        if (check != nullptr) check->add(state, i);
+    }
+}
+
 void holdAtRest(const PartModel& model, std::span<const std::uint16_t> cover, PartState& state, BlockKernel kernel) {
     std::size_t done = 0;
 #if defined(FLEXFIT_X86_KERNELS)
@@ -183,7 +194,7 @@ void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartStat
     const double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
     blockForces(*model.springBlocks, x, v, f, kernel);
-    listedSpringForces(model, model.springBlocks->remainder, nullptr, x, v, f, kernel);
+    listedSpringForces(model.springBlocks->remainderSprings, nullptr, x, v, f, kernel);
     std::size_t integrated = 0, heldDone = 0;  // what the vector kernels did; the scalar passes finish
 #if defined(FLEXFIT_X86_KERNELS)
     if (kernel == BlockKernel::Avx512) heldDone = integrated = integrateAvx512(model, update, state, held, check);

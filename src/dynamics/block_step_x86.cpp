@@ -343,6 +343,10 @@ FLEXFIT_AVX2 inline __m256d loadMass(const double* p) {
     return _mm256_maskload_pd(p, _mm256_setr_epi64x(-1, -1, -1, 0));
 }
 
+// A spring's first end's x y z as one vector, lane 3 the next mass's x (which the transposes
+// drop): unmasked, as a first end always has a mass after it (springA < springB).
+FLEXFIT_AVX2 inline __m256d loadFirstEnd(const double* p) { return _mm256_loadu_pd(p); }
+
 // Listed springs 8 at a time (the AVX2 kernel's method, below, in 8 lanes): the 8 springs'
 // (x y z _) rows paired into 4 vectors as (0 2) (1 3) (4 6) (5 7), whose in-lane unpacks and
 // 128-bit shuffles give x, y, z in lane order 0..7. On this machine 8 % faster than 4 lanes.
@@ -359,35 +363,106 @@ FLEXFIT_AVX512 inline void transposeRows8(const __m256d r[8], __m512d& x, __m512
     z = _mm512_shuffle_f64x2(xz0123, xz4567, 0xDD);
 }
 
-FLEXFIT_AVX512 inline __m512d lanesOf8(const std::vector<double>& values, const Index* e, bool consecutive) {
-    return consecutive ? _mm512_loadu_pd(values.data() + e[0])
-                       : _mm512_setr_pd(values[e[0]], values[e[1]], values[e[2]], values[e[3]], values[e[4]],
-                                        values[e[5]], values[e[6]], values[e[7]]);
+// values[i .. i + count), the lanes from `count` on repeating values[i + count - 1].
+FLEXFIT_AVX512 inline __m512d lanesAt8(const std::vector<double>& values, std::size_t i, std::size_t count) {
+    if (count == 8) return _mm512_loadu_pd(values.data() + i);
+    return _mm512_mask_loadu_pd(_mm512_set1_pd(values[i + count - 1]), __mmask8((1u << count) - 1), values.data() + i);
 }
 
-FLEXFIT_AVX512 void listedForces512(const PartModel& model, const Index* springs, std::size_t n, const double* x,
+// Forces on the first ends of springs [first, first + n) of the list into gx, gy, gz (from 0),
+// in groups of 8; a last group of fewer repeats its last spring in the lanes past the list.
+FLEXFIT_AVX512 void listedForces512(const SpringList& springs, std::size_t first, std::size_t n, const double* x,
                                     const double* v, double* gx, double* gy, double* gz) {
-    for (std::size_t i = 0; i < n; i += 8) {
-        const Index* e = springs + i;
+    for (std::size_t k = 0; k < n; k += 8) {
+        const std::size_t i = first + k, count = std::min<std::size_t>(8, n - k);
         __m256d d[8], w[8];
         for (std::size_t l = 0; l < 8; ++l) {
-            const std::size_t a = 3 * std::size_t(model.springA[e[l]]), b = 3 * std::size_t(model.springB[e[l]]);
-            d[l] = _mm256_sub_pd(loadMass(x + a), loadMass(x + b));
-            w[l] = _mm256_sub_pd(loadMass(v + a), loadMass(v + b));
+            const std::size_t e = i + std::min(l, count - 1);
+            const std::size_t a = 3 * std::size_t(springs.springA[e]), b = 3 * std::size_t(springs.springB[e]);
+            d[l] = _mm256_sub_pd(loadFirstEnd(x + a), loadMass(x + b));
+            w[l] = _mm256_sub_pd(loadFirstEnd(v + a), loadMass(v + b));
         }
         __m512d dx, dy, dz, wx, wy, wz;
         transposeRows8(d, dx, dy, dz);
         transposeRows8(w, wx, wy, wz);
-        bool consecutive = true;
-        for (std::size_t l = 1; l < 8; ++l) consecutive = consecutive && e[l] == e[0] + l;
         const __m512d r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)), _mm512_mul_pd(dz, dz));
         const __m512d dot = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(wx, dx), _mm512_mul_pd(wy, dy)), _mm512_mul_pd(wz, dz));
-        const __m512d s = springScale8(r2, dot, lanesOf8(model.stiffness, e, consecutive),
-                                       lanesOf8(model.damping, e, consecutive), lanesOf8(model.restLength, e, consecutive));
-        _mm512_storeu_pd(gx + i, _mm512_mul_pd(s, dx));
-        _mm512_storeu_pd(gy + i, _mm512_mul_pd(s, dy));
-        _mm512_storeu_pd(gz + i, _mm512_mul_pd(s, dz));
+        const __m512d s = springScale8(r2, dot, lanesAt8(springs.stiffness, i, count), lanesAt8(springs.damping, i, count),
+                                       lanesAt8(springs.restLength, i, count));
+        _mm512_storeu_pd(gx + k, _mm512_mul_pd(s, dx));
+        _mm512_storeu_pd(gy + k, _mm512_mul_pd(s, dy));
+        _mm512_storeu_pd(gz + k, _mm512_mul_pd(s, dz));
     }
+}
+
+// Listed masses 8 at a time (the region's loose masses): each mass's x y z rows turned to lanes
+// (transposeRows8), integrated coordinate by coordinate as integrate512 integrates each double,
+// and written back mass by mass; a last group of fewer repeats its last mass (the same values
+// written twice). The same bits as integrateMass. With `check` (its origin fixed), the new
+// positions' beyond-bits or-ed into it.
+FLEXFIT_AVX512 void integrateListed512(const PartModel& model, const MassUpdate& p, std::span<const Index> masses,
+                                        PartState& state, PositionCheck* check) {
+    double* x = state.positions.data()->data();
+    double* v = state.velocities.data()->data();
+    double* f = state.forces.data()->data();
+    const double* rest = model.restPositions.data()->data();
+    const __m512d h = _mm512_set1_pd(p.h), invH = _mm512_set1_pd(p.invH), drag = _mm512_set1_pd(p.drag);
+    const __m512d anchor = _mm512_set1_pd(p.anchorStiffness), constraint = _mm512_set1_pd(p.constraint);
+    const bool anchored = p.anchorStiffness != 0.0, readsRest = p.readsRest();
+    const __m512i carry = _mm512_set1_epi64(check != nullptr ? std::int64_t(check->carry) : 0);
+    __m512i beyond = _mm512_setzero_si512();
+    for (std::size_t k = 0; k < masses.size(); k += 8) {
+        const std::size_t count = std::min<std::size_t>(8, masses.size() - k);
+        std::size_t at[8];
+        __m256d xr[8], vr[8], fr[8], rr[8];
+        alignas(64) double massLanes[8], inverseLanes[8];
+        for (std::size_t l = 0; l < 8; ++l) {
+            const std::size_t m = masses[k + std::min(l, count - 1)];
+            at[l] = 3 * m;
+            xr[l] = loadMass(x + at[l]);
+            vr[l] = loadMass(v + at[l]);
+            fr[l] = loadMass(f + at[l]);
+            rr[l] = readsRest ? loadMass(rest + at[l]) : _mm256_setzero_pd();
+            massLanes[l] = model.mass[m];
+            inverseLanes[l] = model.inverseMass[m];
+        }
+        __m512d xo[3], vo[3], fo[3], r[3];
+        transposeRows8(xr, xo[0], xo[1], xo[2]);
+        transposeRows8(vr, vo[0], vo[1], vo[2]);
+        transposeRows8(fr, fo[0], fo[1], fo[2]);
+        transposeRows8(rr, r[0], r[1], r[2]);
+        const __m512d mass = _mm512_load_pd(massLanes), hm = _mm512_mul_pd(h, _mm512_load_pd(inverseLanes));
+        alignas(64) double xn[3][8], vn[3][8];
+        for (int j = 0; j < 3; ++j) {
+            // total = f + ((m g - drag v) - k_a (x - rest)), as MassUpdate::bodyForce
+            __m512d body = _mm512_sub_pd(_mm512_mul_pd(mass, _mm512_set1_pd(p.gravity[j])), _mm512_mul_pd(drag, vo[j]));
+            if (anchored) body = _mm512_sub_pd(body, _mm512_mul_pd(anchor, _mm512_sub_pd(xo[j], r[j])));
+            const __m512d total = _mm512_add_pd(fo[j], body);
+            __m512d xj, vj;
+            if (p.semiImplicit) {
+                vj = _mm512_add_pd(vo[j], _mm512_mul_pd(hm, total));
+                xj = _mm512_add_pd(xo[j], _mm512_mul_pd(h, vj));
+            } else {
+                xj = _mm512_add_pd(xo[j], _mm512_mul_pd(h, vo[j]));
+                vj = _mm512_add_pd(vo[j], _mm512_mul_pd(hm, total));
+            }
+            if (p.constraint > 0.0) {
+                const __m512d correction = _mm512_mul_pd(constraint, _mm512_sub_pd(r[j], xj));
+                xj = _mm512_add_pd(xj, correction);
+                vj = _mm512_add_pd(vj, _mm512_mul_pd(invH, correction));
+            }
+            if (check != nullptr) beyond = orBeyondBits8(beyond, xj, _mm512_set1_pd(check->origin[j]), carry);
+            _mm512_store_pd(xn[j], xj);
+            _mm512_store_pd(vn[j], vj);
+        }
+        for (std::size_t l = 0; l < count; ++l) {
+            double* xm = x + at[l];
+            double* vm = v + at[l];
+            double* fm = f + at[l];
+            for (int j = 0; j < 3; ++j) xm[j] = xn[j][l], vm[j] = vn[j][l], fm[j] = 0.0;
+        }
+    }
+    if (check != nullptr) check->bits |= std::uint64_t(_mm512_reduce_or_epi64(beyond));
 }
 
 // ---------------------------------------------------------------- AVX2: a block as two halves
@@ -584,90 +659,93 @@ FLEXFIT_AVX2 inline Lanes4 transposeRows4(const __m256d r[4]) {
             _mm256_permute2f128_pd(xz01, xz23, 0x31)};
 }
 
-// values[e[0..3]]: one load when the springs are consecutive (all of them in a model without
-// blocks), else built in registers (4 scalar stores read back as one vector would stall).
-FLEXFIT_AVX2 inline __m256d lanesOf(const std::vector<double>& values, const Index* e, bool consecutive) {
-    return consecutive ? _mm256_loadu_pd(values.data() + e[0])
-                       : _mm256_setr_pd(values[e[0]], values[e[1]], values[e[2]], values[e[3]]);
+// values[i .. i + count), the lanes from `count` on repeating values[i + count - 1].
+FLEXFIT_AVX2 inline __m256d lanesAt4(const std::vector<double>& values, std::size_t i, std::size_t count) {
+    if (count == 4) return _mm256_loadu_pd(values.data() + i);
+    const double* p = values.data() + i;
+    return _mm256_setr_pd(p[0], p[std::min<std::size_t>(1, count - 1)], p[std::min<std::size_t>(2, count - 1)], p[count - 1]);
 }
 
-// Forces on the first ends of springs[0..n), n a multiple of 4, into gx, gy, gz.
-FLEXFIT_AVX2 void listedForces256(const PartModel& model, const Index* springs, std::size_t n, const double* x,
+// Forces on the first ends of springs [first, first + n) into gx, gy, gz (from 0), 4 at a time;
+// a last group of fewer repeats its last spring in the lanes past the list.
+FLEXFIT_AVX2 void listedForces256(const SpringList& springs, std::size_t first, std::size_t n, const double* x,
                                   const double* v, double* gx, double* gy, double* gz) {
-    for (std::size_t i = 0; i < n; i += 4) {
+    for (std::size_t k = 0; k < n; k += 4) {
+        const std::size_t i = first + k, count = std::min<std::size_t>(4, n - k);
         __m256d d[4], w[4];
-        const Index* e = springs + i;
         for (std::size_t l = 0; l < 4; ++l) {
-            const std::size_t a = 3 * std::size_t(model.springA[e[l]]), b = 3 * std::size_t(model.springB[e[l]]);
-            d[l] = _mm256_sub_pd(loadMass(x + a), loadMass(x + b));
-            w[l] = _mm256_sub_pd(loadMass(v + a), loadMass(v + b));
+            const std::size_t e = i + std::min(l, count - 1);
+            const std::size_t a = 3 * std::size_t(springs.springA[e]), b = 3 * std::size_t(springs.springB[e]);
+            d[l] = _mm256_sub_pd(loadFirstEnd(x + a), loadMass(x + b));
+            w[l] = _mm256_sub_pd(loadFirstEnd(v + a), loadMass(v + b));
         }
-        const bool consecutive = e[1] == e[0] + 1 && e[2] == e[0] + 2 && e[3] == e[0] + 3;
-        const Lanes4 g = springForces4(transposeRows4(d), transposeRows4(w), lanesOf(model.stiffness, e, consecutive),
-                                       lanesOf(model.damping, e, consecutive), lanesOf(model.restLength, e, consecutive));
-        _mm256_storeu_pd(gx + i, g.x);
-        _mm256_storeu_pd(gy + i, g.y);
-        _mm256_storeu_pd(gz + i, g.z);
+        const Lanes4 g = springForces4(transposeRows4(d), transposeRows4(w), lanesAt4(springs.stiffness, i, count),
+                                       lanesAt4(springs.damping, i, count), lanesAt4(springs.restLength, i, count));
+        _mm256_storeu_pd(gx + k, g.x);
+        _mm256_storeu_pd(gy + k, g.y);
+        _mm256_storeu_pd(gz + k, g.z);
     }
 }
 
-// g_i on the first end, -g_i on the second of each listed spring i, in list order. The first
-// end's force stays in registers while consecutive springs share it (the remainder is sorted by
-// first end): the same additions in the same order, without a store and reload between them.
-// Safe because a spring's second end is never its first.
-inline void addListedForces(const PartModel& model, std::span<const Index> springs, const double* gx, const double* gy,
-                            const double* gz, double* f) {
-    const Index* springA = model.springA.data();
-    const Index* springB = model.springB.data();
+// g_i on the first end, -g_i on the second of listed springs [first, first + n), in list
+// order. The first end's force stays in registers while consecutive springs share it (the
+// remainder is sorted by first end): the same additions in the same order, without a store and
+// reload between them. Safe because a spring's second end is never its first.
+inline void addListedForces(const SpringList& springs, std::size_t first, std::size_t n, const double* gx,
+                            const double* gy, const double* gz, double* f) {
+    const Index* springA = springs.springA.data() + first;
+    const Index* springB = springs.springB.data() + first;
     std::size_t i = 0;
-    while (i < springs.size()) {
+    while (i < n) {
         // The run of listed springs that share the first end a, as a loop of known length.
-        const Index a = springA[springs[i]];
+        const Index a = springA[i];
         std::size_t end = i + 1;
-        while (end < springs.size() && springA[springs[end]] == a) ++end;
+        while (end < n && springA[end] == a) ++end;
         double* fa = f + 3 * std::size_t(a);
         double hx = fa[0], hy = fa[1], hz = fa[2];
         for (; i < end; ++i) {
             hx += gx[i], hy += gy[i], hz += gz[i];
-            double* fb = f + 3 * std::size_t(springB[springs[i]]);
+            double* fb = f + 3 * std::size_t(springB[i]);
             fb[0] -= gx[i], fb[1] -= gy[i], fb[2] -= gz[i];
         }
         fa[0] = hx, fa[1] = hy, fa[2] = hz;
     }
 }
 
-// Forces of springs[0..n) into gx, gy, gz; n a multiple of the kernel's width.
-using ListedForces = void (*)(const PartModel& model, const Index* springs, std::size_t n, const double* x,
-                              const double* v, double* gx, double* gy, double* gz);
-
-// The listed springs' forces added in list order: to both ends, or with a cover only to the
-// ends whose count is non-zero. Does the largest multiple of `width` springs; returns it.
-std::size_t listedSpringForcesBy(ListedForces forces, std::size_t width, const PartModel& model,
-                                 std::span<const Index> springs, const std::uint16_t* cover, const double* x,
-                                 const double* v, double* f) {
-    const std::size_t n = springs.size() / width * width;
-    alignas(64) double gx[kListChunk], gy[kListChunk], gz[kListChunk];
-    for (std::size_t start = 0; start < n; start += kListChunk) {
-        const std::size_t count = std::min(kListChunk, n - start);
-        forces(model, springs.data() + start, count, x, v, gx, gy, gz);
-        if (cover == nullptr) {
-            addListedForces(model, springs.subspan(start, count), gx, gy, gz, f);
-            continue;
+// The same with a cover: only to the ends whose count is non-zero. (Selecting a scratch row
+// for an end that does not move, instead of branching, measured no faster.)
+inline void addCoveredListedForces(const SpringList& springs, std::size_t first, std::size_t n, const std::uint16_t* cover,
+                                   const double* gx, const double* gy, const double* gz, double* f) {
+    const Index* springA = springs.springA.data() + first;
+    const Index* springB = springs.springB.data() + first;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Index a = springA[i], b = springB[i];
+        if (cover[a] != 0) {
+            double* fa = f + 3 * std::size_t(a);
+            fa[0] += gx[i], fa[1] += gy[i], fa[2] += gz[i];
         }
-        for (std::size_t i = 0; i < count; ++i) {
-            const Index e = springs[start + i];
-            const Index a = model.springA[e], b = model.springB[e];
-            if (cover[a] != 0) {
-                double* fa = f + 3 * std::size_t(a);
-                fa[0] += gx[i], fa[1] += gy[i], fa[2] += gz[i];
-            }
-            if (cover[b] != 0) {
-                double* fb = f + 3 * std::size_t(b);
-                fb[0] -= gx[i], fb[1] -= gy[i], fb[2] -= gz[i];
-            }
+        if (cover[b] != 0) {
+            double* fb = f + 3 * std::size_t(b);
+            fb[0] -= gx[i], fb[1] -= gy[i], fb[2] -= gz[i];
         }
     }
-    return n;
+}
+
+// Forces of springs [first, first + n) into gx, gy, gz (n up to kListChunk).
+using ListedForces = void (*)(const SpringList& springs, std::size_t first, std::size_t n, const double* x,
+                              const double* v, double* gx, double* gy, double* gz);
+
+// The listed springs' forces added in list order, in chunks: to both ends, or with a cover only
+// to the ends whose count is non-zero.
+void listedSpringForcesBy(ListedForces forces, const SpringList& springs, const std::uint16_t* cover, const double* x,
+                          const double* v, double* f) {
+    alignas(64) double gx[kListChunk], gy[kListChunk], gz[kListChunk];
+    for (std::size_t start = 0; start < springs.size(); start += kListChunk) {
+        const std::size_t count = std::min(kListChunk, springs.size() - start);
+        forces(springs, start, count, x, v, gx, gy, gz);
+        if (cover == nullptr) addListedForces(springs, start, count, gx, gy, gz, f);
+        else addCoveredListedForces(springs, start, count, cover, gx, gy, gz, f);
+    }
 }
 
 FLEXFIT_AVX2 inline __m256d spread4(__m256d values, int j) {
@@ -757,13 +835,13 @@ void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* 
 void blockForcesAvx512(const SpringBlocks& blocks, const double* x, const double* v, double* f) {
     blockForces512(blocks, x, v, f);
 }
-std::size_t listedSpringForcesAvx2(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
-                                   const double* x, const double* v, double* f) {
-    return listedSpringForcesBy(listedForces256, 4, model, springs, cover, x, v, f);
+void listedSpringForcesAvx2(const SpringList& springs, const std::uint16_t* cover, const double* x, const double* v,
+                            double* f) {
+    listedSpringForcesBy(listedForces256, springs, cover, x, v, f);
 }
-std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
-                                     const double* x, const double* v, double* f) {
-    return listedSpringForcesBy(listedForces512, 8, model, springs, cover, x, v, f);
+void listedSpringForcesAvx512(const SpringList& springs, const std::uint16_t* cover, const double* x, const double* v,
+                              double* f) {
+    listedSpringForcesBy(listedForces512, springs, cover, x, v, f);
 }
 std::size_t integrateAvx2(const PartModel& model, const MassUpdate& update, PartState& state, const std::uint16_t* held,
                           PositionCheck* check) {
@@ -776,6 +854,10 @@ std::size_t integrateAvx512(const PartModel& model, const MassUpdate& update, Pa
     return checkedWholePass(8, model.massCount() / 8, state, check, [&](std::size_t first, std::size_t groups, PositionCheck* c) {
         integrate512(model, update, state, nullptr, first, groups, held, c);
     });
+}
+void integrateListedAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> masses,
+                           PartState& state, PositionCheck* check) {
+    integrateListed512(model, update, masses, state, check);
 }
 void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,
                          const std::uint16_t* held, PartState& state, PositionCheck* check) {

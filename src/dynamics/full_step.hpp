@@ -93,9 +93,10 @@ void regionBlockForces(const SpringBlocks& blocks, std::span<const Index> vector
 
 // Listed springs in list order: g on the first end, -g on the second (f[a] += g, f[b] -= g), or
 // with a cover only on the ends whose cover count is non-zero. The vector kernels compute the
-// forces 4 at a time and add them in the same order: the same bits in every kernel.
-void listedSpringForces(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
-                        const double* x, const double* v, double* f, BlockKernel kernel);
+// forces 8 (AVX-512) or 4 (AVX2) at a time, the last group's lanes past the list repeating its
+// last spring, and add them in the same order: the same bits in every kernel.
+void listedSpringForces(const SpringList& springs, const std::uint16_t* cover, const double* x, const double* v,
+                        double* f, BlockKernel kernel);
 // The vector kernels keep the forces of this many listed springs on the stack between passes.
 inline constexpr std::size_t kListChunk = 256;
 
@@ -107,15 +108,19 @@ inline constexpr std::size_t kListChunk = 256;
 void integrateOctets(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,
                      const std::uint16_t* held, PartState& state, BlockKernel kernel, PositionCheck* check = nullptr);
 
+// Integrates the listed masses (each once) as integrateMass would, mass by mass: the same bits
+// in every kernel (the AVX-512 kernel 8 masses in lanes, the others one at a time). With
+// `check` (its origin fixed), every kernel ors the new positions' beyond-bits into it.
+void integrateListed(const PartModel& model, const MassUpdate& update, std::span<const Index> masses, PartState& state,
+                     BlockKernel kernel, PositionCheck* check = nullptr);
+
 // The vector kernels (block_step_x86.cpp). Forces of all blocks into f (3 doubles per mass).
 void blockForcesAvx2(const SpringBlocks& blocks, const double* x, const double* v, double* f);
 void blockForcesAvx512(const SpringBlocks& blocks, const double* x, const double* v, double* f);
-// listedSpringForces for springs [0, n), n the largest multiple of 4; returns n.
-std::size_t listedSpringForcesAvx2(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
-                                   const double* x, const double* v, double* f);
-// The same with n a multiple of 8.
-std::size_t listedSpringForcesAvx512(const PartModel& model, std::span<const Index> springs, const std::uint16_t* cover,
-                                     const double* x, const double* v, double* f);
+void listedSpringForcesAvx2(const SpringList& springs, const std::uint16_t* cover, const double* x, const double* v,
+                            double* f);
+void listedSpringForcesAvx512(const SpringList& springs, const std::uint16_t* cover, const double* x, const double* v,
+                              double* f);
 // Integrates masses [0, n) for the largest n that is a multiple of the width (4, 8); returns n.
 // The masses whose `held` count is 0 (when given) end at rest, as holdAtRest leaves them. With
 // `check`, the first group goes first, fixes the origin, and every position is checked.
@@ -127,6 +132,8 @@ void regionBlockForcesAvx2(const SpringBlocks& blocks, std::span<const Index> ve
                            const double* x, const double* v, double* f);
 void regionBlockForcesAvx512(const SpringBlocks& blocks, std::span<const Index> vectorBlocks, const std::uint16_t* cover,
                              const double* x, const double* v, double* f);
+void integrateListedAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> masses,
+                           PartState& state, PositionCheck* check = nullptr);
 void integrateOctetsAvx2(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,
                          const std::uint16_t* held, PartState& state, PositionCheck* check = nullptr);
 void integrateOctetsAvx512(const PartModel& model, const MassUpdate& update, std::span<const Index> octets,

@@ -15,7 +15,7 @@ namespace {
 
 // The moving masses: body forces, integration, restoration; pending forces consumed. The
 // region's vector octets by the vector kernel (their masses that do not move put back where they
-// are, at rest), then the others one at a time (each mass alone: same bits). With
+// are, at rest), then the others as a list (each mass alone: same bits). With
 // `check`, mass 0 first when it moves (its octet, or itself), which fixes the origin; then every
 // other mass checked as it is written. Masses are independent here: the order changes no bit.
 void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const ActiveRegion& region, PartState& state,
@@ -23,9 +23,10 @@ void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const 
     const detail::BlockKernel kernel = detail::fullStepKernel();
     std::span<const Index> octets = region.vectorOctets().members(), octetsAfter;
     const std::uint16_t* held = region.coverCounts().data();
+    std::span<const Index> loose = region.looseMasses().members(), looseAfter;
     if (check == nullptr || kernel == detail::BlockKernel::Scalar) {
         detail::integrateOctets(model, p, octets, held, state, kernel);
-        for (Index i : region.looseMasses()) detail::integrateMass(model, p, state, i);
+        detail::integrateListed(model, p, loose, state, kernel);
         return;
     }
     const bool massZeroFirst = check->fromMassZero() && region.moves(0);
@@ -35,19 +36,19 @@ void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const 
         detail::integrateOctets(model, p, octets.subspan(slot, 1), held, state, kernel);
         octetsAfter = octets.subspan(slot + 1);
         octets = octets.first(slot);
-    } else if (massZeroFirst) {
+    } else if (massZeroFirst) {  // mass 0 alone, then the loose masses before and after it
+        const std::size_t slot = region.looseMasses().slotOf(0);
         detail::integrateMass(model, p, state, 0);
+        looseAfter = loose.subspan(slot + 1);
+        loose = loose.first(slot);
     }
     check->fixOrigin(state);
     if (octetZero) check->add(state, 0, 8);
     else if (massZeroFirst) check->add(state, 0);
     detail::integrateOctets(model, p, octets, held, state, kernel, check);
     detail::integrateOctets(model, p, octetsAfter, held, state, kernel, check);
-    for (Index i : region.looseMasses()) {
-        if (i == 0 && massZeroFirst) continue;
-        detail::integrateMass(model, p, state, i);
-        check->add(state, i);
-    }
+    detail::integrateListed(model, p, loose, state, kernel, check);
+    detail::integrateListed(model, p, looseAfter, state, kernel, check);
     check->covered = true;
 }
 
@@ -74,7 +75,7 @@ void detail::stepRegion(const PartModel& model, const SimulationSettings& settin
     if (!region.vectorBlocks().empty())
         detail::regionBlockForces(*model.springBlocks, region.vectorBlocks().members(), mask, x, v, f,
                                   detail::fullStepKernel());
-    detail::listedSpringForces(model, region.looseSprings().members(), mask, x, v, f, detail::fullStepKernel());
+    detail::listedSpringForces(region.looseSpringList(), mask, x, v, f, detail::fullStepKernel());
     integrateRegion(model, p, region, state, settings.integrator == Integrator::SemiImplicitEuler ? check : nullptr);
     state.time += settings.timeStep;
     ++state.stepCount;

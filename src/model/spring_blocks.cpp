@@ -51,7 +51,10 @@ SpringBlocks buildSpringBlocks(std::span<const Index> springA, std::span<const I
         start = end;
     }
     for (std::size_t e = 0; e < springs; ++e)
-        if (blocks.laneOfSpring[e] == SpringBlocks::kNoLane) blocks.remainder.push_back(Index(e));
+        if (blocks.laneOfSpring[e] == SpringBlocks::kNoLane) {
+            blocks.remainder.push_back(Index(e));
+            blocks.remainderSprings.append(springA[e], springB[e], restLength[e], stiffness[e], damping[e]);
+        }
     return blocks;
 }
 

@@ -35,6 +35,7 @@
 #pragma once
 
 #include "flexfit/core.hpp"
+#include "flexfit/spring_list.hpp"
 
 #include <span>
 #include <vector>
@@ -50,6 +51,7 @@ struct SpringBlocks {
     // (8B) constants of lane i of block q at 8q + i.
     DoubleArray restLength, stiffness, damping;  // read 8 lanes at a time
     std::vector<Index> remainder;  // springs in no block, ascending
+    SpringList remainderSprings;   // the same springs' ends and constants, in that order
     // Lane 8q + i of block q is spring laneSpring[8q + i], or kNoLane when empty; laneOfSpring[e]
     // is spring e's lane, or kNoLane for a remainder spring (the active region tracks its blocks
     // with them).

@@ -92,6 +92,21 @@ void coverRun(ActiveRegion& region, std::vector<int>& covers, std::mt19937& rng,
     }
 }
 
+// The loose springs' list (what the region step reads) holds, slot for slot, the ends and
+// constants of the springs looseSprings() lists, read from the model.
+void expectListedSlotForSlot(const PartModel& model, const ActiveRegion& region) {
+    const SpringList& list = region.looseSpringList();
+    ASSERT_EQ(list.size(), region.looseSprings().size());
+    for (std::size_t s = 0; s < list.size(); ++s) {
+        const Index e = region.looseSprings()[s];
+        ASSERT_EQ(list.springA[s], model.springA[e]) << "slot " << s;
+        ASSERT_EQ(list.springB[s], model.springB[e]) << "slot " << s;
+        ASSERT_EQ(list.restLength[s], model.restLength[e]) << "slot " << s;
+        ASSERT_EQ(list.stiffness[s], model.stiffness[e]) << "slot " << s;
+        ASSERT_EQ(list.damping[s], model.damping[e]) << "slot " << s;
+    }
+}
+
 }  // namespace
 
 // The region step's layout on a model with spring blocks, against brute force over the blocks'
@@ -124,6 +139,7 @@ TEST(ActiveRegion, VectorBlocksAndLooseSpringsPartitionTheComputedSprings) {
         EXPECT_EQ(vectorMembers.size(), vector.size());
         EXPECT_EQ(std::set<Index>(looseMembers.begin(), looseMembers.end()), loose) << "op " << op;
         EXPECT_EQ(looseMembers.size(), loose.size());
+        expectListedSlotForSlot(*model, region);
         largestVector = std::max(largestVector, vector.size());
     }
     EXPECT_GT(largestVector, 20u);  // the test saw vector blocks come and go
@@ -171,4 +187,9 @@ TEST(ActiveRegion, WithoutBlocksEveryComputedSpringIsLoose) {
     EXPECT_TRUE(region.vectorBlocks().empty());
     EXPECT_EQ(std::vector<Index>(region.looseSprings().members().begin(), region.looseSprings().members().end()),
               std::vector<Index>(region.springs().members().begin(), region.springs().members().end()));
+    expectListedSlotForSlot(*model, region);
+    for (Index m = 0; m < 30; m += 3) region.uncover(m);  // swap-removes
+    EXPECT_EQ(std::vector<Index>(region.looseSprings().members().begin(), region.looseSprings().members().end()),
+              std::vector<Index>(region.springs().members().begin(), region.springs().members().end()));
+    expectListedSlotForSlot(*model, region);
 }

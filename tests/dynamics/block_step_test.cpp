@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <iostream>
+#include <numeric>
 #include <random>
 #include <utility>
 
@@ -196,6 +197,7 @@ TEST(BlockStep, AgreesWithTheSameSpringsInNoBlock) {
     SpringBlocks none;
     none.laneOfSpring.assign(model->springCount(), SpringBlocks::kNoLane);
     for (std::size_t e = 0; e < model->springCount(); ++e) none.remainder.push_back(Index(e));
+    none.remainderSprings = springListOf(*model, none.remainder);
     unblocked->springBlocks = std::make_shared<const SpringBlocks>(std::move(none));
     for (const auto kernel : flexfit::testing::availableBlockKernels())
         for (RestorationMethod method : {RestorationMethod::None, RestorationMethod::AnchorSprings, RestorationMethod::Constraint}) {
@@ -412,7 +414,7 @@ TEST(BlockStep, ListedSpringsFollowTheListInEveryKernel) {
         for (Index i : orders[r % 3]) list.push_back(runs[r] + i);
     for (std::size_t r = runs.size() / 3; r < runs.size() / 2; ++r) list.push_back(runs[r] + Index(rng() % 4));
     ASSERT_GT(list.size(), 2 * detail::kListChunk);  // several chunks
-    for (std::size_t tail = 0; tail < 4; ++tail) {
+    for (std::size_t tail = 0; tail < 8; ++tail) {  // every length of the last group of 8 (AVX-512) or 4
         const std::span<const Index> springs(list.data(), list.size() - tail);
         for (const bool covered : {false, true}) {
             PartState expected = moved;
@@ -427,7 +429,7 @@ TEST(BlockStep, ListedSpringsFollowTheListInEveryKernel) {
             for (BlockKernel kernel : kAllKernels) {
                 if (!detail::blockKernelAvailable(kernel)) continue;
                 PartState state = moved;
-                detail::listedSpringForces(*model, springs, covered ? cover.data() : nullptr,
+                detail::listedSpringForces(springListOf(*model, springs), covered ? cover.data() : nullptr,
                                            state.positions.data()->data(), state.velocities.data()->data(),
                                            state.forces.data()->data(), kernel);
                 EXPECT_TRUE(sameBits(state.forces, expected.forces))
@@ -435,6 +437,47 @@ TEST(BlockStep, ListedSpringsFollowTheListInEveryKernel) {
             }
         }
     }
+}
+
+// A list of masses integrated by each kernel against integrateMass mass by mass, with every
+// restoration and integrator, at every length of the last group of 8 (the AVX-512 kernel repeats
+// its last mass there), the last mass of the model included (its rows are read masked); and the
+// check's bits against beyondBits of each new position.
+TEST(BlockStep, ListedMassesIntegrateAsIntegrateMassInEveryKernel) {
+    const auto model = buildPartModel(flexfit::testing::shuffledVertices(makeTorus2(), 4));
+    const PartState moved = kickedState(*model, 5);
+    std::mt19937 rng(17);
+    std::vector<Index> all(model->massCount());
+    std::iota(all.begin(), all.end(), Index(0));
+    std::shuffle(all.begin(), all.end(), rng);
+    all.insert(all.begin() + 5, Index(model->massCount() - 1));
+    all.erase(std::find(all.begin() + 6, all.end(), Index(model->massCount() - 1)));
+    PartState spoiled = moved;  // the tenth listed mass beyond the bound: the check must see it
+    spoiled.positions[all[9]].y() += 3.0 * model->positionBound;
+    for (RestorationMethod method : {RestorationMethod::None, RestorationMethod::AnchorSprings, RestorationMethod::Constraint})
+        for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::ExplicitEuler}) {
+            const detail::MassUpdate update = detail::MassUpdate::from(settingsFor(method, integrator));
+            for (std::size_t n : {std::size_t(0), std::size_t(1), std::size_t(7), std::size_t(8), std::size_t(13), std::size_t(30)}) {
+                const std::span<const Index> masses(all.data(), n);
+                PartState expected = spoiled;
+                detail::PositionCheck reference(model->positionBound);
+                reference.origin = moved.positions[3];
+                for (const Index m : masses) {
+                    detail::integrateMass(*model, update, expected, m);
+                    reference.add(expected, m);
+                }
+                EXPECT_EQ(detail::noneBeyond(reference.bits), n < 10) << n;
+                for (BlockKernel kernel : kAllKernels) {
+                    if (!detail::blockKernelAvailable(kernel)) continue;
+                    PartState state = spoiled;
+                    detail::PositionCheck check(model->positionBound);
+                    check.origin = reference.origin;
+                    detail::integrateListed(*model, update, masses, state, kernel, &check);
+                    EXPECT_TRUE(sameBits(state, expected)) << detail::toString(kernel) << " " << n << " masses";
+                    EXPECT_EQ(check.bits, reference.bits) << detail::toString(kernel) << " " << n << " masses";
+                }
+            }
+        }
 }
 
 // The divergence check the vector integration makes as it writes the positions (PositionCheck)
