@@ -96,9 +96,12 @@ RegionWork RegionWork::of(const ActiveRegion& region) {
 
 bool fullStepCostsLess(const PartModel& model, const RegionWork& work) {
     // Costs in ns on the reference machine (simulation.hpp); only their ratios matter. A loose
-    // spring's ends and constants are gathered: it costs more once the part's state outgrows
-    // the nearest caches, fitted as a ramp over the mass count (576 to 7,349 masses measured).
-    const double regionSpring = 5.0 + 3.0 * std::min(1.0, double(model.massCount()) / 7000.0);
+    // spring's ends' state is gathered: it costs more once the part's state outgrows the
+    // nearest caches, fitted as a ramp over the mass count (576 to 7,349 masses measured). 5.0 +
+    // 3.0 before the region kept its loose springs' ends and constants in a list, scaled by what
+    // that list did to the regions of loose springs only (0.83-0.88x of their step,
+    // bench/results/listed_springs_zones_1207.csv).
+    const double regionSpring = 4.3 + 2.6 * std::min(1.0, double(model.massCount()) / 7000.0);
     constexpr double kRegionBlockLane = 2.7, kRegionMass = 2.0;
     constexpr double kBlockLane = 2.8, kListedSpring = 6.0, kPutBack = 0.3;
     // The region step only where it is estimated at most kRegionShare of the full step: the two
