@@ -175,11 +175,26 @@ private:
     std::vector<std::int32_t> stack_;    // broad-phase traversal
     IndexSet refitted_;                  // (nbody) refitted by the last query call
     QueryStats stats_;
+    // A face pair of two rigid parts (neither deforms: their shapes are the models') keeps its
+    // last answer with the poses it was found at; while both poses stay bit for bit the same,
+    // the answer is the query's (its contacts, in order) and no query runs. Bodies at rest
+    // meet each other at the same poses between a step's sub-step queries, the rigid motion's
+    // settling and the narrow phase: a resting stack's pairs are each queried once a step.
+    struct Answer {
+        bool kept = false;
+        Pose poseA, poseB;
+        std::vector<Contact> contacts;
+    };
     struct KeptCoherence {
         PairCoherence coherence;
         PointShellCoherence pointShell;
+        Answer answer;                 // coherent face queries of two rigid parts
         std::uint64_t lastUpdate = 0;  // the update() count when last used
     };
+    // Whether the pair's kept answer stands at the parts' current poses; keeps `found` (the
+    // contacts just appended) as its answer otherwise, when both parts are rigid.
+    bool answerStands(const Answer& answer, BodyId a, BodyId b) const;
+    void keepAnswer(Answer& answer, BodyId a, BodyId b, std::span<const Contact> found) const;
     std::map<std::uint64_t, KeptCoherence> coherence_;  // by (a << 32 | b), a presses b (ordered: no hash order in a step)
     std::uint64_t updates_ = 0;
     std::uint64_t faceQueries_ = 0, faceTraversals_ = 0;

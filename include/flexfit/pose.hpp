@@ -29,4 +29,10 @@ struct Pose {
     Pose then(const Pose& after) const;
 };
 
+// The same pose bit for bit (coefficient by coefficient; a NaN never is): what the rigid motion
+// and the collision world's kept answers test before reusing what was found at a pose.
+inline bool samePose(const Pose& a, const Pose& b) {
+    return a.translation == b.translation && a.rotation.coeffs() == b.rotation.coeffs();
+}
+
 }  // namespace flexfit

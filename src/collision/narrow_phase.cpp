@@ -72,18 +72,38 @@ void CollisionWorld::queryPair(BodyId a, BodyId b, std::vector<Contact>& out, Qu
     if (usesPointShell(a, b)) return queryPointShellPair(a, b, out, stats);
     refitChanged(a);
     refitChanged(b);
-    ++faceQueries_;
     if (!settings_.coherent) {
+        ++faceQueries_;
         ++faceTraversals_;
         return flexfit::queryPair(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, out, stats);
     }
     KeptCoherence& kept = coherence_[std::uint64_t(a) << 32 | b];
     kept.lastUpdate = updates_;
+    if (answerStands(kept.answer, a, b)) {  // not a face query: nothing is tested
+        out.insert(out.end(), kept.answer.contacts.begin(), kept.answer.contacts.end());
+        stats.contacts += kept.answer.contacts.size();
+        return;
+    }
+    ++faceQueries_;
     // Lists taken, and the whole traversals that answered instead of a list.
     const auto traversed = [&] { return kept.coherence.traversals + kept.coherence.plainTraversals; };
     const std::uint64_t before = traversed();
+    const std::size_t first = out.size();
     queryPairCoherent(a, *parts_[a], colliders_[a], b, *parts_[b], colliders_[b], settings_.exactTest, kept.coherence, out, stats);
     faceTraversals_ += traversed() - before;
+    keepAnswer(kept.answer, a, b, std::span<const Contact>(out).subspan(first));
+}
+
+bool CollisionWorld::answerStands(const Answer& answer, BodyId a, BodyId b) const {
+    return answer.kept && samePose(answer.poseA, parts_[a]->pose()) && samePose(answer.poseB, parts_[b]->pose());
+}
+
+void CollisionWorld::keepAnswer(Answer& answer, BodyId a, BodyId b, std::span<const Contact> found) const {
+    answer.kept = !parts_[a]->deforms() && !parts_[b]->deforms();
+    if (!answer.kept) return;
+    answer.poseA = parts_[a]->pose();
+    answer.poseB = parts_[b]->pose();
+    answer.contacts.assign(found.begin(), found.end());
 }
 
 void CollisionWorld::queryPointShellPair(BodyId a, BodyId b, std::vector<Contact>& out, QueryStats& stats) {

@@ -207,10 +207,6 @@ bool settleMove(BodyId id, double dt, double slop, double bound, const StepConte
     return false;
 }
 
-bool samePose(const Pose& a, const Pose& b) {
-    return a.translation == b.translation && a.rotation.coeffs() == b.rotation.coeffs();
-}
-
 // 3 for every mover, then again for those cut short while a pass changes a pose: a body is
 // checked against the others' moves as they stand, so a box under a falling one is held back
 // by that one's whole move until it is cut back in turn. Without the passes, a stack stepped

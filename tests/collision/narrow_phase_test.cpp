@@ -229,3 +229,45 @@ TEST(NarrowPhase, FaceTraversalsCountTheWholeTraversalsOfAPairTooFastForLists) {
     for (int step = 0; step < 60; ++step) coherent.findContacts();
     EXPECT_LE(coherent.faceTraversals(), jumping + 18) << "at rest, at most the 16 plain queries and a list";
 }
+
+// Rigid pairs at the poses of their last query are answered by it: the same contacts, field
+// for field and in order, as a world that queries every time (coherent = false), with no face
+// query run. A pair one of whose parts moved, or deforms, is queried again.
+TEST(NarrowPhase, RigidPairsAtTheirLastPosesAreAnsweredWithoutAQuery) {
+    Heap heap(6, 8, [](BodyId i) { return i != 2; });  // body 2 deforms
+    auto& [parts, world] = heap;
+    CollisionSettings plainSettings = facesEverywhere();
+    plainSettings.coherent = false;
+    CollisionWorld plain(plainSettings);
+    for (BodyId i = 0; i < parts.size(); ++i) plain.add(i, *parts[i]);
+    auto pairsWith = [&](auto touches) {  // the candidate pairs `touches` selects
+        std::uint64_t n = 0;
+        for (auto [a, b] : world.candidatePairs()) n += touches(a) || touches(b);
+        return n;
+    };
+    auto expectAsPlain = [&](int round) {
+        const std::uint64_t before = world.faceQueries();
+        const std::vector<Contact> got = world.findContacts();
+        flexfit::testing::expectSameContacts(got, plain.findContacts(), round);
+        return world.faceQueries() - before;
+    };
+    ASSERT_GT(expectAsPlain(0), 0u);  // every pair queried once
+    ASSERT_GT(world.contacts().size(), 0u);
+    const std::uint64_t deformingPairs = pairsWith([](BodyId i) { return i == 2; });
+    ASSERT_GT(deformingPairs, 0u);
+    ASSERT_LT(deformingPairs, world.candidatePairs().size());
+    EXPECT_EQ(expectAsPlain(1), deformingPairs);  // nothing moved: only body 2's pairs queried
+    // A rigid body in contact with another rigid one moves a little.
+    const auto rigidContact = std::find_if(world.contacts().begin(), world.contacts().end(),
+                                           [](const Contact& c) { return c.partA != 2 && c.partB != 2; });
+    ASSERT_NE(rigidContact, world.contacts().end());
+    const BodyId moved = rigidContact->partA;
+    parts[moved]->translate(Vec3(1e-6, -2e-6, 0.0));
+    EXPECT_EQ(expectAsPlain(2), pairsWith([&](BodyId i) { return i == 2 || i == moved; }));
+    parts[moved]->setPose(parts[moved]->pose());  // the same pose written again: still answered
+    EXPECT_EQ(expectAsPlain(3), deformingPairs);
+    // One body's rigid contacts: the same answers.
+    const std::uint64_t before = world.faceQueries();
+    flexfit::testing::expectSameContacts(world.contactsOf(moved, true), plain.contactsOf(moved, true), 4);
+    EXPECT_EQ(world.faceQueries(), before);
+}
