@@ -7,40 +7,62 @@
 namespace flexfit::detail {
 namespace {
 
-// The solver's inner calls are forced inline (GCC kept them out of line): the stack scene's
-// solve 73 -> 64 us a step, the same bits.
-
 // Velocity of the body's material point at r from its centre of mass.
-[[gnu::always_inline]] inline Vec3 pointVelocity(const RigidBody& body, const Vec3& r) {
-    return body.linearVelocity + body.angularVelocity.cross(r);
-}
+Vec3 pointVelocity(const RigidBody& body, const Vec3& r) { return body.linearVelocity + body.angularVelocity.cross(r); }
 
-[[gnu::always_inline]] inline Vec3 relativeVelocity(const Bodies& bodies, const SolverContact& c) {
+Vec3 relativeVelocity(const Bodies& bodies, const SolverContact& c) {
     return pointVelocity(bodies.rigid[c.a], c.ra) - pointVelocity(bodies.rigid[c.b], c.rb);
 }
 
-// The inverse of the effective mass the pair opposes to an impulse along `direction`.
-double effectiveMass(const Bodies& bodies, const ContactSolver& s, const SolverContact& c, const Vec3& direction) {
-    double inverse = 0.0;
-    for (const auto& [id, r] : {std::pair{c.a, c.ra}, std::pair{c.b, c.rb}}) {
-        if (!bodies.dynamic(id)) continue;
-        const Vec3 rn = r.cross(direction);
-        inverse += bodies.rigid[id].inverseMass + rn.dot(s.inverseInertia[id] * rn);
+// The point's relative speed along direction k (prepareDirections), from the bodies'
+// velocities: d . (v_a - v_b) + (r_a x d) . w_a - (r_b x d) . w_b.
+inline double speedAlong(const SolverContact& c, int k, const Vec3& d, const Bodies& bodies) {
+    const RigidBody& a = bodies.rigid[c.a];
+    const RigidBody& b = bodies.rigid[c.b];
+    const SolverContact::Direction& along = c.along[k];
+    return d.dot(a.linearVelocity - b.linearVelocity) + along.armA.dot(a.angularVelocity) - along.armB.dot(b.angularVelocity);
+}
+
+// Impulse `linear` (world) on a at the point and -linear on b, whose angular parts are
+// `turnA` and `turnB` (sums of the directions' turns times their impulses).
+inline void applyImpulse(const SolverContact& c, const Vec3& linear, const Vec3& turnA, const Vec3& turnB, Bodies& bodies) {
+    if (c.dynamicA) {
+        RigidBody& a = bodies.rigid[c.a];
+        a.linearVelocity += c.inverseMassA * linear;
+        a.angularVelocity += turnA;
     }
+    if (c.dynamicB) {
+        RigidBody& b = bodies.rigid[c.b];
+        b.linearVelocity -= c.inverseMassB * linear;
+        b.angularVelocity -= turnB;
+    }
+}
+
+// An impulse `impulse` along direction k.
+inline void applyAlong(const SolverContact& c, int k, const Vec3& d, double impulse, Bodies& bodies) {
+    applyImpulse(c, impulse * d, impulse * c.along[k].turnA, impulse * c.along[k].turnB, bodies);
+}
+
+// The inverse of the effective mass the pair opposes to an impulse along direction k.
+double effectiveMass(const SolverContact& c, int k) {
+    const SolverContact::Direction& d = c.along[k];
+    const double inverse = c.inverseMassA + d.armA.dot(d.turnA) + c.inverseMassB + d.armB.dot(d.turnB);
     return inverse > 0.0 ? 1.0 / inverse : 0.0;
 }
 
-// Impulse p on a at the point, -p on b.
-[[gnu::always_inline]] inline void applyImpulse(const Vec3& p, const ContactSolver& s, const SolverContact& c, Bodies& bodies) {
-    if (bodies.dynamic(c.a)) {
-        RigidBody& a = bodies.rigid[c.a];
-        a.linearVelocity += a.inverseMass * p;
-        a.angularVelocity += s.inverseInertia[c.a] * c.ra.cross(p);
-    }
-    if (bodies.dynamic(c.b)) {
-        RigidBody& b = bodies.rigid[c.b];
-        b.linearVelocity -= b.inverseMass * p;
-        b.angularVelocity -= s.inverseInertia[c.b] * c.rb.cross(p);
+// The directions' arms and turns at the point's lever arms (SolverContact::Direction).
+void prepareDirections(const Bodies& bodies, const ContactSolver& s, SolverContact& c) {
+    c.dynamicA = bodies.dynamic(c.a);
+    c.dynamicB = bodies.dynamic(c.b);
+    c.inverseMassA = c.dynamicA ? bodies.rigid[c.a].inverseMass : 0.0;
+    c.inverseMassB = c.dynamicB ? bodies.rigid[c.b].inverseMass : 0.0;
+    const Vec3 directions[3] = {c.normal, c.tangent1, c.tangent2};
+    for (int k = 0; k < 3; ++k) {
+        SolverContact::Direction& d = c.along[k];
+        d.armA = c.ra.cross(directions[k]);
+        d.armB = c.rb.cross(directions[k]);
+        d.turnA = c.dynamicA ? Vec3(s.inverseInertia[c.a] * d.armA) : Vec3::Zero();
+        d.turnB = c.dynamicB ? Vec3(s.inverseInertia[c.b] * d.armB) : Vec3::Zero();
     }
 }
 
@@ -53,11 +75,10 @@ void tangentsOf(const Vec3& n, Vec3& t1, Vec3& t2) {
 
 // Coulomb: the impulse that stops the sliding while within the static cone, else the kinetic
 // one against it.
-void solveFriction(SolverContact& c, const ContactSolver& s, Bodies& bodies) {
-    const Vec3 v = relativeVelocity(bodies, c);
+void solveFriction(SolverContact& c, Bodies& bodies) {
     const double old1 = c.tangentImpulse1, old2 = c.tangentImpulse2;
-    double new1 = old1 - c.tangentMass1 * v.dot(c.tangent1);
-    double new2 = old2 - c.tangentMass2 * v.dot(c.tangent2);
+    double new1 = old1 - c.tangentMass1 * speedAlong(c, 1, c.tangent1, bodies);
+    double new2 = old2 - c.tangentMass2 * speedAlong(c, 2, c.tangent2, bodies);
     const double cone = c.staticFriction * c.normalImpulse;
     if (!wellInsideCone(new1, new2, cone)) {
         const double magnitude = std::hypot(new1, new2);
@@ -69,15 +90,17 @@ void solveFriction(SolverContact& c, const ContactSolver& s, Bodies& bodies) {
     }
     c.tangentImpulse1 = new1;
     c.tangentImpulse2 = new2;
-    applyImpulse((new1 - old1) * c.tangent1 + (new2 - old2) * c.tangent2, s, c, bodies);
+    const double change1 = new1 - old1, change2 = new2 - old2;
+    applyImpulse(c, change1 * c.tangent1 + change2 * c.tangent2, change1 * c.along[1].turnA + change2 * c.along[2].turnA,
+                 change1 * c.along[1].turnB + change2 * c.along[2].turnB, bodies);
 }
 
-void solveNormal(SolverContact& c, double targetSpeed, const ContactSolver& s, Bodies& bodies) {
-    const double speed = relativeVelocity(bodies, c).dot(c.normal);
+void solveNormal(SolverContact& c, double targetSpeed, Bodies& bodies) {
+    const double speed = speedAlong(c, 0, c.normal, bodies);
     const double accumulated = std::max(c.normalImpulse - c.normalMass * (speed - targetSpeed), 0.0);
     const double change = accumulated - c.normalImpulse;
     c.normalImpulse = accumulated;
-    applyImpulse(change * c.normal, s, c, bodies);
+    applyAlong(c, 0, c.normal, change, bodies);
 }
 
 }  // namespace
@@ -129,9 +152,10 @@ void addContacts(std::span<const Contact> contacts, const Bodies& bodies, Contac
         c.normal = contact.normal;
         tangentsOf(c.normal, c.tangent1, c.tangent2);
         c.depth = contact.depth;
-        c.normalMass = effectiveMass(bodies, solver, c, c.normal);
-        c.tangentMass1 = effectiveMass(bodies, solver, c, c.tangent1);
-        c.tangentMass2 = effectiveMass(bodies, solver, c, c.tangent2);
+        prepareDirections(bodies, solver, c);
+        c.normalMass = effectiveMass(c, 0);
+        c.tangentMass1 = effectiveMass(c, 1);
+        c.tangentMass2 = effectiveMass(c, 2);
         c.approachSpeed = relativeVelocity(bodies, c).dot(c.normal);
         c.staticFriction = combinedFriction(ba.staticFriction, bb.staticFriction);
         c.kineticFriction = combinedFriction(ba.kineticFriction, bb.kineticFriction);
@@ -157,7 +181,10 @@ void warmStart(Bodies& bodies, ContactSolver& solver) {
         const double kept = found->normalImpulse > 0.0 ? c.normalImpulse / found->normalImpulse : 0.0;
         c.tangentImpulse1 = kept * found->tangentImpulse.dot(c.tangent1);
         c.tangentImpulse2 = kept * found->tangentImpulse.dot(c.tangent2);
-        applyImpulse(c.normalImpulse * c.normal + c.tangentImpulse1 * c.tangent1 + c.tangentImpulse2 * c.tangent2, solver, c, bodies);
+        applyImpulse(c, c.normalImpulse * c.normal + c.tangentImpulse1 * c.tangent1 + c.tangentImpulse2 * c.tangent2,
+                     c.normalImpulse * c.along[0].turnA + c.tangentImpulse1 * c.along[1].turnA + c.tangentImpulse2 * c.along[2].turnA,
+                     c.normalImpulse * c.along[0].turnB + c.tangentImpulse1 * c.along[1].turnB + c.tangentImpulse2 * c.along[2].turnB,
+                     bodies);
     }
 }
 
@@ -167,6 +194,7 @@ void refreshLeverArms(const Bodies& bodies, ContactSolver& solver) {
         const Vec3 point = 0.5 * ((comA + c.ra) + (comB + c.rb));
         c.ra = point - comA;
         c.rb = point - comB;
+        prepareDirections(bodies, solver, c);
     }
 }
 
@@ -175,8 +203,8 @@ void solveVelocities(int iterations, const Separation& separation, Bodies& bodie
         for (SolverContact& c : solver.contacts) {
             // Friction first, within the normal impulse of the last pass (Box2D's order); a
             // frictionless pair's tangent impulses stay zero.
-            if (c.staticFriction > 0.0 || c.kineticFriction > 0.0) solveFriction(c, solver, bodies);
-            solveNormal(c, std::min(separation.rate * std::max(c.depth - separation.slop, 0.0), separation.maxSpeed), solver, bodies);
+            if (c.staticFriction > 0.0 || c.kineticFriction > 0.0) solveFriction(c, bodies);
+            solveNormal(c, std::min(separation.rate * std::max(c.depth - separation.slop, 0.0), separation.maxSpeed), bodies);
         }
 }
 
@@ -186,7 +214,7 @@ void applyRestitution(int iterations, Bodies& bodies, ContactSolver& solver) {
     if (!any) return;
     for (int iteration = 0; iteration < iterations; ++iteration)
         for (SolverContact& c : solver.contacts)
-            if (bounces(c)) solveNormal(c, -c.restitution * c.approachSpeed, solver, bodies);
+            if (bounces(c)) solveNormal(c, -c.restitution * c.approachSpeed, bodies);
 }
 
 }  // namespace flexfit::detail

@@ -61,6 +61,17 @@ struct SolverContact {
     double depth = 0.0;
     double normalMass = 0.0, tangentMass1 = 0.0, tangentMass2 = 0.0;  // 1 / effective inverse mass
     double normalImpulse = 0.0, tangentImpulse1 = 0.0, tangentImpulse2 = 0.0;  // accumulated
+    // What an impulse along each of normal, tangent1, tangent2 (k = 0, 1, 2) does, prepared
+    // once a sub-step and after the lever arms move (prepareDirections), so the passes need no
+    // cross product or inertia product: r x d of each body (its angular velocity's share of the
+    // point's speed along d) and I^-1 (r x d) (the angular velocity a unit impulse along d
+    // gives it; zero for a body that is not dynamic, whose velocity no impulse changes).
+    struct Direction {
+        Vec3 armA, armB, turnA, turnB;
+    };
+    Direction along[3];
+    double inverseMassA = 0.0, inverseMassB = 0.0;  // 0 for a body that is not dynamic
+    bool dynamicA = false, dynamicB = false;
     double approachSpeed = 0.0;  // relative normal speed before the solve (< 0: approaching)
     double bounceThreshold = 1e-9;  // approach speed below which it does not bounce
     double staticFriction = 0.0, kineticFriction = 0.0, restitution = 0.0;
