@@ -83,7 +83,6 @@ private:
         IndexSet set;
         SpringList list;
         void reset(const PartModel& m);
-        bool contains(Index e) const { return set.contains(e); }
         void insert(Index e);
         void erase(Index e);
     };
