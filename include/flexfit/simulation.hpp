@@ -183,9 +183,10 @@ struct RegionWork {
 
 // Whether stepRegionByFullModel costs less than stepActiveRegion for a region doing `work`. A
 // rule on counts alone, so every machine chooses alike and a run's bits do not depend on the
-// CPU: the region step costs about 5 ns a loose spring on a part of a few hundred masses, rising
-// to 8 ns from 7,000 masses (its ends and constants are gathered, in the order the zones grew:
-// dearer once the state outgrows the nearest caches), 2.7 ns a block lane and 2 ns a moving
+// CPU: the region step costs about 4.3 ns a loose spring on a part of a few hundred masses,
+// rising to 6.9 ns from 7,000 masses (its ends' state is gathered, in the order the zones grew:
+// dearer once the state outgrows the nearest caches; 5 and 8 ns before the region kept its loose
+// springs' ends and constants in a list, 2026-12-07), 2.7 ns a block lane and 2 ns a moving
 // mass; the full step about 2.8 ns a spring by spring blocks and 6 ns listed (in index order),
 // plus 0.3 ns per mass put back. Fitted 2026-12-05 to bench_zone_coverage's records on three
 // machines (AMD EPYC with AVX2, two Intel Xeons with AVX-512), torus1, torus2, the heart, the
@@ -195,9 +196,12 @@ struct RegionWork {
 // 3.0 against 5.0 us, its region steps alike): the region steps the rule took between 30 and 66 %
 // coverage then cost 1.05-1.20x the whole model. So the region step is taken only where its
 // estimate is at most 0.62 of the full step's (about the two records' ratio of full-step speeds):
-// it takes the full step for torus1 at 32 % coverage (estimated 0.63; the region step cost 1.06-
-// 1.09x that evening, 0.70x on 12-05) and still the region step for the heart at 44-47 %
-// (estimated 0.61; 0.73-0.79x). Taking the full step costs the whole model plus the put-back,
+// with the costs of 12-05 it took the full step for torus1 at 32 % coverage (estimated 0.63; the
+// region step cost 1.06-1.09x that evening, 0.70x on 12-05) and still the region step for the
+// heart at 44-47 % (estimated 0.61; 0.73-0.79x). With the list's loose-spring cost torus1 at
+// 32 % is estimated 0.55 and takes the region step (on the AMD Zen 5 machine, 2026-12-07, 0.954x
+// the whole model against 1.042x for the full step: bench/results/listed_springs_zones_1207.csv).
+// Taking the full step costs the whole model plus the put-back,
 // which read up to 1.06x on the heart that evening (1.02x on 12-05)
 // (bench/results/zone_coverage_1206.csv). tests/dynamics/region_step_test.cpp checks the rule
 // against both records where they agree: any share from about 0.45 to 0.75 passes it (the rule
