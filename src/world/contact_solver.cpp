@@ -105,14 +105,6 @@ void solveNormal(SolverContact& c, double targetSpeed, Bodies& bodies) {
 
 }  // namespace
 
-// Whether the tangent impulse (x, y) is inside the static cone of radius `cone` by far more
-// than rounding: then std::hypot(x, y) > cone is false, and hypot (a libm call, 8 % of the
-// stack scene's samples in perf, where every resting contact is well inside) need not run.
-// The squares round by a few ulps against hypot's one, far within the 1e-12 margin; cones
-// below 1e-150 (whose squares could lose digits below the normal range) always take hypot.
-bool wellInsideCone(double x, double y, double cone) {
-    return cone > 1e-150 && x * x + y * y < cone * cone * (1.0 - 1e-12);
-}
 
 // Rigid contacts; and a dynamic deforming body's contacts with rigid parts (its rigid motion
 // meets them as a rigid body's would; the response deforms it there).

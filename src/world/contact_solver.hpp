@@ -102,8 +102,14 @@ void keepImpulses(ContactSolver& solver);
 void warmStart(Bodies& bodies, ContactSolver& solver);
 
 // Whether the tangent impulse (x, y) is inside the static cone of radius `cone` by far more
-// than rounding, so that std::hypot(x, y) > cone is false: the friction step skips hypot then.
-bool wellInsideCone(double x, double y, double cone);
+// than rounding: then std::hypot(x, y) > cone is false, and hypot (a libm call, 8 % of the
+// stack scene's samples in perf, where every resting contact is well inside) need not run.
+// The squares round by a few ulps against hypot's one, far within the 1e-12 margin; cones
+// below 1e-150 (whose squares could lose digits below the normal range) always take hypot.
+// Inline: a call of its own was 6 % of the stack scene's samples.
+inline bool wellInsideCone(double x, double y, double cone) {
+    return cone > 1e-150 && x * x + y * y < cone * cone * (1.0 - 1e-12);
+}
 
 // Combining rules (body.hpp): geometric mean of the frictions, larger restitution.
 double combinedFriction(double a, double b);
