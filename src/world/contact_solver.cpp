@@ -14,9 +14,13 @@ Vec3 relativeVelocity(const Bodies& bodies, const SolverContact& c) {
     return pointVelocity(bodies.rigid[c.a], c.ra) - pointVelocity(bodies.rigid[c.b], c.rb);
 }
 
+// Direction k of the point: its normal (0), tangent1 (1) or tangent2 (2).
+inline const Vec3& directionOf(const SolverContact& c, int k) { return k == 0 ? c.normal : k == 1 ? c.tangent1 : c.tangent2; }
+
 // The point's relative speed along direction k (prepareDirections), from the bodies'
 // velocities: d . (v_a - v_b) + (r_a x d) . w_a - (r_b x d) . w_b.
-inline double speedAlong(const SolverContact& c, int k, const Vec3& d, const Bodies& bodies) {
+inline double speedAlong(const SolverContact& c, int k, const Bodies& bodies) {
+    const Vec3& d = directionOf(c, k);
     const RigidBody& a = bodies.rigid[c.a];
     const RigidBody& b = bodies.rigid[c.b];
     const SolverContact::Direction& along = c.along[k];
@@ -39,8 +43,8 @@ inline void applyImpulse(const SolverContact& c, const Vec3& linear, const Vec3&
 }
 
 // An impulse `impulse` along direction k.
-inline void applyAlong(const SolverContact& c, int k, const Vec3& d, double impulse, Bodies& bodies) {
-    applyImpulse(c, impulse * d, impulse * c.along[k].turnA, impulse * c.along[k].turnB, bodies);
+inline void applyAlong(const SolverContact& c, int k, double impulse, Bodies& bodies) {
+    applyImpulse(c, impulse * directionOf(c, k), impulse * c.along[k].turnA, impulse * c.along[k].turnB, bodies);
 }
 
 // The inverse of the effective mass the pair opposes to an impulse along direction k.
@@ -56,11 +60,10 @@ void prepareDirections(const Bodies& bodies, const ContactSolver& s, SolverConta
     c.dynamicB = bodies.dynamic(c.b);
     c.inverseMassA = c.dynamicA ? bodies.rigid[c.a].inverseMass : 0.0;
     c.inverseMassB = c.dynamicB ? bodies.rigid[c.b].inverseMass : 0.0;
-    const Vec3 directions[3] = {c.normal, c.tangent1, c.tangent2};
     for (int k = 0; k < 3; ++k) {
         SolverContact::Direction& d = c.along[k];
-        d.armA = c.ra.cross(directions[k]);
-        d.armB = c.rb.cross(directions[k]);
+        d.armA = c.ra.cross(directionOf(c, k));
+        d.armB = c.rb.cross(directionOf(c, k));
         d.turnA = c.dynamicA ? Vec3(s.inverseInertia[c.a] * d.armA) : Vec3::Zero();
         d.turnB = c.dynamicB ? Vec3(s.inverseInertia[c.b] * d.armB) : Vec3::Zero();
     }
@@ -77,8 +80,8 @@ void tangentsOf(const Vec3& n, Vec3& t1, Vec3& t2) {
 // one against it.
 void solveFriction(SolverContact& c, Bodies& bodies) {
     const double old1 = c.tangentImpulse1, old2 = c.tangentImpulse2;
-    double new1 = old1 - c.tangentMass1 * speedAlong(c, 1, c.tangent1, bodies);
-    double new2 = old2 - c.tangentMass2 * speedAlong(c, 2, c.tangent2, bodies);
+    double new1 = old1 - c.tangentMass1 * speedAlong(c, 1, bodies);
+    double new2 = old2 - c.tangentMass2 * speedAlong(c, 2, bodies);
     const double cone = c.staticFriction * c.normalImpulse;
     if (!wellInsideCone(new1, new2, cone)) {
         const double magnitude = std::hypot(new1, new2);
@@ -96,11 +99,11 @@ void solveFriction(SolverContact& c, Bodies& bodies) {
 }
 
 void solveNormal(SolverContact& c, double targetSpeed, Bodies& bodies) {
-    const double speed = speedAlong(c, 0, c.normal, bodies);
+    const double speed = speedAlong(c, 0, bodies);
     const double accumulated = std::max(c.normalImpulse - c.normalMass * (speed - targetSpeed), 0.0);
     const double change = accumulated - c.normalImpulse;
     c.normalImpulse = accumulated;
-    applyAlong(c, 0, c.normal, change, bodies);
+    applyAlong(c, 0, change, bodies);
 }
 
 }  // namespace
