@@ -63,9 +63,10 @@ public:
         nodes_.reserve(2 * leafVolumes.size());
         parents_.reserve(2 * leafVolumes.size());
         subtreeEnd_.assign(2 * leafVolumes.size() - 1, 0);
-        std::vector<Index> items(leafVolumes.size());
-        std::iota(items.begin(), items.end(), Index(0));
-        buildNode(leafVolumes, items, 0, items.size(), -1, 0, how);
+        // Kept between builds: a tree rebuilt every step (the broad phase's) allocates nothing.
+        items_.resize(leafVolumes.size());
+        std::iota(items_.begin(), items_.end(), Index(0));
+        buildNode(leafVolumes, items_, 0, items_.size(), -1, 0, how);
         dirty_.reset(nodes_.size());
     }
 
@@ -251,6 +252,7 @@ private:
     std::uint16_t maxDepth_ = 0;
     std::vector<std::uint32_t> perDepth_;  // byDepth()'s counts, then slots
     std::vector<Index> ordered_;           // byDepth()'s result
+    std::vector<Index> items_;             // build()'s items, split in place
     std::size_t refitNodes_ = 0;
 };
 

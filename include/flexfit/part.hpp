@@ -207,6 +207,10 @@ private:
     void uncover(const Zone& zone);
     void returnToRest(Index mass);
     Zone* findZone(ZoneId id);
+    // A retired zone's lists, kept for the next zone to open (empty when none is kept), so that
+    // zones opening and retiring in a running loop allocate nothing once warm.
+    Zone spareZone();
+    void keepSpare(Zone&& zone);
     void collectMembers(Zone& zone);
     bool zoneAtRest(const Zone& zone) const;
     void markChanged(Index mass);
@@ -225,6 +229,7 @@ private:
     std::unique_ptr<KRingWalker> walker_;
 
     std::vector<Zone> zones_;
+    std::vector<Zone> spareZones_;  // retired zones' lists (scratch: a copy starts without)
     ZoneId nextZoneId_ = 1;
     ActiveRegion region_;
     std::vector<std::uint64_t> lastLoadStep_; // (V) step of the last force on each mass

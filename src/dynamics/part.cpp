@@ -32,9 +32,9 @@ void checkZoneSettings(const ZoneSettings& z) {
 
 
 struct Part::Zone {
-    ZoneId id;
+    ZoneId id = kNoZone;
     std::vector<Index> seeds;
-    int level;
+    int level = 0;
     std::vector<RingMember> members;
 };
 
@@ -176,20 +176,25 @@ void Part::collectMembers(Zone& zone) {
 
 ZoneId Part::openZone(ZoneSeed seed, int level) {
     if (level < 0 || level > 255) throw InputError(kPartSource, 0, "zone level " + std::to_string(level) + " is outside [0, 255]");
-    Zone zone{nextZoneId_, {}, level, {}};
+    Zone zone = spareZone();
+    zone.id = nextZoneId_;
+    zone.level = level;
     if (seed.kind == ZoneSeed::Kind::Mass) {
         if (seed.index >= model_->massCount())
             throw InputError(kPartSource, 0, "zone seed mass " + std::to_string(seed.index) + " does not exist (the model has " +
                                                  std::to_string(model_->massCount()) + " masses)");
-        zone.seeds = {seed.index};
+        zone.seeds.assign(1, seed.index);
     } else {
         if (seed.index >= model_->faceCount())
             throw InputError(kPartSource, 0, "zone seed face " + std::to_string(seed.index) + " does not exist (the model has " +
                                                  std::to_string(model_->faceCount()) + " faces)");
         const Face& f = model_->mesh.faces[seed.index];
-        zone.seeds = {f[0], f[1], f[2]};
+        zone.seeds.assign(f.begin(), f.end());
     }
-    if (settings_.mode != PartMode::RigidDeformable) return kNoZone;
+    if (settings_.mode != PartMode::RigidDeformable) {
+        keepSpare(std::move(zone));
+        return kNoZone;
+    }
     ++nextZoneId_;
     collectMembers(zone);
     cover(zone);
@@ -202,19 +207,32 @@ void Part::setZoneLevel(ZoneId id, int level) {
     Zone* zone = findZone(id);
     if (zone == nullptr || zone->level == level) return;
     // Cover the new members before uncovering the old, so masses in both keep their state.
-    Zone old{zone->id, {}, zone->level, std::move(zone->members)};
+    Zone old = spareZone();
+    old.level = zone->level;
+    std::swap(old.members, zone->members);
     zone->level = level;
     collectMembers(*zone);
     cover(*zone);
     uncover(old);
+    keepSpare(std::move(old));
 }
 
 void Part::retireZone(ZoneId id) {
     auto it = std::find_if(zones_.begin(), zones_.end(), [id](const Zone& z) { return z.id == id; });
     if (it == zones_.end()) return;
     uncover(*it);
+    keepSpare(std::move(*it));
     zones_.erase(it);
 }
+
+Part::Zone Part::spareZone() {
+    if (spareZones_.empty()) return Zone{};
+    Zone zone = std::move(spareZones_.back());
+    spareZones_.pop_back();
+    return zone;
+}
+
+void Part::keepSpare(Zone&& zone) { spareZones_.push_back(std::move(zone)); }
 
 std::size_t Part::zoneCount() const { return zones_.size(); }
 
@@ -395,6 +413,7 @@ void Part::retireRestingZones() {
         const Zone& zone = zones_[z];
         if (zoneAtRest(zone)) {
             uncover(zone);
+            keepSpare(std::move(zones_[z]));
             zones_.erase(zones_.begin() + std::ptrdiff_t(z));
         } else {
             ++z;
