@@ -170,9 +170,12 @@ public:
     // writes the positions).
     void step(StepCounters* counters = nullptr);
     // The moving masses by one step of context.timeStep, under context.gravity (world frame);
-    // O(1) when nothing moves. Checks nothing but what stepFullModel checks (a world checks its
-    // parts after its whole step, world.hpp).
-    void advance(const StepContext& context, StepCounters* counters = nullptr);
+    // O(1) when nothing moves. Returns true when the step itself found every moving mass's new
+    // position within the model's bound, as checkRegionFinite would: the full model's step
+    // (which throws DivergenceError otherwise), or the region step's vector integration pass
+    // with semi-implicit Euler. False: the caller checks (step() does; a world checks the part
+    // after its whole step, world.hpp).
+    bool advance(const StepContext& context, StepCounters* counters = nullptr);
     // Every retireCheckInterval steps: retires the zones at rest (see Lifecycle above).
     void retireRestingZones();
 
@@ -237,10 +240,6 @@ private:
     mutable bool regionStepped_ = false;      // the region's masses moved and are not in changed_ yet
     // Every mass changed (a step moved them all): O(1) instead of marking each.
     bool allChanged_ = false;
-    bool fullModelStepped_ = false;  // the last advance() ran the full model's step (which checked every mass)
-    // advance(); with checkRegion, a region step checks its new positions as it writes them
-    // (step() then skips its own check): returns whether it did and found them within.
-    bool advanceChecking(const StepContext& context, StepCounters* counters, bool checkRegion);
     std::vector<Index> allMasses_;  // 0 .. V-1, built the first time every mass moves
 };
 

@@ -271,26 +271,21 @@ void Part::kickMass(Index mass, const Vec3& worldVelocityChange) {
 
 void Part::step(StepCounters* counters) {
     const double start = state_.time;
-    const bool checked = advanceChecking({settings_.simulation.timeStep, settings_.simulation.gravity}, counters, true);
-    // The full step checks every mass itself (stepFullModel); the region step, in its pass or here.
-    if (!fullModelStepped_ && !checked)
+    if (!advance({settings_.simulation.timeStep, settings_.simulation.gravity}, counters))
         detail::checkRegionFinite(*model_, settings_.simulation, state_, region_, std::nullopt, start);
     retireRestingZones();
 }
 
-void Part::advance(const StepContext& context, StepCounters* counters) { advanceChecking(context, counters, false); }
-
-bool Part::advanceChecking(const StepContext& context, StepCounters* counters, bool checkRegion) {
+bool Part::advance(const StepContext& context, StepCounters* counters) {
     if (region_.empty()) {  // rigid, or no zone open: nothing moves, O(1)
         state_.time += context.timeStep;
         ++state_.stepCount;
-        return false;
+        return true;
     }
     SimulationSettings s = settings_.simulation;
     s.timeStep = context.timeStep;
     s.gravity = pose_.rotateInverse(context.gravity);  // world gravity seen in the part frame
-    fullModelStepped_ = true;
-    bool checked = false;
+    bool checked = true;  // the full model's step checks every mass itself (and throws)
     if (region_.coversEveryMass() && settings_.zones.fullSweepWhenComplete)
         stepFullModel(*model_, s, {}, state_, counters);
     // The implicit solve holds a region's edge fixed; the full step would solve for it too.
@@ -298,9 +293,8 @@ bool Part::advanceChecking(const StepContext& context, StepCounters* counters, b
              fullStepCostsLess(*model_, RegionWork::of(region_)))
         stepRegionByFullModel(*model_, s, region_, state_, counters);
     else {
-        fullModelStepped_ = false;
         detail::PositionCheck check(model_->positionBound);
-        detail::stepRegion(*model_, s, region_, state_, counters, checkRegion ? &check : nullptr);
+        detail::stepRegion(*model_, s, region_, state_, counters, &check);
         checked = check.passed();
     }
     if (region_.coversEveryMass())

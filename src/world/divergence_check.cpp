@@ -20,11 +20,11 @@ void checkRigid(BodyId id, double time, const char* what, const Vector& value) {
 
 }  // namespace
 
-void checkFinite(const StepContext& step, const Bodies& bodies) {
+void checkFinite(const StepContext& step, const Bodies& bodies, std::span<const std::uint8_t> zonesChecked) {
     // Masses first: a diverging part pushes non-finite reactions onto the bodies it touches.
     for (BodyId id = 0; id < bodies.size(); ++id) {
         const Part& part = *bodies.parts[id];
-        if (part.movingMasses().empty()) continue;
+        if (part.movingMasses().empty() || (id < zonesChecked.size() && zonesChecked[id])) continue;
         SimulationSettings used = part.settings().simulation;  // as the zone dynamics stepped it
         used.timeStep = step.timeStep;
         checkRegionFinite(part.model(), used, part.state(), part.region(), id, step.time);

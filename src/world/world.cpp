@@ -228,12 +228,12 @@ void stepStages(detail::WorldData& d) {
     profiler.enter(Stage::ContactResponse);
     detail::respondToContacts(step, d.settings.contactDamping, contacts, d.bodies, d.response);  // deformable pushes, reactions
     profiler.enter(Stage::ZoneDynamics);
-    detail::advanceZones(step, d.bodies);                          // moving masses, restoration
+    detail::advanceZones(step, d.bodies, d.zonesChecked);          // moving masses, restoration
     profiler.enter(Stage::ZoneRetirement);
     detail::retireZones(d.bodies);                                 // zones at rest back to rest
     profiler.enter(Stage::Assembly);
     detail::assemble(step, contacts, d.assembly, d.bodies, d.op);  // snapping rules
-    detail::checkFinite(step, d.bodies);                           // divergence (charged to assembly)
+    detail::checkFinite(step, d.bodies, d.zonesChecked);           // divergence (charged to assembly)
     profiler.finish();
     d.time += d.settings.timeStep;
     ++d.stepIndex;

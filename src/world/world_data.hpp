@@ -24,6 +24,7 @@ struct WorldData {
     ContactResponse response;   // contact stiffness per body, response scratch
     RigidMotionScratch rigidMotion;  // the sub-steps' solver and contacts
     AssemblyState assembly;     // the rules and their events
+    std::vector<std::uint8_t> zonesChecked;  // (bodies) the zone dynamics step checked its moving masses
     Profile profile;
     std::vector<std::string> warnings;  // World::warnings()
     std::optional<DivergenceError> diverged;  // the step that diverged: no step after it

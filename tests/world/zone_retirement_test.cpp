@@ -18,9 +18,10 @@ TEST(ZoneRetirement, ZonesAtRestRetireAtTheCheckIntervalAndLoadedOnesStay) {
     idle.openZone(ZoneSeed::mass(10), 3);  // nothing ever loads it: at rest from the start
     loaded.openZone(ZoneSeed::mass(10), 3);
     const StepContext step{1e-3, Vec3::Zero(), 0, 0.0};
+    std::vector<std::uint8_t> checked;
     for (int i = 1; i <= 8; ++i) {
         loaded.applyForce(10, Vec3(0.1, 0, 0));
-        detail::advanceZones(step, bodies);
+        detail::advanceZones(step, bodies, checked);
         detail::retireZones(bodies);
         ASSERT_EQ(idle.zoneCount(), i < 8 ? 1u : 0u) << "after step " << i;
         EXPECT_EQ(loaded.zoneCount(), 1u);
