@@ -3,7 +3,7 @@ JOBS ?= $(shell nproc)
 FLEXFIT := build/release/apps/flexfit/flexfit
 DEMO_OUT ?= out/demo
 
-.PHONY: demo test test-sanitizer-long deps release asan bench clean
+.PHONY: demo test test-sanitizer-long test-threads deps release asan tsan bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -44,6 +44,16 @@ test: release asan
 
 test-sanitizer-long: asan
 	ctest --preset asan -j $(JOBS) -R '$(SANITIZER_LONG)' --no-tests=error
+
+# The tests that run threads (tests/threads.txt) under ThreadSanitizer: only the programs that
+# hold them are built (the tsan build preset's targets). CI runs it after make test.
+tsan: deps
+	@cmake --preset tsan >/dev/null
+	@cmake --build --preset tsan -j $(JOBS)
+
+THREADS := ^($(shell grep -v -e '^\#' -e '^ *$$' tests/threads.txt | sed 's/[.]/\\./g' | paste -sd'|'))( |$$)
+test-threads: tsan
+	ctest --preset tsan -j $(JOBS) -R '$(THREADS)' --no-tests=error
 
 BENCH_FLAGS := --benchmark_repetitions=12 --benchmark_enable_random_interleaving=true \
 	--benchmark_report_aggregates_only=true --benchmark_min_time=0.2 \

@@ -59,6 +59,12 @@
 // followed without lag; move the target continuously (a jump d gives an impulse b d).
 // A body that snaps is released. Forces on selected masses or faces deform a
 // deformable part (zones open there) and push a rigid dynamic one at that point.
+//
+// Threads: one world is stepped and read from one thread at a time (a haptic loop and a
+// renderer take turns, or the renderer reads a copy). Separate worlds may step on separate
+// threads at once, as `flexfit sweep --jobs` runs its scenes: the library shares no mutable
+// state between worlds, only per-thread scratch (checked under ThreadSanitizer in CI,
+// tests/threads.txt). Once warm, a step allocates no memory (docs/architecture.md).
 #pragma once
 
 #include "flexfit/assembly.hpp"
