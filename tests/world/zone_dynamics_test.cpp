@@ -44,8 +44,8 @@ TEST(ZoneDynamics, EveryPartAdvancesByTheWorldsStepWithoutGravity) {
 TEST(ZoneDynamics, ItSaysWhichPartsItsStepCheckedAndFindsNoneThatDiverged) {
     // Three parts with a zone each: semi-implicit Euler (its integration pass checks, where a
     // vector kernel runs), explicit Euler (the caller must check its velocities too), and one at
-    // rest (nothing to check). A check that passes is only claimed while every moving position
-    // is within the bound: a NaN put into a moving mass before the step is never claimed.
+    // rest (nothing to check). A check is only claimed while every moving position is within
+    // the model's bound: not after a mass is thrown beyond it.
     const auto model = buildPartModel(makeTorus1());
     PartSettings semi, explicitEuler;
     explicitEuler.simulation.integrator = Integrator::ExplicitEuler;
