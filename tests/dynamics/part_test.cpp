@@ -147,6 +147,36 @@ TEST(Part, LoadedZoneStaysOpen) {
     EXPECT_EQ(part.zoneCount(), 1u);
 }
 
+TEST(Part, ZonesOpenedOnRetiredZonesListsCoverWhatFreshZonesCover) {
+    // A retired zone's lists are kept for the next zone to open (no allocation once warm): the
+    // next zones, of other seeds, kinds and levels, cover exactly their k-rings (the expansion
+    // here is the reference), and a level change reuses them too.
+    const auto model = buildPartModel(makeTorus2());
+    Part part(model, zoneSettings());
+    const ZoneId large = part.openZone(ZoneSeed::mass(77), 6);
+    const ZoneId face = part.openZone(ZoneSeed::face(300), 4);
+    part.retireZone(large);
+    part.retireZone(face);
+    ASSERT_TRUE(part.movingMasses().empty());
+    const ZoneId small = part.openZone(ZoneSeed::mass(500), 2);
+    const Face& f = model->mesh.faces[40];
+    const ZoneId onFace = part.openZone(ZoneSeed::face(40), 3);
+    std::set<Index> expected = ringByExpansion(*model, {500}, 1);
+    for (Index m : ringByExpansion(*model, {f[0], f[1], f[2]}, 2)) expected.insert(m);
+    EXPECT_EQ(asSet(part.movingMasses()), expected);
+    EXPECT_EQ(asSet(part.computedSprings()), springsTouching(*model, expected));
+    EXPECT_NE(small, onFace);
+    EXPECT_GT(onFace, face);  // ids are never reused
+    part.setZoneLevel(small, 5);
+    expected = ringByExpansion(*model, {500}, 4);
+    for (Index m : ringByExpansion(*model, {f[0], f[1], f[2]}, 2)) expected.insert(m);
+    EXPECT_EQ(asSet(part.movingMasses()), expected);
+    part.retireZone(small);
+    part.retireZone(onFace);
+    EXPECT_TRUE(part.movingMasses().empty());
+    EXPECT_EQ(part.state().positions, model->restPositions);
+}
+
 TEST(Part, GrowingAndShrinkingKeepsTheStateOfMassesThatStay) {
     const auto model = buildPartModel(makeTorus1());
     Part part(model, zoneSettings());
