@@ -276,6 +276,38 @@ std::size_t checkedWholePass(std::size_t width, std::size_t groups, PartState& s
     return width * groups;
 }
 
+// MassUpdate's step of one coordinate of 8 masses, as integrateMass takes it for each double:
+// the body force ((m g - drag v) - k_a (x - rest), as MassUpdate::bodyForce), the integrator,
+// then the restoration constraint. integrate512 and integrateListed512 share it.
+struct CoordinateStep8 {
+    const MassUpdate& p;
+    __m512d h, invH, drag, anchor, constraint;
+};
+FLEXFIT_AVX512 inline CoordinateStep8 coordinateStep8(const MassUpdate& p) {
+    return {p, _mm512_set1_pd(p.h), _mm512_set1_pd(p.invH), _mm512_set1_pd(p.drag), _mm512_set1_pd(p.anchorStiffness),
+            _mm512_set1_pd(p.constraint)};
+}
+// m: the masses, hm: h over them, g: gravity's coordinate; xo, vo, fo, r: position, velocity,
+// force and rest (r unread unless anchored or constrained). The new position and velocity.
+FLEXFIT_AVX512 inline void stepCoordinate8(const CoordinateStep8& s, __m512d m, __m512d hm, __m512d g, __m512d xo, __m512d vo,
+                                           __m512d fo, __m512d r, __m512d& xn, __m512d& vn) {
+    __m512d body = _mm512_sub_pd(_mm512_mul_pd(m, g), _mm512_mul_pd(s.drag, vo));
+    if (s.p.anchorStiffness != 0.0) body = _mm512_sub_pd(body, _mm512_mul_pd(s.anchor, _mm512_sub_pd(xo, r)));
+    const __m512d total = _mm512_add_pd(fo, body);
+    if (s.p.semiImplicit) {
+        vn = _mm512_add_pd(vo, _mm512_mul_pd(hm, total));
+        xn = _mm512_add_pd(xo, _mm512_mul_pd(s.h, vn));
+    } else {
+        xn = _mm512_add_pd(xo, _mm512_mul_pd(s.h, vo));
+        vn = _mm512_add_pd(vo, _mm512_mul_pd(hm, total));
+    }
+    if (s.p.constraint > 0.0) {
+        const __m512d correction = _mm512_mul_pd(s.constraint, _mm512_sub_pd(r, xn));
+        xn = _mm512_add_pd(xn, correction);
+        vn = _mm512_add_pd(vn, _mm512_mul_pd(s.invH, correction));
+    }
+}
+
 // Groups firstGroup.. of 8 masses: group g starts at 8 octets[g], or at 8 g without a list. A
 // check must have its origin fixed (checkedWholePass).
 FLEXFIT_AVX512 void integrate512(const PartModel& model, const MassUpdate& p, PartState& state, const Index* octets,
@@ -287,9 +319,8 @@ FLEXFIT_AVX512 void integrate512(const PartModel& model, const MassUpdate& p, Pa
     const double* rest = model.restPositions.data()->data();
     alignas(64) double gravity[24];
     for (int j = 0; j < 24; ++j) gravity[j] = p.gravity[j % 3];
-    const __m512d h = _mm512_set1_pd(p.h), invH = _mm512_set1_pd(p.invH), drag = _mm512_set1_pd(p.drag);
-    const __m512d anchor = _mm512_set1_pd(p.anchorStiffness), constraint = _mm512_set1_pd(p.constraint);
-    const bool anchored = p.anchorStiffness != 0.0, readsRest = p.readsRest();
+    const CoordinateStep8 step = coordinateStep8(p);
+    const bool readsRest = p.readsRest();
     __m512d origin[3] = {};
     if (check != nullptr) {
         const auto at = originPattern<8>(*check);
@@ -300,30 +331,15 @@ FLEXFIT_AVX512 void integrate512(const PartModel& model, const MassUpdate& p, Pa
     for (std::size_t g = firstGroup; g < groups; ++g) {
         const std::size_t i = 8 * (octets != nullptr ? std::size_t(octets[g]) : g);
         const __m512d mass = _mm512_loadu_pd(model.mass.data() + i);
-        const __m512d hOverMass = _mm512_mul_pd(h, _mm512_loadu_pd(model.inverseMass.data() + i));
+        const __m512d hOverMass = _mm512_mul_pd(step.h, _mm512_loadu_pd(model.inverseMass.data() + i));
         const std::uint32_t heldLanes = held != nullptr ? kSpread3[heldBits8(held + i)] : 0u;
         for (int j = 0; j < 3; ++j) {
             const std::size_t o = 3 * i + 8 * std::size_t(j);
             const __m512d m = spread8(mass, j), hm = spread8(hOverMass, j);
             const __m512d xo = _mm512_loadu_pd(x + o), vo = _mm512_loadu_pd(v + o);
             const __m512d r = readsRest ? _mm512_loadu_pd(rest + o) : _mm512_setzero_pd();
-            // total = f + ((m g - drag v) - k_a (x - rest)), as MassUpdate::bodyForce
-            __m512d body = _mm512_sub_pd(_mm512_mul_pd(m, _mm512_load_pd(gravity + 8 * j)), _mm512_mul_pd(drag, vo));
-            if (anchored) body = _mm512_sub_pd(body, _mm512_mul_pd(anchor, _mm512_sub_pd(xo, r)));
-            const __m512d total = _mm512_add_pd(_mm512_loadu_pd(f + o), body);
             __m512d xn, vn;
-            if (p.semiImplicit) {
-                vn = _mm512_add_pd(vo, _mm512_mul_pd(hm, total));
-                xn = _mm512_add_pd(xo, _mm512_mul_pd(h, vn));
-            } else {
-                xn = _mm512_add_pd(xo, _mm512_mul_pd(h, vo));
-                vn = _mm512_add_pd(vo, _mm512_mul_pd(hm, total));
-            }
-            if (p.constraint > 0.0) {
-                const __m512d correction = _mm512_mul_pd(constraint, _mm512_sub_pd(r, xn));
-                xn = _mm512_add_pd(xn, correction);
-                vn = _mm512_add_pd(vn, _mm512_mul_pd(invH, correction));
-            }
+            stepCoordinate8(step, m, hm, _mm512_load_pd(gravity + 8 * j), xo, vo, _mm512_loadu_pd(f + o), r, xn, vn);
             if (heldLanes != 0) {  // masses no zone covers: back to rest, as holdAtRest puts them
                 const auto atRest = __mmask8((heldLanes >> (8 * j)) & 0xffu);
                 xn = _mm512_mask_loadu_pd(xn, atRest, rest + o);
@@ -406,9 +422,8 @@ FLEXFIT_AVX512 void integrateListed512(const PartModel& model, const MassUpdate&
     double* v = state.velocities.data()->data();
     double* f = state.forces.data()->data();
     const double* rest = model.restPositions.data()->data();
-    const __m512d h = _mm512_set1_pd(p.h), invH = _mm512_set1_pd(p.invH), drag = _mm512_set1_pd(p.drag);
-    const __m512d anchor = _mm512_set1_pd(p.anchorStiffness), constraint = _mm512_set1_pd(p.constraint);
-    const bool anchored = p.anchorStiffness != 0.0, readsRest = p.readsRest();
+    const CoordinateStep8 step = coordinateStep8(p);
+    const bool readsRest = p.readsRest();
     const __m512i carry = _mm512_set1_epi64(check != nullptr ? std::int64_t(check->carry) : 0);
     __m512i beyond = _mm512_setzero_si512();
     for (std::size_t k = 0; k < masses.size(); k += 8) {
@@ -431,26 +446,11 @@ FLEXFIT_AVX512 void integrateListed512(const PartModel& model, const MassUpdate&
         transposeRows8(vr, vo[0], vo[1], vo[2]);
         transposeRows8(fr, fo[0], fo[1], fo[2]);
         transposeRows8(rr, r[0], r[1], r[2]);
-        const __m512d mass = _mm512_load_pd(massLanes), hm = _mm512_mul_pd(h, _mm512_load_pd(inverseLanes));
+        const __m512d mass = _mm512_load_pd(massLanes), hm = _mm512_mul_pd(step.h, _mm512_load_pd(inverseLanes));
         alignas(64) double xn[3][8], vn[3][8];
         for (int j = 0; j < 3; ++j) {
-            // total = f + ((m g - drag v) - k_a (x - rest)), as MassUpdate::bodyForce
-            __m512d body = _mm512_sub_pd(_mm512_mul_pd(mass, _mm512_set1_pd(p.gravity[j])), _mm512_mul_pd(drag, vo[j]));
-            if (anchored) body = _mm512_sub_pd(body, _mm512_mul_pd(anchor, _mm512_sub_pd(xo[j], r[j])));
-            const __m512d total = _mm512_add_pd(fo[j], body);
             __m512d xj, vj;
-            if (p.semiImplicit) {
-                vj = _mm512_add_pd(vo[j], _mm512_mul_pd(hm, total));
-                xj = _mm512_add_pd(xo[j], _mm512_mul_pd(h, vj));
-            } else {
-                xj = _mm512_add_pd(xo[j], _mm512_mul_pd(h, vo[j]));
-                vj = _mm512_add_pd(vo[j], _mm512_mul_pd(hm, total));
-            }
-            if (p.constraint > 0.0) {
-                const __m512d correction = _mm512_mul_pd(constraint, _mm512_sub_pd(r[j], xj));
-                xj = _mm512_add_pd(xj, correction);
-                vj = _mm512_add_pd(vj, _mm512_mul_pd(invH, correction));
-            }
+            stepCoordinate8(step, mass, hm, _mm512_set1_pd(p.gravity[j]), xo[j], vo[j], fo[j], r[j], xj, vj);
             if (check != nullptr) beyond = orBeyondBits8(beyond, xj, _mm512_set1_pd(check->origin[j]), carry);
             _mm512_store_pd(xn[j], xj);
             _mm512_store_pd(vn[j], vj);

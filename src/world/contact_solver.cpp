@@ -108,7 +108,6 @@ void solveNormal(SolverContact& c, double targetSpeed, Bodies& bodies) {
 
 }  // namespace
 
-
 // Rigid contacts; and a dynamic deforming body's contacts with rigid parts (its rigid motion
 // meets them as a rigid body's would; the response deforms it there).
 bool solvedByImpulses(const Bodies& bodies, BodyId a, BodyId b) {
