@@ -203,6 +203,7 @@ void applyPartKeywords(const py::kwargs& keywords, PartSettings& part, BodySetti
         else if (k == "contact_level") zones.contactLevel = integer();
         else if (k == "activity_threshold") zones.activityThreshold = number();
         else if (k == "rest_speed") zones.restSpeed = number();
+        else if (k == "reserved_zones") zones.reservedZones = integer();
         else if (!body && k == "time_step") sim.timeStep = number();
         else if (body && k == "motion") body->motion = enumFrom<MotionType>(value.cast<std::string>(), "motion");
         else if (body && k == "density") body->density = number();

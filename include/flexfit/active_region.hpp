@@ -52,6 +52,10 @@ public:
     // and its springs with no other moving end stop being computed; returns true then.
     bool uncover(Index mass);
 
+    // Room in every list for the whole model (its masses, springs and groups: about 60 bytes a
+    // spring), so that covering and uncovering never allocate (Part::reserveZones).
+    void reserveWholeModel();
+
     bool moves(Index mass) const { return coverCount_[mass] != 0; }
     bool empty() const { return masses_.empty(); }
     bool coversEveryMass() const { return masses_.size() == coverCount_.size(); }

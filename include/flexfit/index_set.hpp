@@ -44,6 +44,8 @@ public:
         slot_.resize(capacity, 0);
     }
     std::size_t capacity() const { return mark_.size(); }
+    // Room for `members` members in the list, so that inserting up to that many allocates nothing.
+    void reserve(std::size_t members) { members_.reserve(members); }
     std::size_t size() const { return members_.size(); }
     bool empty() const { return members_.empty(); }
 

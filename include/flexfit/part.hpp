@@ -66,6 +66,10 @@ struct ZoneSettings {
     // Step a region with stepFullModel, its other masses held at rest, whenever that costs less
     // (fullStepCostsLess): a part never costs much more than its whole model.
     bool fullStepWhenCheaper = true;
+    // Zones that can be open at once, from the first, with no allocation (Part::reserveZones at
+    // max(defaultLevel, contactLevel)): for a real-time loop whose first press must not allocate
+    // either. 0: each zone's lists grow the first time it opens. At most 65,535.
+    int reservedZones = 0;
 };
 
 struct PartSettings {
@@ -129,6 +133,14 @@ public:
     void retireZone(ZoneId zone);
     std::size_t zoneCount() const;
     std::vector<ZoneId> zoneIds() const;
+    // Room for `zones` zones open at once, each of level up to `level`, so that opening,
+    // re-levelling and retiring them allocate nothing from the first zone on (without it, a
+    // zone's lists grow the first time it opens: a haptic loop's first press allocates). Costs
+    // one walk of the level's ring from every face, to size the largest zone, and room for the
+    // whole model in the region's lists (about 60 bytes a spring). Nothing outside
+    // RigidDeformable mode. Throws InputError for a level outside [0, 255] or more than 65,535
+    // zones. A copy of the part starts without the room (it is scratch, as the spare lists are).
+    void reserveZones(std::size_t zones, int level);
 
     // --- Loads, for the next step ---
     // Mass indices here and below are the model's (PartModel::massOf gives a renumbered model's

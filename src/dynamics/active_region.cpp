@@ -71,6 +71,17 @@ ActiveRegion::ActiveRegion(const PartModel& model)
     blockGroups_.loose.reset(model);
 }
 
+void ActiveRegion::reserveWholeModel() {
+    if (model_ == nullptr) return;
+    masses_.reserve(model_->massCount());
+    springs_.reserve(model_->springCount());
+    octets_.vector.reserve(octets_.count.size());
+    octets_.loose.reserve(model_->massCount());
+    blockGroups_.vector.reserve(blockGroups_.count.size());
+    blockGroups_.loose.set.reserve(model_->springCount());
+    blockGroups_.loose.list.reserve(model_->springCount());
+}
+
 bool ActiveRegion::cover(Index mass) {
     if (coverCount_[mass]++ != 0) return false;
     masses_.insert(mass);

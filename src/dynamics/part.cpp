@@ -26,6 +26,20 @@ void checkZoneSettings(const ZoneSettings& z) {
     if (!(z.restSpeed >= 0.0) || !std::isfinite(z.restSpeed))
         throw InputError("zone settings", 0, "rest speed must be finite and >= 0");
     if (z.retireCheckInterval < 1) throw InputError("zone settings", 0, "retire check interval must be >= 1");
+    if (z.reservedZones < 0 || z.reservedZones > 65535) throw InputError("zone settings", 0, "reserved zones must be in [0, 65535]");
+}
+
+// The most masses a zone of `level` covers: its ring from the face with the largest, or a
+// single mass's where the model has no face.
+std::size_t largestZone(const PartModel& model, KRingWalker& walker, int level) {
+    if (level == 0) return 0;
+    std::vector<RingMember> ring;
+    std::size_t largest = model.massCount() > 0 ? 1 : 0;
+    for (const Face& f : model.mesh.faces) {
+        walker.collect(model.topology, f, level - 1, ring);
+        largest = std::max(largest, ring.size());
+    }
+    return largest;
 }
 
 }  // namespace
@@ -55,6 +69,7 @@ Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
     checkZoneSettings(settings_.zones);
     if (settings_.mode == PartMode::FullDeformable)  // every mass moves, always: the region is the mesh
         for (Index m = 0; m < model_->massCount(); ++m) region_.cover(m);
+    reserveZones(std::size_t(settings_.zones.reservedZones), std::max(settings_.zones.defaultLevel, settings_.zones.contactLevel));
 }
 
 Part::~Part() = default;
@@ -87,6 +102,7 @@ void Part::setSettings(const PartSettings& settings) {
     validateSettings(settings.simulation);
     checkZoneSettings(settings.zones);
     settings_ = settings;
+    reserveZones(std::size_t(settings_.zones.reservedZones), std::max(settings_.zones.defaultLevel, settings_.zones.contactLevel));
 }
 
 // --- Pose ---
@@ -223,6 +239,27 @@ void Part::retireZone(ZoneId id) {
     uncover(*it);
     keepSpare(std::move(*it));
     zones_.erase(it);
+}
+
+void Part::reserveZones(std::size_t zones, int level) {
+    if (level < 0 || level > 255) throw InputError(kPartSource, 0, "zone level " + std::to_string(level) + " is outside [0, 255]");
+    if (zones > 65535) throw InputError(kPartSource, 0, "cannot reserve " + std::to_string(zones) + " zones (at most 65,535)");
+    if (settings_.mode != PartMode::RigidDeformable || zones == 0) return;
+    const std::size_t members = largestZone(*model_, *walker_, level);
+    region_.reserveWholeModel();
+    changed_.reserve(model_->massCount());
+    walker_->reserve(members);
+    zones_.reserve(zones);
+    // Re-levelling a zone takes one list more than the open zones, for its old members.
+    const std::size_t lists = zones + 1;
+    spareZones_.reserve(lists);
+    auto makeRoom = [members](Zone& zone) {
+        zone.seeds.reserve(3);
+        zone.members.reserve(members);
+    };
+    for (Zone& zone : zones_) makeRoom(zone);
+    for (Zone& zone : spareZones_) makeRoom(zone);
+    while (zones_.size() + spareZones_.size() < lists) makeRoom(spareZones_.emplace_back());
 }
 
 Part::Zone Part::spareZone() {

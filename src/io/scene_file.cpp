@@ -412,6 +412,7 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     z.contactLevel = t.integer("contact_level", z.contactLevel, 0, 255);
     z.activityThreshold = t.positive("activity_threshold", z.activityThreshold);
     z.restSpeed = t.positive("rest_speed", z.restSpeed);
+    z.reservedZones = t.integer("reserved_zones", z.reservedZones, 0, 65535);
 
     p.body.motion = t.choice("motion", MotionType::Static);
     p.body.density = t.positive("density", 1.0);

@@ -27,6 +27,8 @@ public:
     void collect(const Topology& topology, std::span<const Index> seeds, int rings, std::vector<RingMember>& out);
 
     std::size_t lastVisited() const { return lastVisited_; }  // masses touched by the last query
+    // Room to visit `masses` masses with no allocation (Part::reserveZones).
+    void reserve(std::size_t masses) { visited_.reserve(masses); }
 
 private:
     IndexSet visited_;  // (V)

@@ -373,6 +373,13 @@ TEST(Part, BadInputIsRejected) {
     PartSettings bad;
     bad.zones.retireCheckInterval = 0;
     EXPECT_THROW(Part(model, bad), InputError);
+    PartSettings tooMany;
+    tooMany.zones.reservedZones = 65536;
+    EXPECT_THROW(Part(model, tooMany), InputError);
+    tooMany.zones.reservedZones = -1;
+    EXPECT_THROW(Part(model, tooMany), InputError);
+    EXPECT_THROW(part.reserveZones(10, 256), InputError);
+    EXPECT_THROW(part.reserveZones(65536, 2), InputError);
     EXPECT_TRUE(part.movingMasses().empty());  // nothing half-done by the failed calls
 }
 

@@ -104,6 +104,8 @@ TEST(SceneFile, ParsesEveryValueItStates) {
     EXPECT_EQ(s.parts[0].model->massCount(), 64u * 24u);
     EXPECT_EQ(s.parts[0].part.simulation.restoration.method, RestorationMethod::AnchorSprings);
     EXPECT_EQ(s.parts[0].part.zones.contactLevel, 3);
+    EXPECT_EQ(s.parts[0].part.zones.reservedZones, 0);
+    EXPECT_EQ(parseScene(withLine("name = \"mouth\"", "reserved_zones = 64"), "scene.toml", ".").parts[0].part.zones.reservedZones, 64);
     EXPECT_EQ(s.parts[1].body.motion, MotionType::Dynamic);
     EXPECT_EQ(s.parts[1].body.density, 0.01);
     EXPECT_EQ(s.parts[1].pose.translation, Vec3(0, 11, 0));
@@ -161,6 +163,8 @@ TEST(SceneFile, OutOfRangeValueIsReported) {
     EXPECT_NE(e.find(":18: part 2, key 'vertex_mass': must be > 0"), std::string::npos) << e;
     const std::string level = errorOf(withLine("name = \"ball\"", "contact_level = 300"));
     EXPECT_NE(level.find("key 'contact_level': must be in [0, 255]"), std::string::npos) << level;
+    const std::string reserved = errorOf(withLine("name = \"ball\"", "reserved_zones = -4"));
+    EXPECT_NE(reserved.find(":18: part 2, key 'reserved_zones': must be in [0, 65535]"), std::string::npos) << reserved;
 }
 
 TEST(SceneFile, UnknownChoiceListsTheOptions) {

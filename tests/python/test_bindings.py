@@ -94,6 +94,13 @@ def test_keyword_of_the_wrong_type_names_the_key():
         flexfit.World().add(flexfit.PartModel(flexfit.sphere(1, 1)), contact_level="three")
 
 
+def test_reserved_zones_are_a_part_keyword_checked_like_the_others():
+    world = flexfit.World()
+    world.add(flexfit.PartModel(flexfit.sphere(1, 1)), mode="rigid-deformable", reserved_zones=8)
+    with pytest.raises(flexfit.InputError, match="reserved zones must be in"):
+        flexfit.World().add(flexfit.PartModel(flexfit.sphere(1, 1)), reserved_zones=70000)
+
+
 def test_views_keep_their_owner_alive():
     world, m, _ = ball_on_torus()
     positions = world.part(m).positions

@@ -135,3 +135,37 @@ TEST_P(PressCycleAllocations, ARepeatedPressAllocatesNothing) {
 INSTANTIATE_TEST_SUITE_P(Queries, PressCycleAllocations,
                          ::testing::Values(RigidDeformableQuery::Faces, RigidDeformableQuery::PointShell),
                          [](const auto& query) { return std::string(query.param == RigidDeformableQuery::Faces ? "Faces" : "PointShell"); });
+
+// Zones reserved (ZoneSettings::reservedZones, Part::reserveZones): zones open, re-level and
+// retire with no allocation from the very first, a zone of the reserved level at every face
+// and every mass of the part (so the largest ring fits), with forces and steps between. The
+// same calls without the reservation allocate.
+long zoneCallsAllocations(int reserved) {
+    PartSettings settings;
+    settings.zones.defaultLevel = 2;
+    settings.zones.contactLevel = 4;
+    settings.zones.reservedZones = reserved;
+    Part part(buildPartModel(makeContainerMouth()), settings);
+    const PartModel& model = part.model();
+    std::vector<ZoneId> open;  // `reserved` zones at once, spread over the part, some re-levelled
+    open.reserve(std::size_t(reserved));
+    return allocationsIn([&] {
+        for (Index f = 0; f < model.faceCount(); ++f) part.retireZone(part.openZone(ZoneSeed::face(f), 4));
+        for (Index m = 0; m < model.massCount(); ++m) part.retireZone(part.openZone(ZoneSeed::mass(m), 4));
+        for (int z = 0; z < reserved; ++z) {
+            open.push_back(part.openZone(ZoneSeed::face(Index(std::size_t(z) * model.faceCount() / std::size_t(reserved))), 1 + z % 4));
+            if (z % 3 == 0) part.setZoneLevel(open.back(), 4);
+            if (z % 5 == 0) part.setZoneLevel(open.back(), 1);
+        }
+        for (int i = 0; i < 20; ++i) {
+            part.applyForce(Index(open.size() * 7 % model.massCount()), Vec3(0.0, 0.5, 0.0));
+            part.step();
+        }
+        for (ZoneId z : open) part.retireZone(z);
+    });
+}
+
+TEST(StepAllocations, ReservedZonesOpenReLevelAndRetireWithoutAllocatingFromTheFirst) {
+    EXPECT_GT(zoneCallsAllocations(0), 0);
+    EXPECT_EQ(zoneCallsAllocations(40), 0);
+}
