@@ -25,6 +25,10 @@ stage columns, as tools/ab_stages.py). Reports:
   tools/tail_repeats.py --flexfit new=build/release/apps/flexfit/flexfit \
       --flexfit 6d7824d=/tmp/base/build/apps/flexfit/flexfit \
       --scene examples/ball_torus_haptic.toml --runs 8 --csv bench/results/tail_repeats.csv
+
+`--without-key NAME=KEY` runs build NAME on a copy of each scene without the lines that set KEY
+(an older build that does not know a newer key, such as `reserved_zones`, which changes no
+state); the copy sits beside the scene, so its relative paths hold, and is removed after.
 """
 import argparse
 import csv
@@ -116,17 +120,39 @@ def summary(scene, name, runs):
     return row | dict(zip(COLUMNS, values)) | parts | {"state_hash": hashes[0]}
 
 
+def without_keys(run, strip):
+    """run(path, scene, out), on a copy of the scene without the keys strip[path] sets."""
+    def stripped(path, scene, out):
+        keys = strip.get(path)
+        if not keys:
+            return run(path, scene, out)
+        setting = re.compile(r"\s*(%s)\s*=" % "|".join(map(re.escape, keys)))
+        original = Path(scene)
+        copy = original.with_name(f".{original.stem}.without-keys.toml")
+        copy.write_text("".join(line for line in original.read_text().splitlines(keepends=True) if not setting.match(line)))
+        try:
+            return run(path, str(copy), out)
+        finally:
+            copy.unlink()
+    return stripped
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--flexfit", action="append", required=True, help="NAME=PATH of a flexfit build")
     ap.add_argument("--scene", action="append", required=True)
     ap.add_argument("--runs", type=int, default=6)
     ap.add_argument("--csv")
+    ap.add_argument("--without-key", action="append", default=[], help="NAME=KEY: build NAME runs the scenes without KEY")
     args = ap.parse_args()
     if args.runs < 2:
         raise SystemExit("give --runs 2 or more: the floor and the repeats compare runs")
     builds = [tuple(b.split("=", 1)) for b in args.flexfit]
-    results = alternating_runs(builds, args.scene, args.runs, run)  # (scene, build) -> [(times, hash, steps)]
+    strip = {}
+    for item in args.without_key:
+        name, key = item.split("=", 1)
+        strip.setdefault(dict(builds)[name], []).append(key)
+    results = alternating_runs(builds, args.scene, args.runs, without_keys(run, strip))  # (scene, build) -> [(times, hash, steps)]
     report([summary(scene, name, results[(scene, name)]) for scene in args.scene for name, _ in builds], args.csv)
 
 

@@ -5,6 +5,7 @@
 #include "core/lanes256.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <optional>
 #include <numeric>
@@ -12,6 +13,19 @@
 namespace flexfit::detail {
 namespace {
 
+// Whether every contact is one point-shell pair's, a rigid part's against a deformable one (a
+// tool pressed into a part: the haptic case). Such a pair's contacts name each mass once (one
+// sample a mass; PointShellCoherent tests), so no mass needs merging: each contact is its mass's
+// push and reaction, in order, as the general path would make them.
+std::atomic<int> mergedResponseScopes{0};
+
+bool onePointShellPair(std::span<const Contact> contacts, const Bodies& bodies) {
+    if (contacts.empty() || mergedResponseScopes.load(std::memory_order_relaxed) != 0) return false;
+    const Contact& first = contacts.front();
+    const Contact& last = contacts.back();  // contacts come grouped by pair
+    return first.partA == last.partA && first.partB == last.partB && first.massB != kNoMass &&
+           !bodies.parts[first.partA]->deforms() && bodies.parts[first.partB]->deforms();
+}
 
 // Zones at the contacted faces and each mass's deepest push, in first-contact order.
 void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& r) {
@@ -19,6 +33,17 @@ void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactRes
     r.pushBodies.clear();
     r.pushMasses.clear();
     r.pushDisplacements.clear();
+    if (onePointShellPair(contacts, bodies)) {
+        const BodyId id = contacts.front().partB;
+        Part& part = *bodies.parts[id];
+        for (const Contact& c : contacts) {
+            part.touchFace(c.faceB);
+            r.pushBodies.push_back(id);
+            r.pushMasses.push_back(c.massB);
+            r.pushDisplacements.push_back((-c.depth * 1.0) * c.normal);  // all of it on B, as below
+        }
+        return;
+    }
     // Pushes the face's masses, or only `mass` when the contact has one (point shell).
     auto pushFace = [&](BodyId id, Index face, Index mass, const Vec3& displacement) {
         Part& part = *bodies.parts[id];
@@ -197,6 +222,13 @@ void applyDeformableReactions(const StepContext& step, double dampingRatio, std:
             }
         }
     };
+    if (onePointShellPair(contacts, bodies)) {
+        const BodyId body = contacts.front().partA, part = contacts.front().partB;
+        if (ReactingSides(bodies, body, part).bodyA)
+            for (const Contact& c : contacts) r.reactions.push_back({body, part, c.massB});
+        applyReactionForces(step, dampingRatio, bodies, r);
+        return;
+    }
     std::optional<ReactingSides> sides;
     BodyId a = 0, b = 0;
     for (const Contact& c : contacts) {
@@ -227,10 +259,15 @@ double effectiveContactStiffness(const Part& part, double timeStep) {
     return springs;
 }
 
+ScopedMergedResponse::ScopedMergedResponse() { mergedResponseScopes.fetch_add(1, std::memory_order_relaxed); }
+ScopedMergedResponse::~ScopedMergedResponse() { mergedResponseScopes.fetch_sub(1, std::memory_order_relaxed); }
+
 void sizeResponseScratch(const Bodies& bodies, ContactResponse& r) {
     const std::size_t masses = bodies.massCount();
     r.pushed.growTo(masses);
+    r.pushed.reserve(masses);
     r.reacting.growTo(masses);
+    r.reacting.reserve(masses);
     r.reactionOwner.resize(masses, 0u);
     r.reactionCount.resize(bodies.size(), 0u);
     // Each list holds a mass at most once (per body for the reactions): no step reallocates.

@@ -59,6 +59,9 @@ struct ContactResponse {
 };
 
 // Deformable pushes, then the reactions dynamic bodies feel, for the contacts of this step.
+// Where every contact is one point-shell pair's (a rigid tool in a deformable part), each names
+// its own mass, so each is its mass's push and reaction as it stands: the sets that merge a
+// mass's contacts are skipped (on the haptic scene's heaviest steps, a quarter of the stage).
 void respondToContacts(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
                        ContactResponse& response);
 
@@ -71,5 +74,15 @@ void sizeResponseScratch(const Bodies& bodies, ContactResponse& response);
 // The deformable pushes alone (zones at the contacted faces, masses moved out): for a body
 // pressing parts in the middle of its sub-steps.
 void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response);
+
+// While at least one scope is alive (on any thread), every response merges its contacts through
+// the sets, one point-shell pair's too: the second implementation the tests compare with.
+class ScopedMergedResponse {
+public:
+    ScopedMergedResponse();
+    ~ScopedMergedResponse();
+    ScopedMergedResponse(const ScopedMergedResponse&) = delete;
+    ScopedMergedResponse& operator=(const ScopedMergedResponse&) = delete;
+};
 
 }  // namespace flexfit::detail

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <optional>
 #include <limits>
+#include <set>
 
 using namespace flexfit;
 using flexfit::testing::rigidPart;
@@ -343,4 +344,58 @@ TEST(ContactResponse, FrictionlessReactionsFourAtATimeGiveTheSameBits) {
     EXPECT_EQ(vector.linear, scalar.linear);
     EXPECT_EQ(vector.angular, scalar.angular);
     EXPECT_EQ(vector.hash, scalar.hash);
+}
+
+TEST(ContactResponse, OnePointShellPairGivesWhatMergingEveryContactGives) {
+    // A dynamic ball falling into a deformable rim by the point shell: every contact is that one
+    // pair's, so the response takes each as its mass's push and reaction (no merging sets). The
+    // same run through the merging path (ScopedMergedResponse, the second implementation): every
+    // step's contacts, reported force and ball velocity, and the state hash, bit for bit; with
+    // and without friction (reactions four at a time, and one by one).
+    struct Run {
+        std::vector<Vec3> reported, linear;
+        std::size_t mostContacts = 0, pointContacts = 0;
+        bool eachMassOnce = true;
+        std::uint64_t hash = 0;
+    };
+    auto run = [](bool merged, double friction) {
+        std::optional<detail::ScopedMergedResponse> merging;
+        if (merged) merging.emplace();
+        WorldSettings settings;
+        settings.collision.rigidDeformable = RigidDeformableQuery::PointShell;
+        World world(settings);
+        PartSettings rim;
+        rim.simulation.restoration = {RestorationMethod::AnchorSprings, 4.0, 0.5, 0.0};
+        rim.zones.contactLevel = 3;
+        BodySettings fixed;
+        fixed.staticFriction = friction;
+        world.add(buildPartModel(makeContainerMouth(), {Material::rigid(), 1.0, {}, {}, {}, {}}), rim, fixed, Pose{});
+        BodySettings ballBody = flexfit::testing::dynamicBody(Vec3(0.2, -30.0, 0.1));
+        ballBody.density = 0.01;
+        ballBody.staticFriction = friction;
+        const BodyId ball = world.add(buildPartModel(makeIcoSphere(8.5, 2)), rigidPart(), ballBody, flexfit::testing::at(Vec3(0.3, 5.2, 0.0)));
+        Run r;
+        for (int i = 0; i < 250; ++i) {
+            world.step();
+            std::set<Index> masses;
+            for (const Contact& c : world.contacts()) {
+                r.pointContacts += c.massB != kNoMass;
+                r.eachMassOnce = r.eachMassOnce && masses.insert(c.massB).second;
+            }
+            r.mostContacts = std::max(r.mostContacts, world.contacts().size());
+            r.reported.push_back(world.body(ball).deformableContactForce);
+            r.linear.push_back(world.body(ball).linearVelocity);
+        }
+        r.hash = world.stateHash();
+        return r;
+    };
+    for (const double friction : {0.0, 0.4}) {
+        const Run direct = run(false, friction), merged = run(true, friction);
+        ASSERT_GT(direct.mostContacts, 20u) << friction;
+        EXPECT_TRUE(direct.eachMassOnce) << friction;
+        EXPECT_EQ(direct.pointContacts, merged.pointContacts) << friction;
+        EXPECT_EQ(direct.reported, merged.reported) << friction;
+        EXPECT_EQ(direct.linear, merged.linear) << friction;
+        EXPECT_EQ(direct.hash, merged.hash) << friction;
+    }
 }
