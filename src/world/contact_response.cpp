@@ -13,18 +13,20 @@
 namespace flexfit::detail {
 namespace {
 
-// Whether every contact is one point-shell pair's, a rigid part's against a deformable one (a
-// tool pressed into a part: the haptic case). Such a pair's contacts name each mass once (one
-// sample a mass; PointShellCoherent tests), so no mass needs merging: each contact is its mass's
-// push and reaction, in order, as the general path would make them.
-std::atomic<int> mergedResponseScopes{0};
+std::atomic<int> mergedResponseScopes{0};  // ScopedMergedResponse
 
+// Whether every contact is one point-shell pair's, a rigid part's against a deformable one (a
+// tool pressed into a part: the haptic case; checked contact by contact, a read of two ids each).
+// Such a pair's contacts name each mass once (one sample a mass; ContactResponse and
+// PointShellCoherent tests), so no mass needs merging: each contact is its mass's push and
+// reaction, in order, as the general path would make them.
 bool onePointShellPair(std::span<const Contact> contacts, const Bodies& bodies) {
     if (contacts.empty() || mergedResponseScopes.load(std::memory_order_relaxed) != 0) return false;
     const Contact& first = contacts.front();
-    const Contact& last = contacts.back();  // contacts come grouped by pair
-    return first.partA == last.partA && first.partB == last.partB && first.massB != kNoMass &&
-           !bodies.parts[first.partA]->deforms() && bodies.parts[first.partB]->deforms();
+    if (bodies.parts[first.partA]->deforms() || !bodies.parts[first.partB]->deforms()) return false;
+    return std::all_of(contacts.begin(), contacts.end(), [&](const Contact& c) {
+        return c.partA == first.partA && c.partB == first.partB && c.massB != kNoMass;
+    });
 }
 
 // Zones at the contacted faces and each mass's deepest push, in first-contact order.
