@@ -139,7 +139,8 @@ public:
     // one walk of the level's ring from every face, to size the largest zone, and room for the
     // whole model in the region's lists (about 60 bytes a spring). Nothing outside
     // RigidDeformable mode. Throws InputError for a level outside [0, 255] or more than 65,535
-    // zones. A copy of the part starts without the room (it is scratch, as the spare lists are).
+    // zones. Again with no more zones and no higher level (setSettings calls it), it does
+    // nothing. A copy of the part starts without the room (scratch, as the spare lists are).
     void reserveZones(std::size_t zones, int level);
 
     // --- Loads, for the next step ---
@@ -245,6 +246,8 @@ private:
 
     std::vector<Zone> zones_;
     std::vector<Zone> spareZones_;  // retired zones' lists (scratch: a copy starts without)
+    std::size_t reservedZones_ = 0; // what reserveZones has made room for (a copy: nothing)
+    int reservedLevel_ = -1;
     ZoneId nextZoneId_ = 1;
     ActiveRegion region_;
     std::vector<std::uint64_t> lastLoadStep_; // (V) step of the last force on each mass

@@ -245,6 +245,9 @@ void Part::reserveZones(std::size_t zones, int level) {
     if (level < 0 || level > 255) throw InputError(kPartSource, 0, "zone level " + std::to_string(level) + " is outside [0, 255]");
     if (zones > 65535) throw InputError(kPartSource, 0, "cannot reserve " + std::to_string(zones) + " zones (at most 65,535)");
     if (settings_.mode != PartMode::RigidDeformable || zones == 0) return;
+    if (zones <= reservedZones_ && level <= reservedLevel_) return;  // the room is there: no walk again
+    zones = std::max(zones, reservedZones_);
+    level = std::max(level, reservedLevel_);
     const std::size_t members = largestZone(*model_, *walker_, level);
     region_.reserveWholeModel();
     changed_.reserve(model_->massCount());
@@ -260,6 +263,8 @@ void Part::reserveZones(std::size_t zones, int level) {
     for (Zone& zone : zones_) makeRoom(zone);
     for (Zone& zone : spareZones_) makeRoom(zone);
     while (zones_.size() + spareZones_.size() < lists) makeRoom(spareZones_.emplace_back());
+    reservedZones_ = zones;
+    reservedLevel_ = level;
 }
 
 Part::Zone Part::spareZone() {

@@ -169,3 +169,19 @@ TEST(StepAllocations, ReservedZonesOpenReLevelAndRetireWithoutAllocatingFromTheF
     EXPECT_GT(zoneCallsAllocations(0), 0);
     EXPECT_EQ(zoneCallsAllocations(40), 0);
 }
+
+TEST(StepAllocations, ZonesReservedAgainAtAHigherLevelOpenWithoutAllocating) {
+    // Live settings that raise the zone level (or the count) make room again; the same settings
+    // again change nothing. Zones of the new level at every face, then 0 allocations.
+    PartSettings settings;
+    settings.zones.contactLevel = 2;
+    settings.zones.reservedZones = 4;
+    Part part(buildPartModel(makeContainerMouth()), settings);
+    settings.zones.contactLevel = 5;
+    part.setSettings(settings);
+    part.setSettings(settings);
+    EXPECT_EQ(allocationsIn([&] {
+                  for (Index f = 0; f < part.model().faceCount(); ++f) part.retireZone(part.openZone(ZoneSeed::face(f), 5));
+              }),
+              0);
+}
