@@ -137,7 +137,7 @@ public:
     // re-levelling and retiring them allocate nothing from the first zone on (without it, a
     // zone's lists grow the first time it opens: a haptic loop's first press allocates). Costs
     // one walk of the level's ring from every face, to size the largest zone, and room for the
-    // whole model in the region's lists (about 60 bytes a spring). Nothing outside
+    // whole model in the region's lists (about 45 bytes a spring). Nothing outside
     // RigidDeformable mode. Throws InputError for a level outside [0, 255] or more than 65,535
     // zones. Again with no more zones and no higher level (setSettings calls it), it does
     // nothing. A copy of the part starts without the room (scratch, as the spare lists are).
