@@ -52,7 +52,7 @@ public:
     // and its springs with no other moving end stop being computed; returns true then.
     bool uncover(Index mass);
 
-    // Room in every list for the whole model (its masses, springs and groups: about 60 bytes a
+    // Room in every list for the whole model (its masses, springs and groups: about 45 bytes a
     // spring), so that covering and uncovering never allocate (Part::reserveZones).
     void reserveWholeModel();
 

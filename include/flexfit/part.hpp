@@ -227,6 +227,7 @@ private:
     // zones opening and retiring in a running loop allocate nothing once warm.
     Zone spareZone();
     void keepSpare(Zone&& zone);
+    void reserveSettingsZones();  // settings_.zones.reservedZones at the part's largest zone level
     void collectMembers(Zone& zone);
     bool zoneAtRest(const Zone& zone) const;
     void markChanged(Index mass);

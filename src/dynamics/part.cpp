@@ -69,7 +69,7 @@ Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
     checkZoneSettings(settings_.zones);
     if (settings_.mode == PartMode::FullDeformable)  // every mass moves, always: the region is the mesh
         for (Index m = 0; m < model_->massCount(); ++m) region_.cover(m);
-    reserveZones(std::size_t(settings_.zones.reservedZones), std::max(settings_.zones.defaultLevel, settings_.zones.contactLevel));
+    reserveSettingsZones();
 }
 
 Part::~Part() = default;
@@ -102,7 +102,7 @@ void Part::setSettings(const PartSettings& settings) {
     validateSettings(settings.simulation);
     checkZoneSettings(settings.zones);
     settings_ = settings;
-    reserveZones(std::size_t(settings_.zones.reservedZones), std::max(settings_.zones.defaultLevel, settings_.zones.contactLevel));
+    reserveSettingsZones();
 }
 
 // --- Pose ---
@@ -265,6 +265,11 @@ void Part::reserveZones(std::size_t zones, int level) {
     while (zones_.size() + spareZones_.size() < lists) makeRoom(spareZones_.emplace_back());
     reservedZones_ = zones;
     reservedLevel_ = level;
+}
+
+void Part::reserveSettingsZones() {
+    const ZoneSettings& z = settings_.zones;
+    reserveZones(std::size_t(z.reservedZones), std::max(z.defaultLevel, z.contactLevel));
 }
 
 Part::Zone Part::spareZone() {

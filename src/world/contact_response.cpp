@@ -29,20 +29,21 @@ bool onePointShellPair(std::span<const Contact> contacts, const Bodies& bodies) 
     });
 }
 
-// Zones at the contacted faces and each mass's deepest push, in first-contact order.
-void collectPushes(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& r) {
+// Zones at the contacted faces and each mass's deepest push, in first-contact order (`onePair`:
+// onePointShellPair, so each contact is its mass's push).
+void collectPushes(std::span<const Contact> contacts, bool onePair, Bodies& bodies, ContactResponse& r) {
     r.pushed.clear();
     r.pushBodies.clear();
     r.pushMasses.clear();
     r.pushDisplacements.clear();
-    if (onePointShellPair(contacts, bodies)) {
+    if (onePair) {
         const BodyId id = contacts.front().partB;
         Part& part = *bodies.parts[id];
         for (const Contact& c : contacts) {
             part.touchFace(c.faceB);
             r.pushBodies.push_back(id);
             r.pushMasses.push_back(c.massB);
-            r.pushDisplacements.push_back((-c.depth * 1.0) * c.normal);  // all of it on B, as below
+            r.pushDisplacements.push_back((-c.depth) * c.normal);  // all of it on B: below's, shareA 0
         }
         return;
     }
@@ -207,10 +208,10 @@ struct ReactingSides {
     }
 };
 
-// Each (body, contacted mass) once, in first-contact order (deterministic); then each body
-// feels its masses' reactions, for the next step.
-void applyDeformableReactions(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
-                              ContactResponse& r) {
+// Each (body, contacted mass) once, in first-contact order (deterministic; `onePair`: each
+// contact is its mass's reaction); then each body feels its masses' reactions, for the next step.
+void applyDeformableReactions(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, bool onePair,
+                              Bodies& bodies, ContactResponse& r) {
     r.reacting.clear();
     for (const ContactResponse::Reaction& reaction : r.reactions) bodies.rigid[reaction.body].deformableContactForce.setZero();  // last step's
     r.reactions.clear();
@@ -224,7 +225,7 @@ void applyDeformableReactions(const StepContext& step, double dampingRatio, std:
             }
         }
     };
-    if (onePointShellPair(contacts, bodies)) {
+    if (onePair) {
         const BodyId body = contacts.front().partA, part = contacts.front().partB;
         if (ReactingSides(bodies, body, part).bodyA)
             for (const Contact& c : contacts) r.reactions.push_back({body, part, c.massB});
@@ -279,16 +280,25 @@ void sizeResponseScratch(const Bodies& bodies, ContactResponse& r) {
     r.reactions.reserve(masses);
 }
 
-void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response) {
-    sizeResponseScratch(bodies, response);  // once a response: respondToContacts starts here too
-    collectPushes(contacts, bodies, response);
+namespace {
+
+void pushAndDisplace(std::span<const Contact> contacts, bool onePair, Bodies& bodies, ContactResponse& response) {
+    sizeResponseScratch(bodies, response);  // once a response (a no-op once sized)
+    collectPushes(contacts, onePair, bodies, response);
     displacePushedMasses(bodies, response);
+}
+
+}  // namespace
+
+void pushDeformableMasses(std::span<const Contact> contacts, Bodies& bodies, ContactResponse& response) {
+    pushAndDisplace(contacts, onePointShellPair(contacts, bodies), bodies, response);
 }
 
 void respondToContacts(const StepContext& step, double dampingRatio, std::span<const Contact> contacts, Bodies& bodies,
                        ContactResponse& response) {
-    pushDeformableMasses(contacts, bodies, response);
-    applyDeformableReactions(step, dampingRatio, contacts, bodies, response);
+    const bool onePair = onePointShellPair(contacts, bodies);  // once: pushing changes no part's mode
+    pushAndDisplace(contacts, onePair, bodies, response);
+    applyDeformableReactions(step, dampingRatio, contacts, onePair, bodies, response);
 }
 
 }  // namespace flexfit::detail
