@@ -197,7 +197,8 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
     dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) {
         // Listing candidates means every leaf pair whose volumes overlap: no pruning then.
         auto prune = [&](Index fa, const auto& volumeB) { return !candidates && tester.prunes(fa, volumeB); };
-        traverse(bvhA, bvhB, bInA, stats, leafPair, prune, 0.0);
+        auto pruneA = [&](Index fb, const auto& volumeA) { return !candidates && tester.prunesByB(fb, volumeA); };
+        traverse(bvhA, bvhB, bInA, stats, leafPair, prune, 0.0, pruneA);
     });
     sortContacts(contacts, first);
 }

@@ -29,7 +29,8 @@ inline Sphere grown(const Sphere& s, double margin) { return {s.centre, s.radius
 inline Aabb grown(const Aabb& b, double margin) { return {b.min.array() - margin, b.max.array() + margin}; }
 
 // Simultaneous depth-first traversal; leafPair(faceA, faceB) for every overlapping leaf pair.
-// prune(faceA, volumeB) may cut a subtree of B that cannot touch A's leaf face. A margin > 0
+// prune(faceA, volumeB) may cut a subtree of B that cannot touch A's leaf face, and
+// pruneA(faceB, volumeA) a subtree of A that cannot touch B's leaf face. A margin > 0
 // grows A's volumes by it (for the coherent query's candidates); which side descends depends
 // on the volumes alone, not on the margin. traverseFrom() goes on from the node pairs left in
 // `stack` for about `budget` volume tests, and can be resumed (the coherent query spreads a traversal
@@ -87,9 +88,9 @@ std::size_t testLeafGroup(std::int32_t i, std::int32_t j, const Bvh<BA>& a, cons
     return stats.volumeTests - before;
 }
 
-template <bool kGrown, class BA, class BB, class LeafPair, class Prune>
+template <bool kGrown, class BA, class BB, class LeafPair, class Prune, class PruneA>
 void traverseFromImpl(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA,
-                      QueryStats& stats, LeafPair& leafPair, Prune& prune, double margin) {
+                      QueryStats& stats, LeafPair& leafPair, Prune& prune, PruneA& pruneA, double margin) {
     const auto& na = a.nodes();
     const auto& nb = b.nodes();
     const std::size_t group = leafGroup();
@@ -102,6 +103,7 @@ void traverseFromImpl(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a
         ++stats.volumeTests;
         if (!volumesOverlap<kGrown>(x.volume, y.volume, bInA, margin)) continue;
         if (x.isLeaf() && !y.isLeaf() && prune(x.item, y.volume)) continue;
+        if (y.isLeaf() && !x.isLeaf() && pruneA(y.item, x.volume)) continue;
         if (!(x.isLeaf() && y.isLeaf()) && a.itemCount(i) <= group && b.itemCount(j) <= group) {
             visited += testLeafGroup<kGrown>(i, j, a, b, bInA, stats, leafPair, margin);
             continue;
@@ -119,22 +121,28 @@ void traverseFromImpl(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a
     }
 }
 
-template <class BA, class BB, class LeafPair, class Prune>
+// No subtree of A pruned by B's leaf faces.
+struct NoPrune {
+    template <class Volume>
+    bool operator()(Index, const Volume&) const { return false; }
+};
+
+template <class BA, class BB, class LeafPair, class Prune, class PruneA = NoPrune>
 void traverseFrom(NodePairStack& stack, std::size_t budget, const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA,
-                  QueryStats& stats, LeafPair leafPair, Prune prune, double margin) {
+                  QueryStats& stats, LeafPair leafPair, Prune prune, double margin, PruneA pruneA = {}) {
     if (margin > 0.0)
-        traverseFromImpl<true>(stack, budget, a, b, bInA, stats, leafPair, prune, margin);
+        traverseFromImpl<true>(stack, budget, a, b, bInA, stats, leafPair, prune, pruneA, margin);
     else
-        traverseFromImpl<false>(stack, budget, a, b, bInA, stats, leafPair, prune, margin);
+        traverseFromImpl<false>(stack, budget, a, b, bInA, stats, leafPair, prune, pruneA, margin);
 }
 
-template <class BA, class BB, class LeafPair, class Prune>
+template <class BA, class BB, class LeafPair, class Prune, class PruneA = NoPrune>
 void traverse(const Bvh<BA>& a, const Bvh<BB>& b, const RelativePose& bInA, QueryStats& stats, LeafPair leafPair, Prune prune,
-              double margin) {
+              double margin, PruneA pruneA = {}) {
     if (a.empty() || b.empty()) return;
     thread_local NodePairStack stack;
     stack.assign(1, {0, 0});
-    traverseFrom(stack, std::numeric_limits<std::size_t>::max(), a, b, bInA, stats, leafPair, prune, margin);
+    traverseFrom(stack, std::numeric_limits<std::size_t>::max(), a, b, bInA, stats, leafPair, prune, margin, pruneA);
 }
 
 template <class Visit>
@@ -145,110 +153,176 @@ void dispatch(const PartCollider& a, const PartCollider& b, Visit visit) {
     return visit(*a.boxes(), *b.boxes());
 }
 
-// Cheap rejection before the triangle test, when A's face is at rest (its planes are cached
-// in A's frame, and moved to B's frame once per face and query): B's triangle entirely beyond
-// the face's plane (either side) or beyond one of its edge planes is separated from it along
-// that direction, and needs no transform. The margin is far wider than the triangle test's
-// own tolerance, so only pairs that test would also reject are skipped.
-class RestPlaneFilter {
+// One part's at-rest face planes moved to the other part's frame: each face's plane and edge
+// planes (PartCollider::restPlanes, cached in the part's own frame), moved once per face and
+// query. A face is at rest when its part is rigid or none of its masses moves: its vertices are
+// then where the rest planes were computed.
+class MovedFacePlanes {
 public:
-    // The planes moved to B's frame, kept between queries so a query allocates nothing: one
-    // per thread (restPlaneScratch()), handed to each filter once. Packed in the order the
-    // faces were first met (by their slot in `moved`): a query touches a few faces of a large
-    // part, and writing each one's 128 bytes into an array by face index missed the cache on
-    // every face (the filter's costliest instructions in a tool pressed into a 3,732-face part).
-    struct Scratch {
-        std::vector<std::array<Eigen::Vector4d, 4>> planesInB;  // by slot of `moved`
-        IndexSet moved;                                         // faces whose planes are in planesInB for this query
+    // Kept between queries so a query allocates nothing: one per thread and side, handed to each
+    // filter once. Packed in the order the faces were first met (by their slot in `moved`): a
+    // query touches a few faces of a large part, and writing each one's 128 bytes into an array
+    // by face index missed the cache on every face (the filter's costliest instructions in a
+    // tool pressed into a 3,732-face part).
+    // A face's planes in the other frame, and the rounding margin of each plane's tests (far
+    // wider than the triangle test's tolerance).
+    struct Planes {
+        std::array<Eigen::Vector4d, 4> planes;
+        std::array<double, 4> margins;
     };
-    RestPlaneFilter(const Part& a, const PartCollider& colliderA, const RelativePose& bInA, Scratch& scratch)
-        : a_(a), collider_(colliderA), bInA_(bInA), planesInB_(scratch.planesInB), movedPlanes_(scratch.moved) {
-        movedPlanes_.clear();
-        movedPlanes_.growTo(a.model().faceCount());
-        planesInB_.clear();
+    struct Scratch {
+        std::vector<Planes> planes;  // by slot of `moved`
+        IndexSet moved;              // faces whose planes are in `planes` for this query
+    };
+    // The planes of `part` moved to the other part's frame: A's to B's when `ofA`, else B's to A's.
+    MovedFacePlanes(const Part& part, const PartCollider& collider, const RelativePose& bInA, bool ofA, Scratch& scratch)
+        : part_(part), collider_(collider), bInA_(bInA), ofA_(ofA), planes_(scratch.planes), moved_(scratch.moved) {
+        moved_.clear();
+        moved_.growTo(part.model().faceCount());
+        planes_.clear();
     }
-    bool separated(Index fa, std::span<const Vec3> pb, const Face& fb) {
-        if (!atRest(fa)) return false;
-        const auto& planes = planesInB(fa);
+    bool rigid() const { return part_.mode() == PartMode::Rigid; }
+    bool atRest(Index face) const {
+        const Face& f = part_.model().mesh.faces[face];
+        return rigid() || !(part_.isMoving(f[0]) || part_.isMoving(f[1]) || part_.isMoving(f[2]));
+    }
+    // The face's planes in the other frame; the reference holds until the next call.
+    const Planes& of(Index face) {
+        if (!moved_.insert(face)) return planes_[moved_.slotOf(face)];
+        const auto& planes = collider_.restPlanes(face);
+        Planes& out = planes_.emplace_back();
+        auto& moved = out.planes;
+        for (std::size_t k = 0; k < planes.size(); ++k) {
+            out.margins[k] = 1e-9 * (1.0 + std::abs(planes[k][3]));
+            const Vec3 n = planes[k].head<3>();
+            // A's: n.(R x + t) = d  <=>  (R^T n).x = d - n.t. B's: n.x_B = d, x_B = R^T (x_A - t)
+            // <=>  (R n).x_A = d + (R n).t. R n is n itself when R is exactly the identity (the
+            // same values up to the sign of a zero, which no comparison here sees).
+            if (ofA_) {
+                const Vec3 turned = bInA_.pureTranslation ? n : Vec3(bInA_.rotation.transpose() * n);
+                moved[k] << turned, planes[k][3] - n.dot(bInA_.translation);
+            } else {
+                const Vec3 turned = bInA_.pureTranslation ? n : Vec3(bInA_.rotation * n);
+                moved[k] << turned, planes[k][3] + turned.dot(bInA_.translation);
+            }
+        }
+        return out;
+    }
+    // The other part's triangle (its positions, in its own frame) entirely beyond one of the
+    // face's planes by more than the margin (or behind its own plane).
+    bool triangleBeyond(Index face, std::span<const Vec3> positions, const Face& other) {
+        const auto& [planes, margins] = of(face);
         for (std::size_t k = 0; k < planes.size(); ++k) {
             const Vec3 n = planes[k].head<3>();
-            const double margin = 1e-9 * (1.0 + std::abs(collider_.restPlanes(fa)[k][3]));
-            const double d0 = n.dot(pb[fb[0]]) - planes[k][3], d1 = n.dot(pb[fb[1]]) - planes[k][3], d2 = n.dot(pb[fb[2]]) - planes[k][3];
-            if (d0 > margin && d1 > margin && d2 > margin) return true;
-            if (k == 0 && d0 < -margin && d1 < -margin && d2 < -margin) return true;
+            const double m = margins[k];
+            const double d0 = n.dot(positions[other[0]]) - planes[k][3], d1 = n.dot(positions[other[1]]) - planes[k][3],
+                         d2 = n.dot(positions[other[2]]) - planes[k][3];
+            if (d0 > m && d1 > m && d2 > m) return true;
+            if (k == 0 && d0 < -m && d1 < -m && d2 < -m) return true;
         }
         return false;
     }
-
-    // A subtree of B whose volume lies entirely beyond one of A's face planes holds no
-    // triangle the face can touch (each would be rejected by separated()).
-    template <class Volume>
-    bool separated(Index fa, const Volume& volumeB, double extra = 0.0) {
-        if (!atRest(fa)) return false;
-        const auto& planes = planesInB(fa);
-        for (std::size_t k = 0; k < planes.size(); ++k) {
-            const Vec3 n = planes[k].head<3>();
-            const double margin = 1e-9 * (1.0 + std::abs(collider_.restPlanes(fa)[k][3])) + extra;
-            const auto [lowest, highest] = extent(volumeB, n);
-            if (lowest - planes[k][3] > margin) return true;
-            if (k == 0 && highest - planes[k][3] < -margin) return true;
-        }
-        return false;
-    }
-
-    // How far B's triangle lies beyond one of the planes of A's face, less the margin
-    // separated() keeps: while A does not deform and B's vertices move less than that (in A's
-    // frame), separated() rejects the pair on that plane. 0 when no plane separates them, or A
-    // deforms.
-    // Stops early once the gap exceeds `enough`.
-    double separation(Index fa, std::span<const Vec3> pb, const Face& fb, double enough) {
-        if (a_.mode() != PartMode::Rigid) return 0.0;
-        const auto& planes = planesInB(fa);
+    // How far the other part's triangle lies beyond one of the face's planes, less the margin
+    // triangleBeyond() keeps (0 when none separates them); stops once it exceeds `enough`.
+    double gap(Index face, std::span<const Vec3> positions, const Face& other, double enough) {
+        const auto& [planes, margins] = of(face);
         double gap = 0.0;
         for (std::size_t k = 0; k < planes.size(); ++k) {
             const Vec3 n = planes[k].head<3>();
-            const double margin = 1e-9 * (1.0 + std::abs(collider_.restPlanes(fa)[k][3]));
-            const double d0 = n.dot(pb[fb[0]]) - planes[k][3], d1 = n.dot(pb[fb[1]]) - planes[k][3], d2 = n.dot(pb[fb[2]]) - planes[k][3];
-            gap = std::max(gap, std::min({d0, d1, d2}) - margin);
-            if (k == 0) gap = std::max(gap, -std::max({d0, d1, d2}) - margin);
+            const double d0 = n.dot(positions[other[0]]) - planes[k][3], d1 = n.dot(positions[other[1]]) - planes[k][3],
+                         d2 = n.dot(positions[other[2]]) - planes[k][3];
+            gap = std::max(gap, std::min({d0, d1, d2}) - margins[k]);
+            if (k == 0) gap = std::max(gap, -std::max({d0, d1, d2}) - margins[k]);
             if (gap > enough) break;
         }
         return gap * (1.0 - 1e-12);
     }
+    // A volume of the other part entirely beyond one of the face's planes by more than the
+    // margin and `extra` (or behind its own plane).
+    template <class Volume>
+    bool volumeBeyond(Index face, const Volume& volume, double extra) {
+        const auto& [planes, margins] = of(face);
+        for (std::size_t k = 0; k < planes.size(); ++k) {
+            const Vec3 n = planes[k].head<3>();
+            const double m = margins[k] + extra;
+            const auto [lowest, highest] = extent(volume, n);
+            if (lowest - planes[k][3] > m) return true;
+            if (k == 0 && highest - planes[k][3] < -m) return true;
+        }
+        return false;
+    }
 
 private:
-    bool atRest(Index fa) const {
-        const Face& f = a_.model().mesh.faces[fa];
-        return a_.mode() == PartMode::Rigid || !(a_.isMoving(f[0]) || a_.isMoving(f[1]) || a_.isMoving(f[2]));
-    }
     // Range of n.x over the volume.
-    static std::pair<double, double> extent(const Aabb& box, const Vec3& n) {
+    [[gnu::always_inline]] static std::pair<double, double> extent(const Aabb& box, const Vec3& n) {
         const double centre = n.dot(box.centre()), reach = n.cwiseAbs().dot(box.halfExtents());
         return {centre - reach, centre + reach};
     }
-    static std::pair<double, double> extent(const Sphere& sphere, const Vec3& n) {
+    [[gnu::always_inline]] static std::pair<double, double> extent(const Sphere& sphere, const Vec3& n) {
         const double centre = n.dot(sphere.centre);
         return {centre - sphere.radius, centre + sphere.radius};
     }
-    // n.(R x + t) = d  <=>  (R^T n).x = d - n.t; R^T n is n itself when R is exactly the
-    // identity (the same values up to the sign of a zero, which no comparison here sees).
-    // The reference holds until the next call.
-    const std::array<Eigen::Vector4d, 4>& planesInB(Index fa) {
-        if (!movedPlanes_.insert(fa)) return planesInB_[movedPlanes_.slotOf(fa)];
-        const auto& planes = collider_.restPlanes(fa);
-        auto& moved = planesInB_.emplace_back();
-        for (std::size_t k = 0; k < planes.size(); ++k) {
-            const Vec3 n = planes[k].head<3>();
-            const Vec3 turned = bInA_.pureTranslation ? n : Vec3(bInA_.rotation.transpose() * n);
-            moved[k] << turned, planes[k][3] - n.dot(bInA_.translation);
-        }
-        return moved;
-    }
-    const Part& a_;
+    const Part& part_;
     const PartCollider& collider_;
     const RelativePose& bInA_;
-    std::vector<std::array<Eigen::Vector4d, 4>>& planesInB_;
-    IndexSet& movedPlanes_;
+    bool ofA_;
+    std::vector<Planes>& planes_;
+    IndexSet& moved_;
+};
+
+// Cheap rejection before the triangle test, when a face of the pair is at rest: the other
+// triangle entirely beyond the at-rest face's plane (either side) or beyond one of its edge
+// planes is separated from it along that direction, and needs no transform (the planes are
+// moved to its frame instead, once per face and query). A's face's planes are tried first, then
+// B's: a large face at rest against a part of small ones (a rigid ball on the rigid container
+// mouth, whose faces are far smaller) rejects by its own planes most of the leaf pairs its box
+// meets. The margin is far wider than the triangle test's own tolerance, so only pairs that
+// test would also reject are skipped.
+class RestPlaneFilter {
+public:
+    struct Scratch {
+        MovedFacePlanes::Scratch ofA, ofB;
+    };
+    RestPlaneFilter(const Part& a, const PartCollider& colliderA, const Part& b, const PartCollider& colliderB, const RelativePose& bInA,
+                    Scratch& scratch)
+        : a_(a, colliderA, bInA, true, scratch.ofA), b_(b, colliderB, bInA, false, scratch.ofB) {}
+
+    // A's face fa (pa: A's positions) against B's face fb (pb: B's), each in its own frame; by
+    // B's face's planes too when `byB`.
+    bool separated(Index fa, Index fb, std::span<const Vec3> pa, std::span<const Vec3> pb, const Face& faceA, const Face& faceB,
+                   bool byB) {
+        return (a_.atRest(fa) && a_.triangleBeyond(fa, pb, faceB)) || (byB && b_.atRest(fb) && b_.triangleBeyond(fb, pa, faceA));
+    }
+
+    // A subtree of B whose volume lies entirely beyond one of A's face planes holds no
+    // triangle the face can touch (each would be rejected by separated()); `extra` widens the
+    // margin.
+    template <class Volume>
+    bool separated(Index fa, const Volume& volumeB, double extra = 0.0) {
+        return a_.atRest(fa) && a_.volumeBeyond(fa, volumeB, extra);
+    }
+    // The same for B's face and a subtree of A.
+    template <class Volume>
+    bool separatedByB(Index fb, const Volume& volumeA, double extra = 0.0) {
+        return b_.atRest(fb) && b_.volumeBeyond(fb, volumeA, extra);
+    }
+
+    // How far one face's triangle lies beyond one of the planes of the other face, a rigid
+    // part's (A's, then B's), less the margin separated() keeps: while the rigid parts do not
+    // deform and the faces move less than that against each other, separated() rejects the pair
+    // on that plane. 0 when no plane separates them, or neither part is rigid. Stops early once
+    // the gap exceeds `enough`.
+    double separation(Index fa, Index fb, std::span<const Vec3> pa, std::span<const Vec3> pb, const Face& faceA, const Face& faceB,
+                      double enough) {
+        double gap = a_.rigid() ? a_.gap(fa, pb, faceB, enough) : 0.0;
+        if (gap <= enough && b_.rigid()) gap = std::max(gap, b_.gap(fb, pa, faceA, enough));
+        return gap;
+    }
+    bool rigidA() const { return a_.rigid(); }
+    bool rigidB() const { return b_.rigid(); }
+
+private:
+    MovedFacePlanes a_, b_;
 };
 
 
@@ -291,12 +365,12 @@ public:
         : idA_(idA), idB_(idB), a_(a), b_(b), test_(test), sides_(facesSides(a, colliderA, b, colliderB)),
           bInA_(bInA), ra_(a.pose().rotation.toRotationMatrix()),
           pa_(a.state().positions), pb_(b.state().positions), facesA_(a.model().mesh.faces), facesB_(b.model().mesh.faces),
-          filter_(a, colliderA, bInA, scratch), contacts_(contacts), stats_(stats) {}
+          filter_(a, colliderA, b, colliderB, bInA, scratch), contacts_(contacts), stats_(stats) {}
 
     void operator()(Index fa, Index fb) {
         const Face& f = facesB_[fb];
         ++stats_.exactTests;
-        if (test_ == ExactTest::TriangleTriangle && filter_.separated(fa, pb_, f)) return;
+        if (test_ == ExactTest::TriangleTriangle && filter_.separated(fa, fb, pa_, pb_, facesA_[fa], f, planesOfB_)) return;
         const Triangle tb{bInA_.apply(pb_[f[0]]), bInA_.apply(pb_[f[1]]), bInA_.apply(pb_[f[2]])};
         std::optional<TriangleContact> hit;
         if (test_ == ExactTest::SphereTriangle) {
@@ -309,17 +383,28 @@ public:
         ++stats_.contacts;
         contacts_.push_back({idA_, idB_, fa, fb, a_.pose().apply(hit->point), ra_ * hit->normal, hit->depth});
     }
-    // Subtrees of B that A's at-rest leaf face cannot touch (RestPlaneFilter).
+    // Leaf pairs rejected by A's at-rest face's planes only, not by B's too: the coherent
+    // query's scans, whose candidates lay within the motion since of both faces' planes when
+    // taken: the planes of B's face rejected few of them, and testing them cost the rigid ball
+    // resting on the rigid mouth 0.7 µs of its 6 µs narrow phase a step.
+    void skipPlanesOfB() { planesOfB_ = false; }
+    // Subtrees of B that A's at-rest leaf face cannot touch, and of A that B's cannot
+    // (RestPlaneFilter).
     template <class Volume>
     bool prunes(Index fa, const Volume& volumeB) {
         return test_ == ExactTest::TriangleTriangle && filter_.separated(fa, volumeB);
     }
-    // Whether separationByA() measures a gap (A rigid, triangle test), or is always 0.
-    bool gapsByA() const { return test_ == ExactTest::TriangleTriangle && a_.mode() == PartMode::Rigid; }
-    // How far B's face may move (its vertices, in A's frame) before the exact test could find
-    // a contact with A's face (A rigid).
-    double separationByA(Index fa, Index fb, double enough) {
-        return test_ == ExactTest::TriangleTriangle ? filter_.separation(fa, b_.state().positions, b_.model().mesh.faces[fb], enough) : 0.0;
+    template <class Volume>
+    bool prunesByB(Index fb, const Volume& volumeA) {
+        return test_ == ExactTest::TriangleTriangle && filter_.separatedByB(fb, volumeA);
+    }
+    // Whether planeGap() measures a gap (A rigid, triangle test), or is always 0. (The world
+    // puts the rigid part first: B is rigid only when A is.)
+    bool gapsByA() const { return test_ == ExactTest::TriangleTriangle && filter_.rigidA(); }
+    // How far the two faces may move against each other before the exact test could find a
+    // contact, by the rigid parts' face planes (RestPlaneFilter::separation).
+    double planeGap(Index fa, Index fb, double enough) {
+        return test_ == ExactTest::TriangleTriangle ? filter_.separation(fa, fb, pa_, pb_, facesA_[fa], facesB_[fb], enough) : 0.0;
     }
     // How far A's face may move (its vertices, in B's frame) before it reaches the plane of B's
     // face as it is now, less a margin far above the exact test's tolerance: while it stays
@@ -362,6 +447,11 @@ public:
     bool prunesBeyond(Index fa, const Volume& volumeB, double margin) {
         return gapsByA() && filter_.separated(fa, volumeB, margin);
     }
+    // A's subtrees beyond a plane of B's (rigid) leaf face by more than `margin`.
+    template <class Volume>
+    bool prunesBeyondByB(Index fb, const Volume& volumeA, double margin) {
+        return test_ == ExactTest::TriangleTriangle && filter_.rigidB() && filter_.separatedByB(fb, volumeA, margin);
+    }
 
 private:
     std::uint32_t idA_, idB_;
@@ -369,6 +459,7 @@ private:
     const Part& b_;
     ExactTest test_;
     FaceSides sides_;  // how intersectTriangles reads the faces (facesSides)
+    bool planesOfB_ = true;  // the rest-plane filter tries B's face's planes too
     const RelativePose& bInA_;
     Eigen::Matrix3d ra_;
     std::span<const Vec3> pa_, pb_;

@@ -72,6 +72,26 @@ FacePairs contactPairs(const std::vector<Contact>& contacts) {
     return out;
 }
 
+// The pruned triangle query (A's leaves boxes) against brute force's contacts, with B's leaves
+// spheres and boxes; what each query found.
+struct PrunedQuery {
+    bool contacts = false;
+    std::size_t exactTests = 0, candidates = 0;  // leaf pairs the query tested, and that overlap
+};
+std::vector<PrunedQuery> expectPrunedQueryFindsBruteForcesContacts(const Part& a, const Part& b, int trial) {
+    std::vector<PrunedQuery> out;
+    for (BoundingVolumeKind kb : {BoundingVolumeKind::Sphere, BoundingVolumeKind::Aabb}) {
+        const PartCollider ca(a, BoundingVolumeKind::Aabb), cb(b, kb);
+        std::vector<Contact> contacts;
+        QueryStats stats;
+        queryPair(0, a, ca, 1, b, cb, ExactTest::TriangleTriangle, contacts, stats);
+        const BruteForce reference = bruteForce(a, b, BoundingVolumeKind::Aabb, kb, ExactTest::TriangleTriangle);
+        EXPECT_EQ(contactPairs(contacts), reference.contacts) << "trial " << trial << " " << toString(kb);
+        out.push_back({!contacts.empty(), stats.exactTests, reference.candidates.size()});
+    }
+    return out;
+}
+
 }  // namespace
 
 // The traversal's leaf groups (pair_query.hpp) change which volume tests run, never the result:
@@ -106,17 +126,46 @@ TEST_P(NarrowPhaseByLeafGroup, PlanePruningKeepsEveryContact) {
         }
         a.setPose(randomPose(rng, 0.6));
         b.setPose(randomPose(rng, 0.6));
-        for (BoundingVolumeKind kb : {BoundingVolumeKind::Sphere, BoundingVolumeKind::Aabb}) {
-            const PartCollider ca(a, BoundingVolumeKind::Aabb), cb(b, kb);
-            std::vector<Contact> contacts;
-            QueryStats stats;
-            queryPair(0, a, ca, 1, b, cb, ExactTest::TriangleTriangle, contacts, stats);
-            EXPECT_EQ(contactPairs(contacts), bruteForce(a, b, BoundingVolumeKind::Aabb, kb, ExactTest::TriangleTriangle).contacts)
-                << "trial " << trial;
-            withContacts += !contacts.empty();
+        for (const PrunedQuery& q : expectPrunedQueryFindsBruteForcesContacts(a, b, trial)) withContacts += q.contacts;
+    }
+    EXPECT_GT(withContacts, 8);
+}
+
+TEST_P(NarrowPhaseByLeafGroup, PruningByBsFacePlanesKeepsEveryContact) {
+    // A part of small faces (A) against one of large faces (B): the query prunes A's subtrees,
+    // and rejects leaf pairs, by the planes of B's faces at rest. A is full-deformable, so none
+    // of its faces is at rest and only B's planes prune; B is rigid, at rest, or deformed around
+    // a mass (those faces not at rest). The contacts must be exactly the brute force's, and the
+    // pruning must leave the exact test fewer leaf pairs than overlap (with the default leaf
+    // groups or smaller).
+    const detail::ScopedLeafGroup grouping(GetParam());
+    std::mt19937 rng(12);
+    int withContacts = 0, pruned = 0;
+    for (int trial = 0; trial < 12; ++trial) {
+        const auto ma = buildPartModel(perturbed(makeTorus(1.0, 0.35, 32, 16), 0.01, rng));
+        const auto mb = buildPartModel(perturbed(makeIcoSphere(0.8, 1), 0.05, rng));
+        PartSettings full, rigid;
+        full.mode = PartMode::FullDeformable;
+        rigid.mode = PartMode::Rigid;
+        Part a(ma, full), b(mb, trial % 3 == 0 ? rigid : PartSettings{});
+        a.applyForce(0, Vec3(0.3, 0.2, -0.1));
+        a.step();
+        if (trial % 3 == 2) {
+            b.applyForce(0, Vec3(-0.2, 0.3, 0.1));  // a zone around mass 0: B's faces there move
+            b.step();
+        }
+        a.setPose(randomPose(rng, 0.5));
+        b.setPose(randomPose(rng, 0.5));
+        for (const PrunedQuery& q : expectPrunedQueryFindsBruteForcesContacts(a, b, trial)) {
+            withContacts += q.contacts;
+            pruned += q.exactTests < q.candidates;
         }
     }
     EXPECT_GT(withContacts, 8);
+    // Leaf groups larger than B's lower subtrees test their leaf pairs without pruning.
+    if (GetParam() <= detail::kDefaultLeafGroup) {
+        EXPECT_GT(pruned, 12);
+    }
 }
 
 TEST_P(NarrowPhaseByLeafGroup, CandidatesAndContactsEqualBruteForce) {
