@@ -52,6 +52,16 @@ public:
     // and its springs with no other moving end stop being computed; returns true then.
     bool uncover(Index mass);
 
+    // One zone fewer covers `mass`, unless it is the last: then nothing changes and it returns
+    // true, and the caller uncovers it later (uncover) or empties the region (clear). A batch of
+    // retiring zones defers its region bookkeeping so: the masses whose last zone retires are
+    // uncovered afterwards in the same order, which makes the same lists as uncovering each at
+    // once (every test the lists make reads the counts of masses not yet uncovered as non-zero).
+    bool uncoverUnlessLast(Index mass);
+    // Empties the region: every mass stops moving, every list is empty (a new region's state,
+    // the room kept). O(its masses and springs).
+    void clear();
+
     // Room in every list for the whole model (its masses, springs and groups: about 45 bytes a
     // spring), so that covering and uncovering never allocate (Part::reserveZones).
     void reserveWholeModel();

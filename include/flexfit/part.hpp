@@ -252,6 +252,7 @@ private:
     ZoneId nextZoneId_ = 1;
     ActiveRegion region_;
     std::vector<std::uint64_t> lastLoadStep_; // (V) step of the last force on each mass
+    std::vector<Index> retiring_;             // scratch: masses whose last zone retires (retireRestingZones)
     mutable IndexSet changed_;                // (V) masses changed since clearChangedMasses()
     mutable bool regionStepped_ = false;      // the region's masses moved and are not in changed_ yet
     // Every mass changed (a step moved them all): O(1) instead of marking each.

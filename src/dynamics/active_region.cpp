@@ -100,6 +100,30 @@ bool ActiveRegion::uncover(Index mass) {
     return true;
 }
 
+bool ActiveRegion::uncoverUnlessLast(Index mass) {
+    if (coverCount_[mass] == 1) return true;
+    --coverCount_[mass];
+    return false;
+}
+
+void ActiveRegion::clear() {
+    for (Index m : masses_) {
+        coverCount_[m] = 0;
+        if (const Index octet = octetOf(m); octet != kNoGroup) octets_.count[octet] = 0;
+    }
+    for (Index e : springs_) {
+        movingEnds_[e] = 0;
+        if (const Index block = blockOf(e); block != kNoGroup) blockGroups_.count[block] = 0;
+    }
+    masses_.clear();
+    springs_.clear();
+    octets_.vector.clear();
+    octets_.loose.clear();
+    blockGroups_.vector.clear();
+    blockGroups_.loose.set.clear();
+    blockGroups_.loose.list.clear();
+}
+
 Index ActiveRegion::blockOf(Index spring) const {
     if (blocks_ == nullptr) return kNoGroup;
     const Index lane = blocks_->laneOfSpring[spring];

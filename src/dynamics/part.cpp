@@ -251,6 +251,7 @@ void Part::reserveZones(std::size_t zones, int level) {
     const std::size_t members = largestZone(*model_, *walker_, level);
     region_.reserveWholeModel();
     changed_.reserve(model_->massCount());
+    retiring_.reserve(model_->massCount());
     walker_->reserve(members);
     zones_.reserve(zones);
     // Re-levelling a zone takes one list more than the open zones, for its old members.
@@ -450,16 +451,29 @@ void Part::retireRestingZones() {
     // Nothing moves: nothing to retire, in O(1) (an untouched part costs nothing here either).
     if (settings_.mode != PartMode::RigidDeformable || region_.empty()) return;
     if (state_.stepCount % std::uint64_t(settings_.zones.retireCheckInterval) != 0) return;
+    // Each retiring zone's masses return to rest as it retires (the next zones' checks read
+    // them), but the region's lists wait until every zone is checked (no check reads them): when
+    // every zone retired, the region is emptied at once (a scene's zones often come to rest
+    // together, and that step was the slowest outside contact: the lists' churn of blocks
+    // dropping below their minimum and back); otherwise the masses whose last zone retired are
+    // uncovered in the order they retired, which makes the same lists (uncoverUnlessLast).
+    retiring_.clear();
     for (std::size_t z = 0; z < zones_.size();) {
         const Zone& zone = zones_[z];
         if (zoneAtRest(zone)) {
-            uncover(zone);
+            for (const RingMember& m : zone.members)
+                if (region_.uncoverUnlessLast(m.mass)) {
+                    returnToRest(m.mass);
+                    retiring_.push_back(m.mass);
+                }
             keepSpare(std::move(zones_[z]));
             zones_.erase(zones_.begin() + std::ptrdiff_t(z));
         } else {
             ++z;
         }
     }
+    if (zones_.empty()) return region_.clear();
+    for (Index m : retiring_) region_.uncover(m);
 }
 
 // --- Read-out ---

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <random>
 #include <set>
 
@@ -192,4 +193,75 @@ TEST(ActiveRegion, WithoutBlocksEveryComputedSpringIsLoose) {
     EXPECT_EQ(std::vector<Index>(region.looseSprings().members().begin(), region.looseSprings().members().end()),
               std::vector<Index>(region.springs().members().begin(), region.springs().members().end()));
     expectListedSlotForSlot(*model, region);
+}
+
+namespace {
+
+// Every list of the region, in order: equal lists mean the region steps alike.
+void expectSameLists(const ActiveRegion& x, const ActiveRegion& y, const char* when) {
+    auto same = [&](const IndexSet& a, const IndexSet& b, const char* what) {
+        EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << what << " " << when;
+    };
+    same(x.masses(), y.masses(), "masses");
+    same(x.springs(), y.springs(), "springs");
+    same(x.vectorBlocks(), y.vectorBlocks(), "vector blocks");
+    same(x.looseSprings(), y.looseSprings(), "loose springs");
+    same(x.vectorOctets(), y.vectorOctets(), "vector octets");
+    same(x.looseMasses(), y.looseMasses(), "loose masses");
+    EXPECT_TRUE(std::ranges::equal(x.coverCounts(), y.coverCounts())) << "cover counts " << when;
+    EXPECT_TRUE(std::ranges::equal(x.looseSpringList().springA, y.looseSpringList().springA)) << "loose list " << when;
+}
+
+// Zones as runs of masses, some overlapping, in random order.
+std::vector<std::vector<Index>> randomZones(const PartModel& model, std::mt19937& rng, int count) {
+    std::vector<std::vector<Index>> zones(std::size_t(count), std::vector<Index>{});
+    for (auto& zone : zones) {
+        const Index start = Index(rng() % model.massCount()), length = Index(8 + rng() % 60);
+        for (Index m = start; m < std::min<Index>(start + length, model.massCount()); ++m) zone.push_back(m);
+    }
+    return zones;
+}
+
+}  // namespace
+
+// A batch of zones retiring: uncoverUnlessLast for each zone's masses, then uncover of the
+// masses whose last zone went, in that order, makes exactly the lists that uncovering each
+// zone's masses at once makes (the reference); when every zone goes, clear() leaves a region
+// that then fills exactly as one emptied mass by mass does.
+TEST(ActiveRegion, ADeferredBatchOfUncoversMakesTheSameListsAsUncoveringAtOnce) {
+    for (const auto& model : {buildPartModel(makeTorus1()), buildPartModel(makeTorus2())}) {
+        std::mt19937 rng(17);
+        for (int trial = 0; trial < 20; ++trial) {
+            const auto zones = randomZones(*model, rng, 12);
+            ActiveRegion atOnce(*model), deferred(*model);
+            for (const auto& zone : zones)
+                for (Index m : zone) atOnce.cover(m), deferred.cover(m);
+            // Retire all zones but every third (trial even) or every zone (odd), in random order.
+            std::vector<std::size_t> order(zones.size());
+            std::iota(order.begin(), order.end(), 0);
+            std::shuffle(order.begin(), order.end(), rng);
+            const bool all = trial % 2 == 1;
+            std::vector<Index> retiring;
+            for (std::size_t z : order) {
+                if (!all && z % 3 == 0) continue;
+                for (Index m : zones[z]) {
+                    atOnce.uncover(m);
+                    if (deferred.uncoverUnlessLast(m)) retiring.push_back(m);
+                }
+            }
+            if (all) {
+                EXPECT_EQ(retiring.size(), deferred.masses().size());
+                deferred.clear();
+                EXPECT_TRUE(deferred.empty());
+                EXPECT_TRUE(deferred.springs().empty());
+            } else {
+                for (Index m : retiring) deferred.uncover(m);
+            }
+            expectSameLists(atOnce, deferred, "after the batch");
+            // New zones after: the same lists again.
+            for (const auto& zone : randomZones(*model, rng, 4))
+                for (Index m : zone) atOnce.cover(m), deferred.cover(m);
+            expectSameLists(atOnce, deferred, "after new zones");
+        }
+    }
 }

@@ -177,6 +177,55 @@ TEST(Part, ZonesOpenedOnRetiredZonesListsCoverWhatFreshZonesCover) {
     EXPECT_EQ(part.state().positions, model->restPositions);
 }
 
+TEST(Part, ZonesRetiringTogetherLeaveThePartAsRetiringThemOneByOne) {
+    // retireRestingZones retires a step's resting zones as a batch (its region bookkeeping
+    // deferred, or the region emptied at once when every zone goes); retireZone, one zone at a
+    // time in the same order, is the reference. The lists, then the state after new zones and
+    // loads, must be the same bit for bit: every zone at rest, or all but a loaded one.
+    const auto model = buildPartModel(makeTorus2());
+    const Index seeds[] = {77, 300, 301, 700, 1000, 1010, 1500};  // of 1,566 masses
+    for (const bool keepOne : {false, true}) {
+        PartSettings batch = zoneSettings(), reference = zoneSettings();
+        batch.zones.retireCheckInterval = 1;
+        reference.zones.retireCheckInterval = 1 << 30;
+        Part x(model, batch), y(model, reference);
+        std::vector<ZoneId> ids;
+        for (std::size_t k = 0; k < std::size(seeds); ++k) {
+            ids.push_back(x.openZone(ZoneSeed::mass(seeds[k]), 3 + int(k % 4)));
+            y.openZone(ZoneSeed::mass(seeds[k]), 3 + int(k % 4));
+        }
+        if (keepOne) {
+            x.applyForce(1000, Vec3(0, 0.3, 0));
+            y.applyForce(1000, Vec3(0, 0.3, 0));
+        }
+        x.step();  // at rest, never loaded: every zone but the loaded one retires in the step
+        y.step();
+        for (std::size_t k = 0; k < ids.size(); ++k)
+            if (!(keepOne && seeds[k] == 1000)) y.retireZone(ids[k]);
+        ASSERT_EQ(x.zoneCount(), keepOne ? 1u : 0u);
+        ASSERT_EQ(y.zoneCount(), x.zoneCount());
+        auto sameList = [](const IndexSet& a, const IndexSet& b) { return std::equal(a.begin(), a.end(), b.begin(), b.end()); };
+        const ActiveRegion &rx = x.region(), &ry = y.region();
+        EXPECT_TRUE(sameList(rx.masses(), ry.masses()) && sameList(rx.springs(), ry.springs()) &&
+                    sameList(rx.looseSprings(), ry.looseSprings()) && sameList(rx.vectorBlocks(), ry.vectorBlocks()) &&
+                    sameList(rx.looseMasses(), ry.looseMasses()) && sameList(rx.vectorOctets(), ry.vectorOctets()))
+            << "keep one " << keepOne;
+        EXPECT_EQ(flexfit::stateHash(x.state()), flexfit::stateHash(y.state()));
+        x.setSettings(reference);  // no more retirement: the zones left stay in both
+        for (Part* p : {&x, &y}) {
+            p->openZone(ZoneSeed::mass(310), 4);
+            p->openZone(ZoneSeed::mass(710), 5);
+            for (int i = 0; i < 40; ++i) {
+                p->applyForce(310, Vec3(0.2, 0.1, 0));
+                p->applyForce(710, Vec3(0, 0, 0.2));
+                p->step();
+            }
+        }
+        EXPECT_EQ(flexfit::stateHash(x.state()), flexfit::stateHash(y.state())) << "keep one " << keepOne;
+        EXPECT_NE(x.state().positions[310], model->restPositions[310]);
+    }
+}
+
 TEST(Part, GrowingAndShrinkingKeepsTheStateOfMassesThatStay) {
     const auto model = buildPartModel(makeTorus1());
     Part part(model, zoneSettings());
