@@ -330,9 +330,18 @@ FLEXFIT_AVX512 void integrate512(const PartModel& model, const MassUpdate& p, Pa
     const __m512i carry = _mm512_set1_epi64(check != nullptr ? std::int64_t(check->carry) : 0);
     for (std::size_t g = firstGroup; g < groups; ++g) {
         const std::size_t i = 8 * (octets != nullptr ? std::size_t(octets[g]) : g);
+        const unsigned heldMasses = held != nullptr ? heldBits8(held + i) : 0u;
+        if (heldMasses == 0xffu) {  // none moves: at rest already (stepSpringBlocks), only its forces zeroed
+            for (int j = 0; j < 3; ++j) {
+                const std::size_t o = 3 * i + 8 * std::size_t(j);
+                if (check != nullptr) beyond = orBeyondBits8(beyond, _mm512_loadu_pd(x + o), origin[j], carry);
+                _mm512_storeu_pd(f + o, _mm512_setzero_pd());
+            }
+            continue;
+        }
         const __m512d mass = _mm512_loadu_pd(model.mass.data() + i);
         const __m512d hOverMass = _mm512_mul_pd(step.h, _mm512_loadu_pd(model.inverseMass.data() + i));
-        const std::uint32_t heldLanes = held != nullptr ? kSpread3[heldBits8(held + i)] : 0u;
+        const std::uint32_t heldLanes = kSpread3[heldMasses];
         for (int j = 0; j < 3; ++j) {
             const std::size_t o = 3 * i + 8 * std::size_t(j);
             const __m512d m = spread8(mass, j), hm = spread8(hOverMass, j);
@@ -785,9 +794,18 @@ FLEXFIT_AVX2 void integrate256(const PartModel& model, const MassUpdate& p, Part
     const __m256i carry = _mm256_set1_epi64x(check != nullptr ? std::int64_t(check->carry) : 0);
     for (std::size_t g = firstGroup; g < groups; ++g) {
         const std::size_t i = octets != nullptr ? 8 * std::size_t(octets[g / 2]) + 4 * (g % 2) : 4 * g;
+        const unsigned heldMasses = held != nullptr ? heldBits4(held + i) : 0u;
+        if (heldMasses == 0xfu) {  // none moves: at rest already (stepSpringBlocks), only its forces zeroed
+            for (int j = 0; j < 3; ++j) {
+                const std::size_t o = 3 * i + 4 * std::size_t(j);
+                if (check != nullptr) beyond = orBeyondBits4(beyond, _mm256_loadu_pd(x + o), origin[j], carry);
+                _mm256_storeu_pd(f + o, _mm256_setzero_pd());
+            }
+            continue;
+        }
         const __m256d mass = _mm256_loadu_pd(model.mass.data() + i);
         const __m256d hOverMass = _mm256_mul_pd(h, _mm256_loadu_pd(model.inverseMass.data() + i));
-        const std::uint32_t heldLanes = held != nullptr ? kSpread3[heldBits4(held + i)] : 0u;
+        const std::uint32_t heldLanes = kSpread3[heldMasses];
         for (int j = 0; j < 3; ++j) {
             const std::size_t o = 3 * i + 4 * std::size_t(j);
             const __m256d m = spread4(mass, j), hm = spread4(hOverMass, j);

@@ -71,6 +71,10 @@ struct PositionCheck {
 // Springs by blocks, the remainder, then every mass. The kernel must be available. With
 // `held` (a cover count per mass), each mass whose count is 0 ends the step at rest instead,
 // velocity and force zero (what holdAtRest does after the step, in the integration's pass).
+// Those masses must be at rest when the step begins (a Part keeps every mass no zone covers so):
+// the vector kernels leave a group of masses none of which moves (8 with AVX-512, 4 with AVX2)
+// where it is and only zero its forces, which is the same bits (a held full step at 62 %
+// coverage of a large torus went from 1.036 to 0.995 of the whole model's step).
 // With `check`, the vector kernels check the new positions as they write them.
 void stepSpringBlocks(const PartModel& model, const MassUpdate& update, PartState& state, BlockKernel kernel,
                       const std::uint16_t* held = nullptr, PositionCheck* check = nullptr);
