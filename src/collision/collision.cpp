@@ -183,6 +183,37 @@ void sortContacts(std::vector<Contact>& contacts, std::size_t first) {
 
 }  // namespace detail
 
+namespace {
+
+// A turned pair's traversal tests each node pair by the oriented-box test (overlapRotated). When
+// one part's tree is far the smaller (a ball against a container mouth of 45 times its faces),
+// it is boxed again in the other part's frame, once per query: the tree copied, each leaf the
+// box of its triangle turned into that frame, the nodes refitted. Every node pair is then tested
+// axis-aligned. A leaf's box is its triangle's in either frame, so every pair of triangles that
+// touch still meets (the exact test, at the parts' own poses, decides the contacts).
+constexpr std::size_t kReboxRatio = 8;  // the smaller tree's leaves at most 1/8 of the other's
+
+struct Reboxed {
+    Bvh<Aabb> tree;
+    std::vector<Vec3> positions;  // the part's, in the other part's frame
+};
+
+// `tree` (of `part`, built on its triangles' boxes) boxed in the frame x' = rotation x + translation.
+const Bvh<Aabb>& reboxed(const Bvh<Aabb>& tree, const Part& part, const Eigen::Matrix3d& rotation, const Vec3& translation) {
+    thread_local Reboxed r;
+    const auto& positions = part.state().positions;
+    r.positions.resize(positions.size());
+    for (std::size_t i = 0; i < positions.size(); ++i) r.positions[i] = rotation * positions[i] + translation;
+    r.tree = tree;
+    const auto& faces = part.model().mesh.faces;
+    r.tree.refitAll([&](Index f) { return faceBox(r.positions, faces[f]); });
+    return r.tree;
+}
+
+bool smallerByFar(const Bvh<Aabb>& x, const Bvh<Aabb>& y) { return kReboxRatio * x.nodes().size() <= y.nodes().size(); }
+
+}  // namespace
+
 void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,
                const PartCollider& colliderB, ExactTest test, std::vector<Contact>& contacts, QueryStats& stats,
                std::vector<std::pair<Index, Index>>* candidates) {
@@ -194,12 +225,23 @@ void queryPair(std::uint32_t idA, const Part& a, const PartCollider& colliderA, 
         if (candidates) candidates->emplace_back(fa, fb);
         tester(fa, fb);
     };
-    dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) {
-        // Listing candidates means every leaf pair whose volumes overlap: no pruning then.
-        auto prune = [&](Index fa, const auto& volumeB) { return !candidates && tester.prunes(fa, volumeB); };
-        auto pruneA = [&](Index fb, const auto& volumeA) { return !candidates && tester.prunesByB(fb, volumeA); };
-        traverse(bvhA, bvhB, bInA, stats, leafPair, prune, 0.0, pruneA);
-    });
+    // Listing candidates means every leaf pair whose volumes overlap: no pruning then.
+    auto prune = [&](Index fa, const auto& volumeB) { return !candidates && tester.prunes(fa, volumeB); };
+    auto pruneA = [&](Index fb, const auto& volumeA) { return !candidates && tester.prunesByB(fb, volumeA); };
+    const bool turnedBoxes = !bInA.pureTranslation && !candidates && test == ExactTest::TriangleTriangle && colliderA.boxes() && colliderB.boxes();
+    const RelativePose same;  // both trees in one frame
+    if (turnedBoxes && smallerByFar(*colliderA.boxes(), *colliderB.boxes())) {
+        // A's boxes in B's frame: x_B = R^T (x_A - t). A's face planes still prune B's subtrees
+        // (they are moved to B's frame); B's are in A's frame, which A's boxes no longer are.
+        const Eigen::Matrix3d toB = bInA.rotation.transpose();
+        traverse(reboxed(*colliderA.boxes(), a, toB, -(toB * bInA.translation)), *colliderB.boxes(), same, stats, leafPair, prune, 0.0);
+    } else if (turnedBoxes && smallerByFar(*colliderB.boxes(), *colliderA.boxes())) {
+        // B's boxes in A's frame; B's face planes prune A's subtrees.
+        traverse(*colliderA.boxes(), reboxed(*colliderB.boxes(), b, bInA.rotation, bInA.translation), same, stats, leafPair, NoPrune{},
+                 0.0, pruneA);
+    } else {
+        dispatch(colliderA, colliderB, [&](const auto& bvhA, const auto& bvhB) { traverse(bvhA, bvhB, bInA, stats, leafPair, prune, 0.0, pruneA); });
+    }
     sortContacts(contacts, first);
 }
 

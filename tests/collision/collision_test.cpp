@@ -168,6 +168,34 @@ TEST_P(NarrowPhaseByLeafGroup, PruningByBsFacePlanesKeepsEveryContact) {
     }
 }
 
+TEST_P(NarrowPhaseByLeafGroup, TurnedPairsOfUnevenTreesFindBruteForcesContacts) {
+    // A turned pair whose trees differ in size by far is traversed with the smaller tree boxed
+    // again in the larger's frame (collision.cpp): a coarse ball (80 faces) and a fine torus
+    // (1,024), each as A and as B, in random poses, rigid or deformed around a mass.
+    const detail::ScopedLeafGroup grouping(GetParam());
+    std::mt19937 rng(13);
+    int withContacts = 0;
+    for (int trial = 0; trial < 12; ++trial) {
+        const auto ball = buildPartModel(perturbed(makeIcoSphere(0.8, 1), 0.05, rng));
+        const auto torus = buildPartModel(perturbed(makeTorus(1.0, 0.35, 32, 16), 0.01, rng));
+        PartSettings rigid;
+        rigid.mode = PartMode::Rigid;
+        Part small(ball, trial % 2 ? PartSettings{} : rigid), large(torus, trial % 3 ? PartSettings{} : rigid);
+        if (trial % 2) {
+            small.applyForce(0, Vec3(0.2, -0.1, 0.3));
+            small.step();
+        }
+        small.setPose(randomPose(rng, 0.5));
+        large.setPose(randomPose(rng, 0.5));
+        for (const bool smallFirst : {true, false}) {
+            const Part& a = smallFirst ? small : large;
+            const Part& b = smallFirst ? large : small;
+            for (const PrunedQuery& q : expectPrunedQueryFindsBruteForcesContacts(a, b, trial)) withContacts += q.contacts;
+        }
+    }
+    EXPECT_GT(withContacts, 16);
+}
+
 TEST_P(NarrowPhaseByLeafGroup, CandidatesAndContactsEqualBruteForce) {
     const detail::ScopedLeafGroup grouping(GetParam());
     std::mt19937 rng(10);
