@@ -159,17 +159,17 @@ void dispatch(const PartCollider& a, const PartCollider& b, Visit visit) {
 // then where the rest planes were computed.
 class MovedFacePlanes {
 public:
-    // Kept between queries so a query allocates nothing: one per thread and side, handed to each
-    // filter once. Packed in the order the faces were first met (by their slot in `moved`): a
-    // query touches a few faces of a large part, and writing each one's 128 bytes into an array
-    // by face index missed the cache on every face (the filter's costliest instructions in a
-    // tool pressed into a 3,732-face part).
     // A face's planes in the other frame, and the rounding margin of each plane's tests (far
     // wider than the triangle test's tolerance).
     struct Planes {
         std::array<Eigen::Vector4d, 4> planes;
         std::array<double, 4> margins;
     };
+    // Kept between queries so a query allocates nothing: one per thread and side, handed to each
+    // filter once. Packed in the order the faces were first met (by their slot in `moved`): a
+    // query touches a few faces of a large part, and writing each one's 128 bytes into an array
+    // by face index missed the cache on every face (the filter's costliest instructions in a
+    // tool pressed into a 3,732-face part).
     struct Scratch {
         std::vector<Planes> planes;  // by slot of `moved`
         IndexSet moved;              // faces whose planes are in `planes` for this query
@@ -213,10 +213,8 @@ public:
     bool triangleBeyond(Index face, std::span<const Vec3> positions, const Face& other) {
         const auto& [planes, margins] = of(face);
         for (std::size_t k = 0; k < planes.size(); ++k) {
-            const Vec3 n = planes[k].head<3>();
             const double m = margins[k];
-            const double d0 = n.dot(positions[other[0]]) - planes[k][3], d1 = n.dot(positions[other[1]]) - planes[k][3],
-                         d2 = n.dot(positions[other[2]]) - planes[k][3];
+            const auto [d0, d1, d2] = distances(planes[k], positions, other);
             if (d0 > m && d1 > m && d2 > m) return true;
             if (k == 0 && d0 < -m && d1 < -m && d2 < -m) return true;
         }
@@ -228,9 +226,7 @@ public:
         const auto& [planes, margins] = of(face);
         double gap = 0.0;
         for (std::size_t k = 0; k < planes.size(); ++k) {
-            const Vec3 n = planes[k].head<3>();
-            const double d0 = n.dot(positions[other[0]]) - planes[k][3], d1 = n.dot(positions[other[1]]) - planes[k][3],
-                         d2 = n.dot(positions[other[2]]) - planes[k][3];
+            const auto [d0, d1, d2] = distances(planes[k], positions, other);
             gap = std::max(gap, std::min({d0, d1, d2}) - margins[k]);
             if (k == 0) gap = std::max(gap, -std::max({d0, d1, d2}) - margins[k]);
             if (gap > enough) break;
@@ -253,6 +249,11 @@ public:
     }
 
 private:
+    // How far each vertex of the other triangle lies beyond the plane (n.x - d).
+    static std::array<double, 3> distances(const Eigen::Vector4d& plane, std::span<const Vec3> positions, const Face& other) {
+        const Vec3 n = plane.head<3>();
+        return {n.dot(positions[other[0]]) - plane[3], n.dot(positions[other[1]]) - plane[3], n.dot(positions[other[2]]) - plane[3]};
+    }
     // Range of n.x over the volume.
     [[gnu::always_inline]] static std::pair<double, double> extent(const Aabb& box, const Vec3& n) {
         const double centre = n.dot(box.centre()), reach = n.cwiseAbs().dot(box.halfExtents());
