@@ -191,14 +191,15 @@ namespace {
 // box of its triangle turned into that frame, the nodes refitted. Every node pair is then tested
 // axis-aligned. A leaf's box is its triangle's in either frame, so every pair of triangles that
 // touch still meets (the exact test, at the parts' own poses, decides the contacts).
-constexpr std::size_t kReboxRatio = 8;  // the smaller tree's leaves at most 1/8 of the other's
+constexpr std::size_t kReboxRatio = 8;  // the smaller tree's nodes at most 1/8 of the other's
 
 struct Reboxed {
     Bvh<Aabb> tree;
     std::vector<Vec3> positions;  // the part's, in the other part's frame
 };
 
-// `tree` (of `part`, built on its triangles' boxes) boxed in the frame x' = rotation x + translation.
+// `tree` (of `part`, its leaves as a triangle query builds them) boxed in the frame
+// x' = rotation x + translation.
 const Bvh<Aabb>& reboxed(const Bvh<Aabb>& tree, const Part& part, const Eigen::Matrix3d& rotation, const Vec3& translation) {
     thread_local Reboxed r;
     const auto& positions = part.state().positions;
@@ -206,7 +207,7 @@ const Bvh<Aabb>& reboxed(const Bvh<Aabb>& tree, const Part& part, const Eigen::M
     for (std::size_t i = 0; i < positions.size(); ++i) r.positions[i] = rotation * positions[i] + translation;
     r.tree = tree;
     const auto& faces = part.model().mesh.faces;
-    r.tree.refitAll([&](Index f) { return faceBox(r.positions, faces[f]); });
+    r.tree.refitAll([&](Index f) { return leafVolume((const Aabb*)nullptr, r.positions, faces[f], ExactTest::TriangleTriangle); });
     return r.tree;
 }
 
