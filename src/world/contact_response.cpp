@@ -151,10 +151,14 @@ FLEXFIT_AVX2_LANES std::size_t applyFrictionlessReactions256(const PairTerms& te
     const Lanes3 partCentre = broadcast(terms.partCentre), partVelocity = broadcast(terms.partVelocity), partSpin = broadcast(terms.partSpin);
     const __m256d stiffness = _mm256_set1_pd(terms.stiffness), damping = _mm256_set1_pd(terms.damping), zero = _mm256_setzero_pd();
     const std::size_t n = reactions.size() / 4 * 4;
+    // The sums in registers, not through the body's memory (each += waited on the last one's
+    // store); the same additions in the same order.
+    Vec3 force = b.force, torque = b.torque, pressed = b.deformableContactForce;
+    const Vec3Array &positions = p.state().positions, &restPositions = p.model().restPositions;
     for (std::size_t k = 0; k < n; k += 4) {
         const ContactResponse::Reaction* four = &reactions[k];
-        const Lanes3 local = gather([&](int j) -> const Vec3& { return p.state().positions[four[j].mass]; });
-        const Lanes3 rest = gather([&](int j) -> const Vec3& { return p.model().restPositions[four[j].mass]; });
+        const Lanes3 local = gather([&](int j) -> const Vec3& { return positions[four[j].mass]; });
+        const Lanes3 rest = gather([&](int j) -> const Vec3& { return restPositions[four[j].mass]; });
         const Lanes3 displacement = rotate(q, sub(local, rest));
         const __m256d length = _mm256_sqrt_pd(dot(displacement, displacement));
         const int acts = _mm256_movemask_pd(_mm256_cmp_pd(length, zero, _CMP_GT_OQ));  // !(length > 0): no reaction
@@ -165,14 +169,17 @@ FLEXFIT_AVX2_LANES std::size_t applyFrictionlessReactions256(const PairTerms& te
         __m256d pressing = _mm256_sub_pd(_mm256_mul_pd(stiffness, length), _mm256_mul_pd(damping, dot(relative, normal)));
         pressing = _mm256_blendv_pd(pressing, zero, _mm256_cmp_pd(pressing, zero, _CMP_LT_OQ));  // std::max(pressing, 0.0)
         const Lanes3 forceLanes = scale(pressing, normal);
-        const Stored3 force = store(forceLanes), torque = store(cross(arm, forceLanes));
+        const Stored3 forces = store(forceLanes), torques = store(cross(arm, forceLanes));
         for (int j = 0; j < 4; ++j) {
             if (!(acts & (1 << j))) continue;
-            b.force += force[j];
-            b.torque += torque[j];
-            b.deformableContactForce += force[j];
+            force += forces[j];
+            torque += torques[j];
+            pressed += forces[j];
         }
     }
+    b.force = force;
+    b.torque = torque;
+    b.deformableContactForce = pressed;
     return n;
 }
 #endif
