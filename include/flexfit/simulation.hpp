@@ -167,11 +167,12 @@ void stepActiveRegion(const PartModel& model, const SimulationSettings& settings
                       PartState& state, StepCounters* counters = nullptr);
 
 // The same region stepped by the full model's step, the masses outside it held at rest (put
-// back after the step: their positions at rest, velocities and pending forces zero). They must
-// be at rest when it is called, as a Part keeps them: the vector kernels skip all but the forces
-// of groups of masses none of which moves. Gives what
+// back after the step: their positions at rest, velocities and pending forces zero, whatever
+// state they began it in). Where they began at rest, as a Part keeps them, gives what
 // stepActiveRegion gives up to the order forces are summed in. O(masses + springs), but at the
-// full step's cost per spring (streamed in index order), not the region's gathered one. Checks every mass for divergence, as stepFullModel does.
+// full step's cost per spring (streamed in index order), not the region's gathered one (a Part
+// also skips the groups of masses none of which moves, and the pass that puts them back).
+// Checks every mass for divergence, as stepFullModel does.
 void stepRegionByFullModel(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                            PartState& state, StepCounters* counters = nullptr);
 

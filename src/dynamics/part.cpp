@@ -339,7 +339,7 @@ bool Part::advance(const StepContext& context, StepCounters* counters) {
     // The implicit solve holds a region's edge fixed; the full step would solve for it too.
     else if (settings_.zones.fullStepWhenCheaper && s.integrator != Integrator::ImplicitEuler &&
              fullStepCostsLess(*model_, RegionWork::of(region_)))
-        stepRegionByFullModel(*model_, s, region_, state_, counters);
+        detail::stepRegionByFullModelFromRest(*model_, s, region_, state_, counters);  // the held masses are at rest
     else {
         detail::PositionCheck check(model_->positionBound);
         detail::stepRegion(*model_, s, region_, state_, counters, &check);

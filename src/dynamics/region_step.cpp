@@ -85,9 +85,17 @@ void detail::stepRegion(const PartModel& model, const SimulationSettings& settin
     }
 }
 
+void detail::stepRegionByFullModelFromRest(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
+                                           PartState& state, StepCounters* counters) {
+    detail::stepAllMasses(model, settings, {}, region.coverCounts().data(), state, counters);
+}
+
 void stepRegionByFullModel(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                            PartState& state, StepCounters* counters) {
-    detail::stepAllMasses(model, settings, {}, region.coverCounts().data(), state, counters);
+    detail::stepRegionByFullModelFromRest(model, settings, region, state, counters);
+    // The groups skipped as at rest may not have been: every held mass back to rest (a selection:
+    // the same bits wherever they already were).
+    detail::holdAtRest(model, region.coverCounts(), state, detail::fullStepKernel());
 }
 
 RegionWork RegionWork::of(const ActiveRegion& region) {

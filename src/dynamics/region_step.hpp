@@ -14,4 +14,10 @@ namespace flexfit::detail {
 void stepRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region, PartState& state,
                 StepCounters* counters, PositionCheck* check);
 
+// stepRegionByFullModel for a state whose masses outside the region are at rest, as a Part
+// keeps them (Part::step): the vector kernels skip the groups of masses none of which moves
+// (their forces zeroed), so no pass over all the masses puts them back.
+void stepRegionByFullModelFromRest(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
+                                   PartState& state, StepCounters* counters);
+
 }  // namespace flexfit::detail

@@ -166,6 +166,43 @@ TEST(RegionStep, ByTheFullModelHoldsInTheIntegrationPassBitForBit) {
     }
 }
 
+// Called from a state whose masses outside the region are not at rest (displaced, moving, with
+// pending forces: a caller's own state, not a Part's), the full step standing for a region still
+// ends with every one of them at rest: the same bits as the full step followed by holdAtRest, in
+// every kernel, where whole groups of held masses would be skipped (the band) and where none are.
+TEST(RegionStep, ByTheFullModelPutsBackHeldMassesThatBeganAwayFromRest) {
+    for (const bool shuffled : {false, true}) {
+        const auto m = buildPartModel(shuffled ? flexfit::testing::shuffledVertices(makeTorus1(), 5) : makeTorus1());
+        for (const bool band : {false, true}) {
+            std::vector<Index> masses = scatteredMasses(*m);
+            if (band) masses.resize(60);
+            const ActiveRegion region = regionOf(*m, masses);
+            PartState start = PartState::atRest(*m);
+            for (Index i = 0; i < m->massCount(); ++i) {
+                if (region.moves(i)) continue;
+                const double t = 1e-3 * double(i % 17);
+                start.positions[i] += Vec3(t, -t, 0.5 * t);
+                start.velocities[i] = Vec3(0.1, t, -0.2);
+                start.forces[i] = Vec3(0.0, 2.0, t);
+            }
+            for (const auto kernel : flexfit::testing::availableBlockKernels()) {
+                const detail::ScopedBlockKernel chosen(kernel);
+                PartState fused = start, after = start;
+                stepRegionByFullModel(*m, noRestoration(), region, fused);
+                stepFullModel(*m, noRestoration(), {}, after);
+                detail::holdAtRest(*m, region.coverCounts(), after, kernel);
+                EXPECT_EQ(flexfit::stateHash(fused), flexfit::stateHash(after))
+                    << detail::toString(kernel) << (shuffled ? " shuffled" : "") << (band ? " band" : " scattered");
+                for (Index i = 0; i < m->massCount(); ++i) {
+                    if (region.moves(i)) continue;
+                    ASSERT_EQ(fused.positions[i], m->restPositions[i]) << "mass " << i << " " << detail::toString(kernel);
+                    ASSERT_EQ(fused.velocities[i], Vec3::Zero()) << "mass " << i << " " << detail::toString(kernel);
+                }
+            }
+        }
+    }
+}
+
 std::shared_ptr<const PartModel> inLocalityOrder(TriMesh mesh) {
     PartModelSettings s;
     s.vertexOrder = VertexOrder::Locality;
