@@ -7,10 +7,10 @@ kinematic level-3 icosphere of radius 10 % of the part's box diagonal comes down
 highest vertex, presses 20 % of its radius in, and slides along it while the part deforms
 (rigid-deformable part, face query: `rigid_deformable_query = "faces"`). For each binary and
 size: the in-contact steps' mean narrow phase and World::step, and the step's p50 / p99
-(nearest rank), from metrics.csv. Runs alternate between binaries, `--rounds` times; the
-medians are reported, and the floor: each step's fastest time over the rounds (floor_*, the
-work's own cost; the medians carry this VM's stalls, which moved a binary's x1 narrow phase
-from 12.8 to 20.8 us between two runs minutes apart).
+(nearest rank), from metrics.csv. Runs alternate between binaries, their order reversed every
+other round, `--rounds` times; the medians are reported, and the floor: each step's fastest
+time over the rounds (floor_*, the work's own cost; the medians carry this VM's stalls, which
+moved a binary's x1 narrow phase from 12.8 to 20.8 us between two runs minutes apart).
 
   tools/tool_press.py --flexfit new=build/release/apps/flexfit/flexfit \
       --flexfit old=/tmp/base/build/apps/flexfit/flexfit --csv bench/results/tool_press.csv
@@ -255,8 +255,8 @@ def main():
     with tempfile.TemporaryDirectory() as directory:
         runs = {}
         for label, faces, scene in scenes(directory, args.refine):
-            for _ in range(args.rounds):
-                for name, path in binaries:
+            for r in range(args.rounds):
+                for name, path in (binaries if r % 2 == 0 else binaries[::-1]):  # drift falls on each alike
                     runs.setdefault((label, faces, name), []).append(measure(path, scene, directory))
     table = []
     for (label, faces, name), results in runs.items():

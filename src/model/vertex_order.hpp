@@ -10,7 +10,10 @@
 // springs fall in spring blocks (spring_blocks.hpp) as on a generated mesh's rows. Measured
 // (bench/results/msd_step.csv): a shuffled heart gets 91 % of its springs in blocks (97 % in
 // the generator's order; reverse Cuthill-McKee gives 43 %), the third-party Wuson 34 % (7 %
-// as its file orders it). Each connected component is ordered in turn, in the order of its
+// as its file orders it) in whole blocks, 71 % (31 %) in blocks of at least 5 springs
+// (spring_blocks.hpp). Known limit: on Wuson (open, 51 pieces) the springs left out mostly
+// have no 4 others of their offset within 8 first masses: its fronts are short and their
+// offsets drift, which a block rule cannot recover; a better order would. Each connected component is ordered in turn, in the order of its
 // lowest vertex.
 //
 // Known limit: a non-manifold vertex's one-ring is not one cycle; its neighbours then follow
