@@ -236,7 +236,6 @@ constexpr double kWalkStart = 0.25;
 constexpr std::size_t kWalkShare = 8;
 constexpr std::size_t kMinWalkNodes = 256;
 
-
 }  // namespace
 
 void queryPairCoherent(std::uint32_t idA, const Part& a, const PartCollider& colliderA, std::uint32_t idB, const Part& b,

@@ -93,9 +93,10 @@ void detail::stepRegionByFullModelFromRest(const PartModel& model, const Simulat
 void stepRegionByFullModel(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                            PartState& state, StepCounters* counters) {
     detail::stepRegionByFullModelFromRest(model, settings, region, state, counters);
-    // The groups skipped as at rest may not have been: every held mass back to rest (a selection:
-    // the same bits wherever they already were).
-    detail::holdAtRest(model, region.coverCounts(), state, detail::fullStepKernel());
+    // The groups the explicit kernels skipped as at rest may not have been: every held mass back
+    // to rest (a selection: the same bits wherever they already were). The implicit step puts
+    // them back itself.
+    if (settings.integrator != Integrator::ImplicitEuler) detail::holdAtRest(model, region.coverCounts(), state, detail::fullStepKernel());
 }
 
 RegionWork RegionWork::of(const ActiveRegion& region) {
