@@ -63,6 +63,7 @@ bench: release
 	@cmake --build --preset release --target benchmarks -j $(JOBS)
 	build/release/bench/bench_msd_step $(BENCH_FLAGS) --benchmark_out=bench/results/msd_step.csv
 	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitFullStep BM_NaiveFullStep
+	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitFullStep BM_NaiveFullStep --statistic min
 	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitAvx2 BM_NaiveFullStep
 	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitScalar BM_NaiveFullStep
 	build/release/bench/bench_part_step $(BENCH_FLAGS) --benchmark_out=bench/results/part_step.csv

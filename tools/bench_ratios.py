@@ -4,21 +4,28 @@
   bench_ratios.py CSV --prefixes OURS REFERENCE    per argument: time(REFERENCE) / time(OURS)
   bench_ratios.py CSV --pair A B [--pair C D ...]  time(A) / time(B) for full benchmark names
   bench_ratios.py CSV --counter NAME               the counter NAME of every benchmark that has it
+  --statistic min                                  the "_min" rows instead (each benchmark's
+                                                   fastest repetition, where the benchmark adds it)
 """
 import argparse
 import csv
 
 
-def load(path):
+AGGREGATES = ("_mean", "_median", "_stddev", "_cv", "_min")
+
+
+def load(path, statistic="median"):
+    """Each benchmark's row: its aggregate `statistic` when repetitions were run, else its one run."""
     rows = {}
     with open(path, newline="") as f:
         lines = f.readlines()
     start = next(i for i, line in enumerate(lines) if line.startswith("name,"))
     for row in csv.DictReader(lines[start:]):
         name = row["name"]
-        if any(tag in name for tag in ("_mean", "_stddev", "_cv")):
-            continue
-        rows[name.replace("_median", "")] = row
+        if name.endswith("_" + statistic):
+            rows[name[: -len(statistic) - 1]] = row
+        elif not name.endswith(AGGREGATES):
+            rows.setdefault(name, row)
     return rows
 
 
@@ -56,8 +63,9 @@ def main():
     parser.add_argument("--prefixes", nargs=2)
     parser.add_argument("--pair", nargs=2, action="append", default=[])
     parser.add_argument("--counter")
+    parser.add_argument("--statistic", choices=("median", "min"), default="median")
     args = parser.parse_args()
-    rows = load(args.csv)
+    rows = load(args.csv, args.statistic)
     if args.prefixes:
         prefixes(rows, *args.prefixes)
     if args.pair:

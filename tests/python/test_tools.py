@@ -95,6 +95,36 @@ def test_ab_bench_table_takes_medians_over_rounds_and_the_reference_of_the_same_
                      f"{12000 / 6000:.3f}", f"{12000 / 4500:.3f}", 3]]
 
 
+def test_bench_ratios_reads_the_median_or_the_fastest_repetition(tmp_path, capsys):
+    """tools/bench_ratios.py on a CSV with repetitions, their median and min rows, and a
+    benchmark run once: the ratios of the chosen statistic, worked out by hand."""
+    import bench_ratios
+    path = tmp_path / "msd.csv"
+    path.write_text("\n".join([
+        "a preamble line",
+        "name,iterations,real_time,cpu_time,time_unit,label",
+        "BM_Ours/0,10,5.0,5.0,ns,torus1",
+        "BM_Ours/0,10,4.0,4.0,ns,torus1",
+        "BM_Ours/0,10,9.0,9.0,ns,torus1",
+        "BM_Ours/0_mean,3,6.0,6.0,ns,torus1",
+        "BM_Ours/0_median,3,5.0,5.0,ns,torus1",
+        "BM_Ours/0_stddev,3,2.6,2.6,ns,torus1",
+        "BM_Ours/0_min,3,4.0,4.0,ns,torus1",
+        "BM_Naive/0,10,15.0,15.0,ns,torus1",
+        "BM_Naive/0_median,3,15.0,15.0,ns,torus1",
+        "BM_Naive/0_min,3,14.0,14.0,ns,torus1",
+        "BM_Ours/1,10,2.0,2.0,ns,heart",
+        "BM_Naive/1,10,7.0,7.0,ns,heart"]) + "\n")
+    medians, fastest = bench_ratios.load(path), bench_ratios.load(path, "min")
+    assert {name: float(row["real_time"]) for name, row in medians.items()} == {
+        "BM_Ours/0": 5.0, "BM_Naive/0": 15.0, "BM_Ours/1": 2.0, "BM_Naive/1": 7.0}
+    assert {name: float(row["real_time"]) for name, row in fastest.items()} == {
+        "BM_Ours/0": 4.0, "BM_Naive/0": 14.0, "BM_Ours/1": 2.0, "BM_Naive/1": 7.0}
+    bench_ratios.prefixes(fastest, "BM_Ours", "BM_Naive")
+    table = capsys.readouterr().out
+    assert "| torus1 | 14 | 4 | 3.50x |" in table and "| heart | 7 | 2 | 3.50x |" in table
+
+
 def test_tail_repeats_tells_a_slow_step_of_every_run_from_stalls_that_move():
     import tail_repeats
     # Each run stalls on another step: every step's fastest time is the work's 10 us, each run's
