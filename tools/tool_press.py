@@ -241,6 +241,19 @@ def floors(results):
             "floor_us_step_p99": percentile(steps, 99)}
 
 
+def summary(results):
+    """One binary's row over its rounds: the median of each figure, the floors, and the contact
+    steps, which a run repeats exactly (the simulation is deterministic): rounds that differ
+    there are an error, not a median."""
+    counts = sorted({r["contact_steps"] for r in results})
+    if len(counts) != 1:
+        raise SystemExit(f"the rounds' contact steps differ ({counts}): a run did not repeat itself")
+    row = {key: counts[0] if key == "contact_steps" else statistics.median(r[key] for r in results)
+           for key in results[0] if key != "per_step"}
+    row.update(floors(results))
+    return row
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--flexfit", action="append", required=True, help="NAME=PATH of a flexfit binary")
@@ -260,12 +273,7 @@ def main():
                     runs.setdefault((label, faces, name), []).append(measure(path, scene, directory))
     table = []
     for (label, faces, name), results in runs.items():
-        row = {"part": label, "faces": faces, "binary": name}
-        for key in results[0]:
-            if key != "per_step":
-                row[key] = statistics.median(r[key] for r in results)
-        row.update(floors(results))
-        table.append(row)
+        table.append({"part": label, "faces": faces, "binary": name, **summary(results)})
     report(table, args.csv)
 
 

@@ -95,6 +95,23 @@ def test_ab_bench_table_takes_medians_over_rounds_and_the_reference_of_the_same_
                      f"{12000 / 6000:.3f}", f"{12000 / 4500:.3f}", 3]]
 
 
+def test_tool_press_summary_keeps_the_contact_steps_whole_and_refuses_rounds_that_differ():
+    """Two rounds of one binary: medians of the figures, the floors from each step's fastest
+    time, the contact steps as the integer every round gave; rounds that disagree on them fail."""
+    def round_of(narrow, steps):
+        return {"contact_steps": 2, "contacts": 3.0, "us_narrow_phase": sum(narrow) / 2, "us_world_step": sum(steps) / 2,
+                "per_step": {"0.001": (narrow[0], steps[0]), "0.002": (narrow[1], steps[1])}}
+    row = tool_press.summary([round_of([4.0, 6.0], [10.0, 12.0]), round_of([5.0, 3.0], [9.0, 14.0])])
+    assert row["contact_steps"] == 2 and isinstance(row["contact_steps"], int)
+    assert row["us_narrow_phase"] == pytest.approx((5.0 + 4.0) / 2) and row["us_world_step"] == pytest.approx((11.0 + 11.5) / 2)
+    assert row["floor_us_narrow_phase"] == pytest.approx((4.0 + 3.0) / 2)
+    assert row["floor_us_world_step"] == pytest.approx((9.0 + 12.0) / 2) and row["floor_us_step_p99"] == 12.0
+    other = round_of([4.0, 6.0], [10.0, 12.0])
+    other["contact_steps"] = 3
+    with pytest.raises(SystemExit, match="did not repeat"):
+        tool_press.summary([round_of([4.0, 6.0], [10.0, 12.0]), other])
+
+
 def test_bench_ratios_reads_the_median_or_the_fastest_repetition(tmp_path, capsys):
     """tools/bench_ratios.py on a CSV with repetitions, their median and min rows, and a
     benchmark run once: the ratios of the chosen statistic, worked out by hand."""
