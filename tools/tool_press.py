@@ -27,8 +27,8 @@ import statistics
 import subprocess
 import tempfile
 
-from ab_stages import step_us
-from results_table import report
+from ab_stages import percentile, step_us  # nearest rank, as every other table here
+from results_table import alternating_runs, report
 
 WUSON = "/usr/share/assimp/models/OFF/Wuson.off"
 
@@ -195,11 +195,6 @@ def scenes(directory, refine="uniform"):
     return out
 
 
-def percentile(values, p):
-    values = sorted(values)
-    return values[min(len(values), max(1, math.ceil(p / 100 * len(values)))) - 1]
-
-
 # A binary path's suffixes, each rewriting the scene for that run.
 VARIANTS = {
     "+plain": ("[world]\n", "[world]\ncoherent_collision = false\n"),
@@ -208,6 +203,7 @@ VARIANTS = {
 
 
 def measure(flexfit, scene, directory):
+    os.makedirs(directory, exist_ok=True)
     out = os.path.join(directory, "run")
     with open(scene) as f:
         text = f.read()
@@ -226,7 +222,7 @@ def measure(flexfit, scene, directory):
     return {"contact_steps": len(rows), "contacts": statistics.mean(float(r["contacts"]) for r in rows),
             "moving_masses": statistics.mean(float(r["moving_masses"]) for r in rows),
             "us_narrow_phase": statistics.mean(narrow), "us_world_step": statistics.mean(steps),
-            "us_step_p50": percentile(steps, 50), "us_step_p99": percentile(steps, 99),
+            "us_step_p50": percentile(sorted(steps), 50), "us_step_p99": percentile(sorted(steps), 99),
             "per_step": {r["time"]: (n, s) for r, n, s in zip(rows, narrow, steps)}}
 
 
@@ -238,7 +234,7 @@ def floors(results):
     narrow = [min(r["per_step"][t][0] for r in results) for t in common]
     steps = [min(r["per_step"][t][1] for r in results) for t in common]
     return {"floor_us_narrow_phase": statistics.mean(narrow), "floor_us_world_step": statistics.mean(steps),
-            "floor_us_step_p99": percentile(steps, 99)}
+            "floor_us_step_p99": percentile(sorted(steps), 99)}
 
 
 def summary(results):
@@ -266,15 +262,10 @@ def main():
     if not os.path.exists(WUSON):
         raise SystemExit(f"{WUSON} is missing: install Debian's assimp-testmodels")
     with tempfile.TemporaryDirectory() as directory:
-        runs = {}
-        for label, faces, scene in scenes(directory, args.refine):
-            for r in range(args.rounds):
-                for name, path in (binaries if r % 2 == 0 else binaries[::-1]):  # drift falls on each alike
-                    runs.setdefault((label, faces, name), []).append(measure(path, scene, directory))
-    table = []
-    for (label, faces, name), results in runs.items():
-        table.append({"part": label, "faces": faces, "binary": name, **summary(results)})
-    report(table, args.csv)
+        parts = scenes(directory, args.refine)
+        runs = alternating_runs(binaries, [scene for _, _, scene in parts], args.rounds, measure)
+    report([{"part": label, "faces": faces, "binary": name, **summary(runs[(scene, name)])}
+            for label, faces, scene in parts for name, _ in binaries], args.csv)
 
 
 if __name__ == "__main__":

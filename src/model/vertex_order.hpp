@@ -11,10 +11,13 @@
 // (bench/results/msd_step.csv): a shuffled heart gets 91 % of its springs in blocks (97 % in
 // the generator's order; reverse Cuthill-McKee gives 43 %), the third-party Wuson 34 % (7 %
 // as its file orders it) in whole blocks, 71 % (31 %) in blocks of at least 5 springs
-// (spring_blocks.hpp). Known limit: on Wuson (open, 51 pieces) the springs left out mostly
-// have no 4 others of their offset within 8 first masses: its fronts are short and their
-// offsets drift, which a block rule cannot recover; a better order would. Each connected component is ordered in turn, in the order of its
+// (spring_blocks.hpp). Each connected component is ordered in turn, in the order of its
 // lowest vertex.
+//
+// Known limit: on Wuson (open, 51 pieces) the springs left out mostly have no 4 others of
+// their offset within 8 first masses: its fronts are short and their offsets drift, which a
+// block rule cannot recover (blocks spanning two adjacent offsets would take 75 % instead of
+// 71 %, counted in a scratch program); a better order would.
 //
 // Known limit: a non-manifold vertex's one-ring is not one cycle; its neighbours then follow
 // the cycle found first and the rest in index order (still a valid, if less regular, order).
