@@ -4,7 +4,14 @@
 // and appended. Polygons are triangulated by assimp; point and line primitives cannot be and
 // are rejected. Vertices are welded (exactly, or within the tolerance) because most formats
 // split them per face corner.
+//
+// The import itself (assimp's reading and the flattening) runs in a child process
+// (core/child_process.hpp): assimp crashes or never returns on some damaged files, and a crash
+// would end the user's program. A crash or a timeout is an InputError naming the file. The
+// mesh comes back through a pipe as the same doubles the flattening computed, so the result is
+// the same bits as an import in this process.
 #include "flexfit/mesh_io.hpp"
+#include "core/child_process.hpp"
 #include "io_internal.hpp"
 #include "text_lines.hpp"
 
@@ -12,6 +19,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -49,6 +57,60 @@ void appendNode(const aiScene& scene, const aiNode& node, const Eigen::Matrix4d&
     const Eigen::Matrix4d world = parent * toEigen(node.mTransformation);
     for (unsigned i = 0; i < node.mNumMeshes; ++i) appendMesh(*scene.mMeshes[node.mMeshes[i]], world, file, out);
     for (unsigned i = 0; i < node.mNumChildren; ++i) appendNode(scene, *node.mChildren[i], world, file, out);
+}
+
+// The flattened triangles as bytes: counts, then the vertices' doubles, then the faces' indices.
+std::string serialize(const TriMesh& mesh) {
+    const std::uint64_t counts[2] = {mesh.vertices.size(), mesh.faces.size()};
+    std::string out(reinterpret_cast<const char*>(counts), sizeof counts);
+    if (!mesh.vertices.empty()) out.append(reinterpret_cast<const char*>(mesh.vertices.front().data()), mesh.vertices.size() * sizeof(Vec3));
+    out.append(reinterpret_cast<const char*>(mesh.faces.data()), mesh.faces.size() * sizeof(Face));
+    return out;
+}
+
+TriMesh deserialize(const std::string& bytes, const std::string& file) {
+    std::uint64_t counts[2] = {0, 0};
+    const auto broken = [&] { return InputError(file, 0, "cannot import: the import process sent a malformed mesh"); };
+    if (bytes.size() < sizeof counts) throw broken();
+    std::memcpy(counts, bytes.data(), sizeof counts);
+    if (counts[0] > bytes.size() / sizeof(Vec3) || counts[1] > bytes.size() / sizeof(Face) ||
+        bytes.size() != sizeof counts + counts[0] * sizeof(Vec3) + counts[1] * sizeof(Face))
+        throw broken();
+    TriMesh mesh;
+    mesh.vertices.resize(counts[0]);
+    mesh.faces.resize(counts[1]);
+    static_assert(sizeof(Vec3) == 3 * sizeof(double), "vertices are three packed doubles");
+    if (counts[0] > 0) std::memcpy(mesh.vertices.front().data(), bytes.data() + sizeof counts, counts[0] * sizeof(Vec3));
+    std::memcpy(mesh.faces.data(), bytes.data() + sizeof counts + counts[0] * sizeof(Vec3), counts[1] * sizeof(Face));
+    return mesh;
+}
+
+// assimp's import and the flattening, as the child process runs them; throws std::runtime_error
+// with the problem alone (the parent names the file).
+std::string importTriangles(const std::string& file) {
+    try {
+        Assimp::Importer importer;
+        const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
+        if (scene == nullptr) throw InputError(file, 0, std::string("cannot import: ") + importer.GetErrorString());
+        if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 || scene->mRootNode == nullptr)
+            throw InputError(file, 0, "cannot import: the file holds no complete scene");
+        TriMesh mesh;
+        appendNode(*scene, *scene->mRootNode, Eigen::Matrix4d::Identity(), file, mesh);
+        return serialize(mesh);
+    } catch (const InputError& e) {
+        throw std::runtime_error(e.problem());
+    }
+}
+
+std::atomic<double> importSecondsOverride{0.0};
+
+// The time an import may take: 30 s, and 2 s more per MB of file (assimp-testmodels' largest
+// files import in well under a second each).
+double importSeconds(const std::filesystem::path& path) {
+    if (const double chosen = importSecondsOverride.load(); chosen > 0.0) return chosen;
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    return 30.0 + (ec ? 0.0 : 2.0 * double(size) / 1e6);
 }
 
 // A token read whole as a number (a leading '+' allowed): its value, or out of a double's
@@ -171,19 +233,33 @@ void checkAsciiStl(const std::filesystem::path& path) {
 
 }  // namespace
 
+namespace detail {
+ScopedImportTimeLimit::ScopedImportTimeLimit(double seconds) { importSecondsOverride.store(seconds); }
+ScopedImportTimeLimit::~ScopedImportTimeLimit() { importSecondsOverride.store(0.0); }
+}  // namespace detail
+
 MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadOptions& options) {
     const std::string file = path.string();
     if (!std::filesystem::exists(path)) throw InputError(file, 0, "cannot open the file for reading: it does not exist");
     checkAsciiStl(path);
-    Assimp::Importer importer;
-    const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
-    if (scene == nullptr) throw InputError(file, 0, std::string("cannot import: ") + importer.GetErrorString());
-    if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 || scene->mRootNode == nullptr)
-        throw InputError(file, 0, "cannot import: the file holds no complete scene");
-
-    TriMesh mesh;
+    const double seconds = importSeconds(path);
+    std::string bytes;
+    try {
+        bytes = detail::runInChild([&] { return importTriangles(file); }, seconds);
+    } catch (const detail::ChildFailure& e) {
+        switch (e.kind()) {
+        case detail::ChildFailure::Kind::Threw: throw InputError(file, 0, e.what());
+        case detail::ChildFailure::Kind::Crashed:
+            throw InputError(file, 0, std::string("cannot import: assimp's importer crashed reading the file (") + e.what() +
+                                          "): the file is damaged, or a variant of its format assimp cannot read");
+        case detail::ChildFailure::Kind::TimedOut:
+            throw InputError(file, 0, std::string("cannot import: assimp's importer ") + e.what() +
+                                          ": the file is damaged, or a variant of its format assimp cannot read");
+        case detail::ChildFailure::Kind::Failed: throw InputError(file, 0, std::string("cannot import: the import process ") + e.what());
+        }
+    }
+    TriMesh mesh = deserialize(bytes, file);
     mesh.name = path.stem().string();
-    appendNode(*scene, *scene->mRootNode, Eigen::Matrix4d::Identity(), file, mesh);
     if (mesh.faces.empty()) throw InputError(file, 0, "empty mesh: no triangles");
     for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
         if (!mesh.vertices[v].allFinite())

@@ -8,7 +8,19 @@ namespace flexfit {
 // The file's extension in lower case (".stl").
 std::string lowerExtension(const std::filesystem::path& path);
 
+// Through assimp, whose import runs in a child process (assimp_io.cpp): a crash or a hang on a
+// damaged file is an InputError. The import may take 30 s plus 2 s per MB of file.
 MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadOptions& options);
+namespace detail {
+// Tests: every assimp import in this scope may take `seconds` (> 0). Scopes must not overlap.
+class ScopedImportTimeLimit {
+public:
+    explicit ScopedImportTimeLimit(double seconds);
+    ~ScopedImportTimeLimit();
+    ScopedImportTimeLimit(const ScopedImportTimeLimit&) = delete;
+    ScopedImportTimeLimit& operator=(const ScopedImportTimeLimit&) = delete;
+};
+}  // namespace detail
 // OBJ in the file's vertex order (obj_io.cpp).
 MeshReadResult parseObj(std::string_view text, const std::string& source, const MeshReadOptions& options);
 MeshReadResult readObj(const std::filesystem::path& path, const MeshReadOptions& options);

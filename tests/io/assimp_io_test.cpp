@@ -3,6 +3,7 @@
 #include "float_precision.hpp"
 #include "strings.hpp"
 #include "flexfit/mesh_io.hpp"
+#include "io/io_internal.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,6 +18,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace flexfit {
@@ -429,6 +431,30 @@ TEST(AssimpIo, GarbageFilesAreRejected) {
     expectReadError(dir.write("empty.obj", ""));
     expectReadError(dir.write("garbage.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [ {"));
     expectReadError(dir.write("unknown.xyz123", "1 2 3\n"));
+}
+
+// Damaged copies of assimp-testmodels files on which assimp 5.2.5's importers crash (MD5, COB)
+// or never return (OpenGEX): each is an InputError naming the file, and this process goes on.
+TEST(AssimpIo, FilesThatCrashOrHangTheImporterAreErrors) {
+    const fs::path models = "/usr/share/assimp/models";
+    if (!fs::exists(models / "MD5/SimpleCube.md5mesh")) GTEST_SKIP() << "assimp-testmodels is not installed (Debian package)";
+    TempDir dir;
+    const auto cut = [&](const fs::path& from, std::size_t bytes, const std::string& name) {
+        std::ifstream in(models / from, std::ios::binary);
+        std::string head(bytes, '\0');
+        in.read(head.data(), std::streamsize(bytes));
+        head.resize(std::size_t(in.gcount()));
+        return dir.write(name, head);
+    };
+    const detail::ScopedImportTimeLimit limit(3.0);
+    for (const auto& [from, bytes, name] : {std::tuple<fs::path, std::size_t, std::string>{"MD5/SimpleCube.md5mesh", 1200, "cut.md5mesh"},
+                                            {"COB/molecule.cob", 18000, "cut.cob"},
+                                            {"OpenGEX/Example.ogex", 3797, "cut.ogex"}}) {
+        if (!fs::exists(models / from)) continue;
+        const InputError e = expectReadError(cut(from, bytes, name));
+        EXPECT_TRUE(contains(e.problem(), "cannot import")) << e.problem();
+    }
+    expectTetrahedronResult(readMesh(dir.write("whole.stl", stlTetrahedron())));  // and imports go on
 }
 
 TEST(AssimpIo, TruncatedAsciiStlIsRejected) {
