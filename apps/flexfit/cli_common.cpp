@@ -130,12 +130,7 @@ MeshReadResult loadMesh(const std::filesystem::path& path, const MeshReadOptions
     return result;
 }
 
-void writeTextFile(const std::filesystem::path& path, const std::string& text) {
-    std::ofstream file(path, std::ios::binary);
-    if (!file) throw InputError(path.string(), 0, "cannot open the file for writing");
-    file << text;
-    if (!file) throw InputError(path.string(), 0, "write failed");
-}
+void writeTextFile(const std::filesystem::path& path, const std::string& text) { writeWholeFile(path, text); }
 
 void writePartsObj(const std::filesystem::path& path, const std::string& header, const std::vector<NamedPart>& parts) {
     std::ostringstream obj;
@@ -143,7 +138,7 @@ void writePartsObj(const std::filesystem::path& path, const std::string& header,
     std::size_t base = 1;
     std::vector<Vec3> world;
     for (const NamedPart& named : parts) {
-        obj << "o " << named.name << "\n";
+        obj << "o " << objObjectName(named.name) << "\n";
         named.part->drawnWorldPositions(world);
         for (const Vec3& v : world) obj << fmt::format("v {:.9g} {:.9g} {:.9g}\n", v.x(), v.y(), v.z());
         for (const Face& f : named.part->model().drawnMesh().faces) obj << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";

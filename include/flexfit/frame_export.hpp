@@ -21,6 +21,7 @@
 #include "flexfit/part.hpp"
 
 #include <filesystem>
+#include <string_view>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,13 @@ void writeVtkCollection(const std::filesystem::path& file, const std::vector<std
 // (`<file>.<pid>-<n>.partial`), so two writers of the same file (a command and a Python sweep,
 // a retried task) never write into each other's temporary.
 std::filesystem::path temporaryBeside(const std::filesystem::path& file);
+
+// Writes `text` as the whole of `file`: under temporaryBeside(file), closed (the last buffer
+// flushed), checked and renamed into place, so a write that fails (a full disk, a file-size
+// limit) leaves no file, or the earlier one, and throws InputError naming the file. A file that
+// exists and is not a regular file (a device, a pipe) is written in place, and checked alike.
+// The mesh writers (mesh_io.hpp), the frames here and the command's outputs use it.
+void writeWholeFile(const std::filesystem::path& file, std::string_view text);
 
 // Frames <directory>/<stem>_<NNNNNN>.vtp and the collection <directory>/<stem>.pvd.
 class VtkSeries {

@@ -59,10 +59,14 @@ MeshReadResult readTri(const std::filesystem::path& path, const MeshReadOptions&
 MeshReadResult readMesh(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
 // Writers; choose by extension with writeMesh (.tri or .obj). Throw InputError when the file
-// cannot be written. Coordinates are written with 17 significant digits (exact round trip).
+// cannot be written, and then leave no file, or the earlier one (writeWholeFile,
+// frame_export.hpp). Coordinates are written with 17 significant digits (exact round trip).
 void writeTri(const TriMesh& mesh, const std::filesystem::path& path);
 void writeObj(const TriMesh& mesh, const std::filesystem::path& path);
 void writeMesh(const TriMesh& mesh, const std::filesystem::path& path);
 std::string formatTri(const TriMesh& mesh);
+// A name as an OBJ "o" line holds it: line breaks become spaces, and a trailing backslash (a
+// line continuation to OBJ readers, which would swallow the next line) an underscore.
+std::string objObjectName(std::string name);
 
 }  // namespace flexfit

@@ -25,17 +25,6 @@ void moveIntoPlace(const std::filesystem::path& temporary, const std::filesystem
     }
 }
 
-void writeWhole(const std::filesystem::path& file, const std::string& text) {
-    const std::filesystem::path temporary = temporaryBeside(file);
-    bool written = false;
-    {
-        std::ofstream out(temporary, std::ios::binary);
-        out << text;
-        written = bool(out);
-    }
-    moveIntoPlace(temporary, file, written);
-}
-
 void checkParts(const std::vector<FramePart>& parts, const std::filesystem::path& file) {
     if (parts.empty()) throw InputError(file.string(), 0, "no parts to write");
     for (const FramePart& p : parts)
@@ -105,13 +94,29 @@ std::filesystem::path temporaryBeside(const std::filesystem::path& file) {
     return file.string() + "." + std::to_string(::getpid()) + "-" + std::to_string(count++) + ".partial";
 }
 
+void writeWholeFile(const std::filesystem::path& file, std::string_view text) {
+    std::error_code ec;
+    const std::filesystem::file_status status = std::filesystem::status(file, ec);
+    const bool inPlace = std::filesystem::exists(status) && !std::filesystem::is_regular_file(status);
+    const std::filesystem::path target = inPlace ? file : temporaryBeside(file);
+    std::ofstream out(target, std::ios::binary);
+    if (!out) throw InputError(file.string(), 0, "cannot write the file: it cannot be created there");
+    out.write(text.data(), std::streamsize(text.size()));
+    out.close();  // flushes the last buffer: a full disk shows here
+    if (inPlace) {
+        if (out.fail()) throw InputError(file.string(), 0, "write failed");
+        return;
+    }
+    moveIntoPlace(target, file, !out.fail(), "write failed");
+}
+
 void writeVtkFrame(const std::filesystem::path& file, const std::vector<FramePart>& parts) {
     checkParts(parts, file);
     std::ostringstream out;
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n";
     for (const FramePart& p : parts) appendPiece(out, p);
     out << "</PolyData>\n</VTKFile>\n";
-    writeWhole(file, out.str());
+    writeWholeFile(file, out.str());
 }
 
 void writeGlbFrame(const std::filesystem::path& file, const std::vector<FramePart>& parts) {
@@ -163,7 +168,7 @@ void writeVtkCollection(const std::filesystem::path& file, const std::vector<std
         pvd << "<DataSet timestep=\"" << line << "\" part=\"0\" file=\"" << xmlEscaped(f) << "\"/>\n";
     }
     pvd << "</Collection>\n</VTKFile>\n";
-    writeWhole(file, pvd.str());
+    writeWholeFile(file, pvd.str());
 }
 
 VtkSeries::VtkSeries(std::filesystem::path directory, std::string stem)

@@ -1,5 +1,6 @@
 // Format dispatch and the OBJ writer.
 #include "flexfit/mesh_io.hpp"
+#include "flexfit/frame_export.hpp"
 #include "io_internal.hpp"
 #include "geometry/mesh_checks.hpp"
 #include "text_lines.hpp"
@@ -117,18 +118,25 @@ MeshReadResult readMesh(const std::filesystem::path& path, const MeshReadOptions
     return readWithAssimp(path, options);
 }
 
+// An OBJ object name on one line: line breaks become spaces, and a trailing backslash (a line
+// continuation to OBJ readers, which would swallow the first vertex) an underscore.
+std::string objObjectName(std::string name) {
+    for (char& c : name)
+        if (c == '\n' || c == '\r') c = ' ';
+    if (!name.empty() && name.back() == '\\') name.back() = '_';
+    return name;
+}
+
 void writeObj(const TriMesh& mesh, const std::filesystem::path& path) {
-    std::ofstream file(path, std::ios::binary);
-    if (!file) throw InputError(path.string(), 0, "cannot open the file for writing");
-    file << "# written by flexfit\n";
-    if (!mesh.name.empty()) file << "o " << mesh.name << "\n";
+    std::string text = "# written by flexfit\n";
+    if (!mesh.name.empty()) text += "o " + objObjectName(mesh.name) + "\n";
     char buffer[128];
     for (const Vec3& v : mesh.vertices) {
         std::snprintf(buffer, sizeof buffer, "v %.17g %.17g %.17g\n", v.x(), v.y(), v.z());
-        file << buffer;
+        text += buffer;
     }
-    for (const Face& f : mesh.faces) file << "f " << f[0] + 1 << " " << f[1] + 1 << " " << f[2] + 1 << "\n";
-    if (!file) throw InputError(path.string(), 0, "write failed");
+    for (const Face& f : mesh.faces) text += "f " + std::to_string(f[0] + 1) + " " + std::to_string(f[1] + 1) + " " + std::to_string(f[2] + 1) + "\n";
+    writeWholeFile(path, text);
 }
 
 void writeMesh(const TriMesh& mesh, const std::filesystem::path& path) {

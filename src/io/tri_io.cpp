@@ -1,5 +1,6 @@
 // The `.tri` reader and writer (format in mesh_io.hpp).
 #include "flexfit/mesh_io.hpp"
+#include "flexfit/frame_export.hpp"
 #include "io_internal.hpp"
 #include "text_lines.hpp"
 
@@ -138,10 +139,7 @@ std::string formatTri(const TriMesh& mesh) {
 }
 
 void writeTri(const TriMesh& mesh, const std::filesystem::path& path) {
-    std::ofstream file(path, std::ios::binary);
-    if (!file) throw InputError(path.string(), 0, "cannot open the file for writing");
-    file << formatTri(mesh);
-    if (!file) throw InputError(path.string(), 0, "write failed");
+    writeWholeFile(path, formatTri(mesh));
 }
 
 }  // namespace flexfit

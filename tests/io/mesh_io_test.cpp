@@ -11,6 +11,10 @@
 
 #include <unistd.h>
 
+#include <csignal>
+#include <sys/resource.h>
+#include <algorithm>
+#include <vector>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -99,6 +103,79 @@ TEST(MeshIo, WritersRejectUnwritablePaths) {
     EXPECT_THROW(writeMesh(mesh, missingDir / "m.obj"), InputError);
     EXPECT_THROW(writeObj(mesh, dir.path()), InputError);  // a directory
     EXPECT_THROW(writeTri(mesh, dir.path()), InputError);
+}
+
+// Runs `write` as a full disk would let it: with the file-size limit at 0 (SIGXFSZ ignored, so
+// a write fails with EFBIG instead of ending the process); the limit and the signal's handling
+// are restored before it returns.
+template <class Write>
+void withNoRoomToWrite(Write write) {
+    rlimit old{};
+    ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+    struct sigaction ignore {}, previous{};
+    ignore.sa_handler = SIG_IGN;
+    ::sigaction(SIGXFSZ, &ignore, &previous);
+    rlimit none = old;
+    none.rlim_cur = 0;
+    ::setrlimit(RLIMIT_FSIZE, &none);
+    write();
+    ::setrlimit(RLIMIT_FSIZE, &old);
+    ::sigaction(SIGXFSZ, &previous, nullptr);
+}
+
+std::vector<std::string> namesIn(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+// A write that fails at its end (the last buffer, flushed when the file closes) is an error, and
+// leaves the earlier file as it was, or none, and no temporary: `flexfit convert` once reported
+// success and left an empty or cut-off mesh.
+TEST(MeshIo, AFailedWriteLeavesTheEarlierFileOrNone) {
+    const TriMesh mesh = makeIcoSphere(1.0, 1);
+    TempDir dir;
+    const fs::path earlier = dir.write("earlier.obj", "earlier\n");
+    std::vector<std::string> errors;
+    withNoRoomToWrite([&] {
+        for (const fs::path& file : {earlier, dir.path() / "new.tri", dir.path() / "new.obj"}) {
+            try {
+                writeMesh(mesh, file);
+                errors.push_back("no error for " + file.string());
+            } catch (const InputError& e) {
+                if (e.source() != file.string() || e.problem() != "write failed") errors.push_back(e.what());
+            }
+        }
+    });
+    EXPECT_TRUE(errors.empty()) << errors.front();
+    std::ifstream in(earlier);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "earlier\n");
+    EXPECT_EQ(namesIn(dir.path()), std::vector<std::string>{"earlier.obj"});
+    if (fs::exists("/dev/full")) {  // a device is written in place, and its failure seen
+        EXPECT_THROW(writeObj(mesh, "/dev/full"), InputError);
+        EXPECT_THROW(writeTri(mesh, "/dev/full"), InputError);
+    }
+    writeMesh(mesh, earlier);  // with room, the file is replaced whole
+    EXPECT_EQ(readMesh(earlier).mesh.faces.size(), mesh.faces.size());
+    EXPECT_EQ(namesIn(dir.path()), std::vector<std::string>{"earlier.obj"});
+}
+
+// An OBJ reader continues a line that ends in a backslash: a model named "C:\parts\" would
+// swallow the first vertex. Line breaks would start a line of their own.
+TEST(MeshIo, ObjectNamesStayOnTheirLine) {
+    EXPECT_EQ(objObjectName("C:\\parts\\"), "C:\\parts_");
+    EXPECT_EQ(objObjectName("two\nlines\r"), "two lines ");
+    EXPECT_EQ(objObjectName("plain"), "plain");
+    TempDir dir;
+    for (const std::string name : {"C:\\parts\\", "a\nb"}) {
+        TriMesh mesh = makeIcoSphere(1.0, 0);
+        mesh.name = name;
+        writeObj(mesh, dir.path() / "m.obj");
+        const MeshReadResult back = readMesh(dir.path() / "m.obj");
+        EXPECT_EQ(back.mesh.vertices.size(), mesh.vertices.size()) << name;
+        EXPECT_EQ(back.mesh.faces.size(), mesh.faces.size()) << name;
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
