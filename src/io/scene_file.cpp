@@ -13,6 +13,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <set>
 
@@ -84,6 +85,17 @@ public:
     std::string requiredText(const std::string& key) {
         if (!has(key)) fail("missing key '" + key + "'");
         return text(key, "");
+    }
+    // A name that heads columns of metrics.csv and labels frames: non-empty, on one line, with
+    // no comma or double quote (which would split or break a CSV header).
+    std::string name(const std::string& key, const std::optional<std::string>& fallback = std::nullopt) {
+        if (!fallback && !has(key)) fail("missing key '" + key + "'");
+        const std::string value = text(key, fallback.value_or(""));
+        const bool plain = !value.empty() && std::none_of(value.begin(), value.end(), [](char c) {
+            return c == ',' || c == '"' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+        });
+        if (!plain && has(key)) fail(*node(key), key, "a name must be non-empty, on one line, with no comma or double quote (names head the columns of metrics.csv)");
+        return value;
     }
     Vec3 vec3(const std::string& key, const Vec3& fallback) {
         const toml::node* n = node(key);
@@ -370,7 +382,7 @@ void readMaterial(Table& t, PartModelSettings& model) {
 
 ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
     ScenePart p;
-    p.name = t.requiredText("name");
+    p.name = t.name("name");
     p.line = t.line();
     if (t.has("mesh") == t.has("generator")) t.fail("needs exactly one of 'mesh' and 'generator'");
     for (const char* key : {"repair", "remesh", "draw", "vertex_order"})
@@ -449,6 +461,7 @@ AssemblyVector readVector(Table& t, const std::string& key) {
     Table s = t.sub(key);
     v.origin = s.vec3("origin", v.origin);
     v.end = s.vec3("end", v.end);
+    if (v.origin == v.end) s.fail(*s.node(s.has("end") ? "end" : "origin"), s.has("end") ? "end" : "origin", "the vector's origin and end coincide: a vector of zero length has no direction");
     s.finish();
     return v;
 }
@@ -469,7 +482,13 @@ AssemblyArea readArea(Table& t) {
 
 AssemblyRule readAssembly(Table& t, const Scene& scene) {
     AssemblyRule r;
-    r.name = t.text("name", "assembly " + std::to_string(scene.assemblies.size()));
+    r.name = t.name("name", "assembly " + std::to_string(scene.assemblies.size()));
+    for (const AssemblyRule& other : scene.assemblies)
+        if (other.name == r.name) {
+            const std::string problem = "duplicate assembly name '" + r.name + "'";
+            if (t.has("name")) t.fail(*t.node("name"), "name", problem);
+            t.fail(problem + " (the default name of the assembly at this place)");
+        }
     r.primary = partId(t, "primary", scene);
     r.secondary = partId(t, "secondary", scene);
     if (r.primary == r.secondary) t.fail(*t.node("secondary"), "secondary", "must differ from the primary");

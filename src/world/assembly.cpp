@@ -87,6 +87,9 @@ std::size_t addRule(const AssemblyRule& rule, std::size_t bodyCount, AssemblySta
         throw InputError("world", 0, "assembly rule '" + rule.name + "' needs two different existing bodies");
     if (!(rule.snapDuration >= 0.0) || !std::isfinite(rule.snapDuration))
         throw InputError("world", 0, "assembly rule '" + rule.name + "': snap duration must be finite and >= 0");
+    for (const AssemblyVector* v : {&rule.primaryVector, &rule.secondaryVector})
+        if (!v->origin.allFinite() || !v->end.allFinite() || v->origin == v->end)
+            throw InputError("world", 0, "assembly rule '" + rule.name + "': a vector's origin and end must be finite and differ (zero length has no direction)");
     RuleState state;
     state.rule = rule;
     assembly.rules.push_back(state);

@@ -210,6 +210,36 @@ TEST(SceneFile, DuplicatePartName) {
     EXPECT_NE(e.find(":17: part 2, key 'name': duplicate part name 'mouth'"), std::string::npos) << e;
 }
 
+// Names head the columns of metrics.csv: a comma, a quote or a line break would split or break
+// its header, and an empty name labels nothing.
+TEST(SceneFile, NamesThatWouldBreakACsvHeaderAreReported) {
+    for (const std::string bad : {"\"b,all\"", "\"b\\\"all\"", "\"b\\nall\"", "\"\""}) {
+        std::string text = kBall;
+        text.replace(text.find("name = \"ball\""), 13, "name = " + bad);
+        const std::string e = errorOf(text);
+        EXPECT_NE(e.find(":17: part 2, key 'name': a name must be non-empty, on one line, with no comma or double quote"), std::string::npos)
+            << bad << ": " << e;
+    }
+    const std::string assembly = errorOf(withLine("[[assembly]]", "name = \"snap, left\""));
+    EXPECT_NE(assembly.find(":26: assembly 1, key 'name': a name must"), std::string::npos) << assembly;
+}
+
+TEST(SceneFile, DuplicateAssemblyName) {
+    std::string text = withLine("[[assembly]]", "name = \"snap\"");
+    text += "\n[[assembly]]\nname = \"snap\"\nprimary = \"ball\"\nsecondary = \"mouth\"\n";
+    const std::string e = errorOf(text);
+    EXPECT_NE(e.find("key 'name': duplicate assembly name 'snap'"), std::string::npos) << e;
+}
+
+// A vector of zero length has no direction to snap along: refused at the key that makes it so.
+TEST(SceneFile, AZeroLengthAssemblyVectorIsReported) {
+    const std::string e = errorOf(withLine("[[assembly]]", "primary_vector = { origin = [0, -8.5, 0], end = [0, -8.5, 0] }"));
+    EXPECT_NE(e.find(":26: assembly 1.primary_vector, key 'end': the vector's origin and end coincide"), std::string::npos) << e;
+    const std::string byDefault = errorOf(withLine("[[assembly]]", "secondary_vector = { origin = [0, 1, 0] }"));  // end defaults to (0, 1, 0)
+    EXPECT_NE(byDefault.find("assembly 1.secondary_vector, key 'origin': the vector's origin and end coincide"), std::string::npos) << byDefault;
+    EXPECT_EQ(errorOf(withLine("[[assembly]]", "primary_vector = { origin = [0, -8.5, 0], end = [0, -7.5, 0] }")), "");
+}
+
 TEST(SceneFile, MeshAndGeneratorAreExclusive) {
     const std::string e = errorOf(withLine("name = \"ball\"", "mesh = \"ball.tri\""));
     EXPECT_NE(e.find(":16: part 2: needs exactly one of 'mesh' and 'generator'"), std::string::npos) << e;

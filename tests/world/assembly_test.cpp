@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 using namespace flexfit;
 
 namespace {
@@ -149,6 +151,12 @@ TEST(Assembly, RulesAreCountedAndARefusedRuleIsNotAdded) {
     EXPECT_THROW(world.addAssembly(r), InputError);
     r.secondary = b;
     r.snapDuration = -1.0;
+    EXPECT_THROW(world.addAssembly(r), InputError);
+    r.snapDuration = 0.0;
+    r.primaryVector.end = r.primaryVector.origin;  // zero length: no direction
+    EXPECT_THROW(world.addAssembly(r), InputError);
+    r.primaryVector = AssemblyVector{};
+    r.secondaryVector.origin = Vec3(0.0, std::nan(""), 0.0);
     EXPECT_THROW(world.addAssembly(r), InputError);
     EXPECT_EQ(world.assemblyCount(), 1u);
     EXPECT_THROW((void)world.assembled(1), InputError);
