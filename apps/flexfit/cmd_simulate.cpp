@@ -120,6 +120,14 @@ void run(const SimulateOptions& opt) {
             kinetic += 0.5 * model.mass[i] * state.velocities[i].squaredNorm();
             displacement = std::max(displacement, (state.positions[i] - model.restPositions[i]).norm());
         }
+        // A state whose positions stay finite while its energy overflows (a uniform load far
+        // beyond the model's scale: every mass moves together, which the part's spread check does
+        // not see) is a divergence, not a row of inf.
+        if (!std::isfinite(kinetic) || !std::isfinite(displacement))
+            throw DivergenceError(std::nullopt, state.time,
+                                  "its kinetic energy or largest displacement overflows a double: a load, gravity or speed far beyond "
+                                  "the model's scale",
+                                  model.name);
         csv << state.stepCount << "," << fmt::format("{:.6f}", state.time);
         for (const ActivityTracker& t : trackers) csv << "," << t.activeNow();
         csv << "," << fmt::format("{:.9g},{:.9g}", kinetic, displacement) << "," << part.movingMasses().size() << ","
