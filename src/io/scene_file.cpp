@@ -446,6 +446,13 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     } catch (const InputError& e) {
         t.fail("invalid part: " + std::string(e.what()));
     }
+    if (p.body.motion == MotionType::Dynamic && t.has("density")) {  // the body the world will make of it
+        try {
+            makeRigidBody(*p.model, p.body);
+        } catch (const InputError& e) {
+            t.fail(*t.node("density"), "density", e.problem());
+        }
+    }
     return p;
 }
 
@@ -519,7 +526,13 @@ void checkMasses(Table& t, const std::vector<Index>& masses, const PartModel& mo
             t.fail(*t.node("masses"), "masses", "vertex " + std::to_string(v) + " of the part's mesh file was removed by the repair (no face uses it): it has no mass");
 }
 
-SceneAction readAction(Table& t, const Scene& scene) {
+std::string formatSeconds(double seconds) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.9g", seconds);
+    return text;
+}
+
+SceneAction readAction(Table& t, Scene& scene) {
     using Kind = SceneAction::Kind;
     SceneAction a;
     a.line = t.line();
@@ -549,6 +562,7 @@ SceneAction readAction(Table& t, const Scene& scene) {
             if (!t.has("force")) t.fail("missing key 'force'");
             a.force = t.vec3("force", Vec3::Zero());
             a.duration = t.nonNegative("duration", 0.0);
+            if (part.body.motion == MotionType::Static) t.fail(*t.node("part"), "part", "a static part does not move: a push has no effect on it");
             break;
         case Kind::Force:
             if (!t.has("force")) t.fail("missing key 'force'");
@@ -563,6 +577,8 @@ SceneAction readAction(Table& t, const Scene& scene) {
         case Kind::Velocity:
             a.linear = t.vec3("linear", Vec3::Zero());
             a.angular = t.vec3("angular", Vec3::Zero());
+            if (part.body.motion == MotionType::Static)
+                t.fail(*t.node("part"), "part", "a static part does not move: a velocity has no effect on it");
             break;
         case Kind::Kick:
             if (!t.has("velocity")) t.fail("missing key 'velocity' (the masses' velocity change)");
@@ -573,6 +589,9 @@ SceneAction readAction(Table& t, const Scene& scene) {
             break;
     }
     t.finish();
+    if (a.time >= scene.duration)
+        scene.warnings.push_back({t.line("time"), t.what() + ", key 'time': at or after the scene's duration (" + formatSeconds(scene.duration) +
+                                                      " s): the action runs only in a longer run"});
     return a;
 }
 

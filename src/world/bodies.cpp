@@ -4,9 +4,17 @@
 #include "flexfit/mass_properties.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace flexfit {
+namespace {
+std::string shortNumber(double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", x);
+    return text;
+}
+}  // namespace
 
 RigidBody makeRigidBody(const PartModel& model, const BodySettings& settings) {
     const std::string source = "world";
@@ -29,6 +37,11 @@ RigidBody makeRigidBody(const PartModel& model, const BodySettings& settings) {
         body.inverseMass = 1.0 / body.mass;
         body.centreOfMass = mp.centroid;
         body.inverseInertia = (settings.density * mp.inertia).inverse();
+        // A density far beyond the mesh's scale overflows the mass or underflows it to 0 (and
+        // the step would turn every contact into NaN): refused here, not found diverged later.
+        if (!(std::isfinite(body.mass) && body.mass > 0.0 && std::isfinite(body.inverseMass) && body.inverseInertia.allFinite()))
+            throw InputError(source, 0, "density " + shortNumber(settings.density) + " x the volume " + shortNumber(mp.volume) + " of '" +
+                                            model.name + "' gives no finite, positive mass and inertia: a density far beyond the mesh's scale");
     }
     for (const Vec3& p : model.restPositions) body.boundingRadius = std::max(body.boundingRadius, (p - body.centreOfMass).norm());
     body.linearVelocity = settings.linearVelocity;

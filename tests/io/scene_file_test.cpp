@@ -269,6 +269,32 @@ TEST(SceneFile, StaticPartCannotBeGrabbed) {
     EXPECT_NE(e.find(":47: action 3, key 'part': a static part cannot be grabbed"), std::string::npos) << e;
 }
 
+// A static part does not move: a push or a velocity on it would be silently lost.
+TEST(SceneFile, StaticPartCannotBePushedOrGivenAVelocity) {
+    const std::string push = errorOf(std::string(kBall) + "\n[[action]]\ntime = 1\ntype = \"push\"\npart = \"mouth\"\nforce = [0, 1, 0]\n");
+    EXPECT_NE(push.find(":47: action 3, key 'part': a static part does not move: a push has no effect on it"), std::string::npos) << push;
+    const std::string velocity = errorOf(std::string(kBall) + "\n[[action]]\ntime = 1\ntype = \"velocity\"\npart = \"mouth\"\nlinear = [0, 1, 0]\n");
+    EXPECT_NE(velocity.find(":47: action 3, key 'part': a static part does not move: a velocity has no effect on it"), std::string::npos)
+        << velocity;
+}
+
+// An action at or after the scene's end never runs in it: said, at its line, not refused (a
+// longer run, --duration, reaches it).
+TEST(SceneFile, AnActionAfterTheEndIsWarnedOf) {
+    const Scene s = parseScene(std::string(kBall) + "\n[[action]]\ntime = 2.5\ntype = \"release\"\npart = \"ball\"\n", "scene.toml", ".");
+    ASSERT_EQ(s.warnings.size(), 1u);
+    EXPECT_EQ(s.warnings[0].line, 45u);
+    EXPECT_EQ(s.warnings[0].message, "action 3, key 'time': at or after the scene's duration (2.5 s): the action runs only in a longer run");
+    EXPECT_TRUE(parseScene(kBall, "scene.toml", ".").warnings.empty());
+}
+
+TEST(SceneFile, ADensityWithNoFiniteMassIsReportedAtItsLine) {
+    std::string text = kBall;
+    text.replace(text.find("density = 0.01"), 14, "density = 1e300");
+    const std::string e = errorOf(text);
+    EXPECT_NE(e.find(":21: part 2, key 'density': density 1e+300 x the volume"), std::string::npos) << e;
+}
+
 TEST(SceneFile, EmptySceneIsRefused) {
     const std::string e = errorOf("[world]\ntime_step = 0.001\n");
     EXPECT_NE(e.find("scene.toml:1: scene: no [[part]]"), std::string::npos) << e;

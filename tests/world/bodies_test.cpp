@@ -54,6 +54,15 @@ TEST(Bodies, BadSettingsAreRefused) {
     sheet.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     sheet.faces = {{0, 1, 2}};
     EXPECT_THROW(makeRigidBody(*buildPartModel(sheet), open), InputError);
+    // A density whose mass overflows, or underflows to 0: refused, not a NaN in the first step.
+    BodySettings dynamic;
+    dynamic.motion = MotionType::Dynamic;
+    for (const double density : {1e300, 1e-320}) {
+        dynamic.density = density;
+        EXPECT_THROW(makeRigidBody(*model, dynamic), InputError) << density;
+    }
+    dynamic.density = 1e-60;  // tiny, but a finite mass and an invertible inertia: accepted
+    EXPECT_GT(makeRigidBody(*model, dynamic).mass, 0.0);
 }
 
 TEST(Bodies, WorldMassNumberingFollowsTheBodies) {
