@@ -5,6 +5,7 @@
 #include "sweep_runner.hpp"
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <thread>
 
@@ -41,6 +42,10 @@ void registerSweep(CLI::App& app) {
         const auto ran = runSweep(sweep, opt->out, jobs, !opt->noProgress);
         fmt::print("{}: {} runs ({} run now, {} done before) on {} threads; table {}\n", opt->sweep, sweep.runs.size(), ran.size(),
                    sweep.runs.size() - ran.size(), jobs, (std::filesystem::path(opt->out) / "results.csv").string());
+        // A diverged run is a result (its row says so), but not one to pass unseen.
+        if (const std::vector<std::string> notOk = sweepRunsNotOk(sweep, opt->out); !notOk.empty())
+            fmt::print(stderr, "warning: {} of {} runs diverged ({}): results.csv has their status and message\n", notOk.size(),
+                       sweep.runs.size(), fmt::join(notOk, ", "));
     });
 }
 

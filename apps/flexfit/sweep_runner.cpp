@@ -100,6 +100,18 @@ bool runSweepRun(const Sweep& sweep, std::size_t run, const std::filesystem::pat
     return true;
 }
 
+std::vector<std::string> sweepRunsNotOk(const Sweep& sweep, const std::filesystem::path& out) {
+    std::vector<std::string> ids;
+    for (std::size_t r = 0; r < sweep.runs.size(); ++r) {
+        std::ifstream in(rowPath(sweep, r, out), std::ios::binary);
+        std::string row;
+        if (!in || !std::getline(in, row)) continue;
+        const std::string start = rowStart(sweep, r);
+        if (row.compare(0, start.size() + 4, start + ",ok,") != 0) ids.push_back(sweep.runs[r].id);
+    }
+    return ids;
+}
+
 std::filesystem::path writeSweepTable(const Sweep& sweep, const std::filesystem::path& out) {
     std::string table = header(sweep, sweepScene(sweep, 0));
     for (std::size_t r = 0; r < sweep.runs.size(); ++r) {

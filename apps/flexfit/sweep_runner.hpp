@@ -31,6 +31,9 @@ bool runSweepRun(const Sweep& sweep, std::size_t run, const std::filesystem::pat
 // Writes out/results.csv from every run's row; throws InputError naming the first run not done.
 std::filesystem::path writeSweepTable(const Sweep& sweep, const std::filesystem::path& out);
 
+// The ids of the done runs whose status is not "ok" (diverged), in order.
+std::vector<std::string> sweepRunsNotOk(const Sweep& sweep, const std::filesystem::path& out);
+
 // Runs the missing runs on `jobs` threads, then writes the table. Returns the runs it ran.
 std::vector<std::size_t> runSweep(const Sweep& sweep, const std::filesystem::path& out, int jobs, bool progress);
 
