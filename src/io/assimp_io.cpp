@@ -216,7 +216,10 @@ void checkAsciiStl(const std::filesystem::path& path) {
                 if (++vertices > 3) fail("a facet with more than three vertices: STL facets are triangles");
                 expectNumbers(1, "vertex");
                 for (std::size_t i = 1; i < 4; ++i)
-                    if (isNonFiniteToken(line.tokens[i])) fail("a vertex has a NaN or infinite coordinate");
+                    if (isNonFiniteToken(line.tokens[i]))
+                        fail(wholeNumber(line.tokens[i])->outOfRange || std::isfinite(wholeNumber(line.tokens[i])->value)
+                                 ? "coordinate '" + std::string(line.tokens[i]) + "' is beyond single precision (STL holds 32-bit floats, about 3.4e38 at most)"
+                                 : std::string("a vertex has a NaN or infinite coordinate"));
             } else if (key == "endloop") {
                 if (vertices != 3) fail("a facet with " + std::to_string(vertices) + " vertices: STL facets are triangles");
                 at = At::LoopEnd;
@@ -231,6 +234,28 @@ void checkAsciiStl(const std::filesystem::path& path) {
     if (at != At::AfterSolid) throw InputError(file, lastLine, "the ASCII STL ends without an 'endsolid' line: the file is cut short");
 }
 
+// A .stl that is not an ASCII STL must be a binary one: an 80-byte header, the facet count n,
+// then 50 bytes a facet. Checked here, so a file cut short or with a wrong count is named as
+// such (assimp says only "Failed to determine STL storage representation").
+void checkBinaryStl(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (lowerExtension(path) != ".stl" || !std::filesystem::is_regular_file(path, ec) || isAsciiStl(path)) return;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec) return;  // assimp names what else is wrong
+    const std::string file = path.string();
+    const std::string neither = "neither an ASCII STL (a first line 'solid', keywords in lower case) nor a binary STL";
+    if (size < 84) throw InputError(file, 0, neither + " (an 84-byte header, then 50 bytes a facet): " + std::to_string(size) + " bytes");
+    std::ifstream in(path, std::ios::binary);
+    char header[84];
+    in.read(header, 84);
+    std::uint32_t facets = 0;
+    std::memcpy(&facets, header + 80, 4);
+    const std::uint64_t expected = 84 + 50 * std::uint64_t(facets);
+    if (size != expected)
+        throw InputError(file, 0, neither + ": as binary, its header counts " + std::to_string(facets) + " facets (" + std::to_string(expected) +
+                                      " bytes) but the file has " + std::to_string(size) + " bytes (cut short, or damaged)");
+}
+
 }  // namespace
 
 namespace detail {
@@ -242,6 +267,7 @@ MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadO
     const std::string file = path.string();
     if (!std::filesystem::exists(path)) throw InputError(file, 0, "cannot open the file for reading: it does not exist");
     checkAsciiStl(path);
+    checkBinaryStl(path);
     const double seconds = importSeconds(path);
     std::string bytes;
     try {

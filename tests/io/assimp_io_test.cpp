@@ -224,6 +224,15 @@ TEST(AssimpIo, BinaryStlTetrahedronIsWelded) {
     // Some exporters start a binary header with "solid": its size still says binary.
     stl.replace(0, 9, "solid bin");
     expectTetrahedronResult(readMesh(dir.write("tet_binary_solid.stl", stl)));
+    // Cut short, or a count that disagrees with the size: said so (assimp named neither).
+    stl.replace(0, 9, "flexfit 1");
+    for (const std::string& bad : {stl.substr(0, stl.size() - 20), stl + std::string(50, '\0'), stl.substr(0, 60)}) {
+        const InputError e = expectReadError(dir.write("bad_binary.stl", bad));
+        EXPECT_TRUE(contains(e.problem(), "neither an ASCII STL")) << e.problem();
+        if (bad.size() >= 84) {
+            EXPECT_TRUE(contains(e.problem(), "its header counts 4 facets (284 bytes) but the file has")) << e.problem();
+        }
+    }
 }
 
 TEST(AssimpIo, AsciiPlyByItsOwnReader) {
@@ -372,6 +381,12 @@ TEST(AssimpIo, StlWithNaNCoordinateNamesTheLineOfTheVertex) {
     const InputError e = expectReadError(dir.write("nan.stl", stl));
     EXPECT_EQ(e.line(), 6u) << e.what();
     EXPECT_TRUE(contains(e.problem(), "NaN or infinite")) << e.problem();
+    // Finite, but beyond a float (assimp reads STL coordinates as 32-bit floats): said so.
+    std::string large = stlTetrahedron();
+    large.replace(large.find("vertex 1 0 0"), 12, "vertex 1 1e39 0");
+    const InputError beyond = expectReadError(dir.write("large.stl", large));
+    EXPECT_EQ(beyond.line(), 6u) << beyond.what();
+    EXPECT_TRUE(contains(beyond.problem(), "coordinate '1e39' is beyond single precision")) << beyond.problem();
 }
 
 TEST(AssimpIo, ObjWithInfCoordinateNamesTheLineOfTheVertex) {
@@ -413,7 +428,7 @@ TEST(AssimpIo, CoordinateBeyondSinglePrecision) {
         readMesh(file);
         ADD_FAILURE() << "big.stl was read";
     } catch (const InputError& e) {
-        EXPECT_TRUE(contains(e.problem(), "NaN or infinite") || contains(e.problem(), "beyond the 1e+20 units")) << e.problem();
+        EXPECT_TRUE(contains(e.problem(), "beyond single precision") || contains(e.problem(), "beyond the 1e+20 units")) << e.problem();
     }
 }
 
