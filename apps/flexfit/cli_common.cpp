@@ -29,6 +29,7 @@ CLI::Validator numberCheck(bool (*accepts)(double), const std::string& what, con
 
 const CLI::Validator positiveNumber = numberCheck([](double v) { return v > 0.0; }, "> 0", "POSITIVE");
 const CLI::Validator nonNegativeNumber = numberCheck([](double v) { return v >= 0.0; }, ">= 0", "NONNEGATIVE");
+const CLI::Validator openAngleDegrees = numberCheck([](double v) { return v > 0.0 && v < 180.0; }, "strictly between 0 and 180", "(0, 180)");
 
 void warn(const std::string& text) { fmt::print(stderr, "warning: {}\n", text); }
 

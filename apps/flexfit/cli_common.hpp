@@ -18,6 +18,7 @@ namespace flexfit::cli {
 // CLI11 2.1's PositiveNumber and NonNegativeNumber let NaN through and print their range's end,
 // the largest double, in 309 digits.
 extern const CLI::Validator positiveNumber;     // finite, > 0
+extern const CLI::Validator openAngleDegrees;   // finite, strictly between 0 and 180
 extern const CLI::Validator nonNegativeNumber;  // finite, >= 0
 
 // "x,y,z" -> Vec3; throws InputError naming `option`.

@@ -42,7 +42,8 @@ void registerRemesh(CLI::App& app) {
     cmd->add_option("--edge", opt->remesh.targetEdge, "Target edge length, in the mesh's units")->required()->check(positiveNumber);
     cmd->add_option("--iterations", opt->remesh.iterations, "Remeshing rounds")->capture_default_str()->check(CLI::Range(1, 100));
     cmd->add_option("--feature-angle", opt->remesh.featureAngle, "Edges whose faces meet at more than this many degrees stay sharp")
-        ->capture_default_str()->check(CLI::Range(0.0, 180.0));
+        ->capture_default_str()
+        ->check(openAngleDegrees);
     cmd->add_option("--thin-features", opt->thinFeatures,
                     "Sharp edges closer than half the target edge: keep them (slivers stay between them), round them, or auto (round "
                     "them when 1 % or more of the triangles are slivers, if that leaves fewer and the surface within the target edge of the input)")
@@ -61,6 +62,11 @@ void registerRemesh(CLI::App& app) {
         if (r.droppedFaces > 0) warn(fmt::format("{}: {} degenerate output faces dropped (where sharp polylines meet)", opt->in, r.droppedFaces));
         fmt::print("  Hausdorff distance {:.4g} ({:.3f} % of the bounding-box diagonal {:.4g})\n", r.hausdorff, 100.0 * r.hausdorffShare(),
                    r.diagonal);
+        if (opt->remesh.targetEdge > 0.1 * r.diagonal)  // the short side is refused; the long one is legal, but rarely meant
+            warn(fmt::format("{}: the target edge {:.4g} is {:.0f} % of the part's bounding-box diagonal: {} faces are left, {:.1f} % of the "
+                             "diagonal from the input (a unit mistaken?)",
+                             opt->in, opt->remesh.targetEdge, 100.0 * opt->remesh.targetEdge / r.diagonal, r.mesh.faces.size(),
+                             100.0 * r.hausdorffShare()));
     });
 }
 

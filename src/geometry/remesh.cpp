@@ -380,8 +380,12 @@ FinishedSurface finish(const WorkSurface& s, const std::string& name, const std:
 }
 
 // The Hausdorff distance's samples: vertices, and points at most this share of the target edge
-// apart along every edge and across every face (deterministic, unlike random sampling).
+// apart along every edge and across every face (deterministic, unlike random sampling), and at
+// most kSampleShare of kCoarseEdgeShare of the diagonal: a target edge far beyond the part's size
+// (1e6 on a torus of diagonal 36) spaced them so far apart that the distance read 5.8 where
+// a target of 50 read 7.7 on the same output.
 constexpr double kSampleShare = 0.25;
+constexpr double kCoarseEdgeShare = 0.1;
 
 // Points of segment ab strictly between its ends, at most `spacing` apart.
 void sampleBetween(const Point& a, const Point& b, double spacing, std::vector<Point>& out) {
@@ -548,7 +552,7 @@ RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, co
     checkRemeshSize(mesh, options.targetEdge, source);
     if (options.iterations < 1 || options.iterations > 100) throw InputError(source, 0, "remesh: iterations must be 1 to 100");
     if (!(options.featureAngle > 0.0 && options.featureAngle < 180.0))
-        throw InputError(source, 0, "remesh: the feature angle must be between 0 and 180 degrees");
+        throw InputError(source, 0, "remesh: the feature angle must be strictly between 0 and 180 degrees");
     r.before = measureQuality(mesh);
     const SurfaceMesh input = toSurfaceMesh(mesh, source);
     WorkSurface work(input);
@@ -560,7 +564,7 @@ RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, co
     PatchProjection projection(input, work.patch, patches);
     remeshIterations(work, options, projection);
     removeCapsAndNeedles(work, options.targetEdge);
-    const HausdorffFrom fromInput(input, kSampleShare * options.targetEdge);
+    const HausdorffFrom fromInput(input, kSampleShare * std::min(options.targetEdge, kCoarseEdgeShare * r.diagonal));
     r.hausdorff = fromInput.to(work.mesh);
     FinishedSurface result = finish(work, mesh.name, source);
     const bool round = options.thinFeatures == ThinFeatures::Round;

@@ -130,6 +130,22 @@ double farthestBruteForce(const TriMesh& from, const TriMesh& to, double spacing
     return farthest;
 }
 
+// A target edge far beyond the part (a unit mistaken) leaves a handful of faces; the distance
+// reported must still be measured at the part's scale. Both it and a brute force over samples
+// 1 % of the diagonal apart are lower bounds of the true distance, each short of it by about
+// its samples' spacing (the remesher's: a quarter of the edge, at most 2.5 % of the diagonal;
+// they were once spaced by the edge alone, and read 5.8 where the distance is 7.5).
+TEST(Remesh, TheHausdorffDistanceOfACoarseRemeshIsMeasuredAtThePartsScale) {
+    const TriMesh input = makeTorus(10.0, 2.5, 32, 12);
+    for (const double edge : {50.0, 1e6}) {
+        const RemeshResult r = remeshForSimulation(input, {.targetEdge = edge}, "torus");
+        const double spacing = 0.01 * r.diagonal;
+        const double lower = std::max(farthestBruteForce(input, r.mesh, spacing), farthestBruteForce(r.mesh, input, spacing));
+        EXPECT_GE(r.hausdorff, lower - 0.025 * r.diagonal) << "edge " << edge;
+        EXPECT_LE(r.hausdorff, lower + 0.02 * r.diagonal) << "edge " << edge;
+    }
+}
+
 // An open cone of height 1 and radius 1: a fan of n needles from its apex.
 TriMesh needleCone(int n) {
     TriMesh cone;
