@@ -22,7 +22,7 @@ void registerRun(CLI::App& app) {
     auto opt = std::make_shared<Options>();
     cmd->add_option("scene", opt->scene, "Scene file (.toml)")->required();
     cmd->add_option("--duration", opt->duration, "Simulated seconds (default: the scene's [world] duration)")->check(positiveNumber);
-    cmd->add_option("--out", opt->out, "Directory for metrics.csv, summary.json and OBJ frames");
+    cmd->add_option("--out", opt->out, "Directory for metrics.csv, summary.json and frames (a run replaces the frames an earlier run left there)");
     cmd->add_flag("--no-progress", opt->noProgress, "No progress bar");
     cmd->add_option("--obj-every", opt->objEvery, "Seconds between OBJ frames (default: the scene's [output]; 0: none)")->check(nonNegativeNumber);
     cmd->add_option("--vtk-every", opt->vtkEvery, "Seconds between VTK frames for ParaView (frame_*.vtp, frames.pvd; 0: none)")->check(nonNegativeNumber);

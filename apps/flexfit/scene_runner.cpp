@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <regex>
+#include <set>
 #include <span>
 
 namespace flexfit::cli {
@@ -106,6 +108,21 @@ std::string jsonString(const std::string& s) {
 
 std::string optionalJson(const std::optional<double>& v) { return v ? fmt::format("{:.6f}", *v) : "null"; }
 
+// A run into a directory an earlier run wrote replaces that run's frames: frame_NNNNNN.obj,
+// .vtp, .glb and frames.pvd that this run did not write are removed once it has finished (they
+// would otherwise sit beside the new ones, and ParaView or a script would read them as this
+// run's). Nothing else in the directory is touched.
+void removeEarlierFrames(const std::filesystem::path& out, const std::set<std::string>& written) {
+    static const std::regex frame(R"(frame_[0-9]{6}\.(obj|vtp|glb)|frames\.pvd)");
+    std::error_code ec;
+    std::vector<std::filesystem::path> earlier;
+    for (const auto& entry : std::filesystem::directory_iterator(out, ec)) {
+        const std::string name = entry.path().filename().string();
+        if (entry.is_regular_file(ec) && std::regex_match(name, frame) && !written.contains(name)) earlier.push_back(entry.path());
+    }
+    for (const auto& path : earlier) std::filesystem::remove(path, ec);  // best effort: the run itself is done
+}
+
 }  // namespace
 
 RunSummary runScene(const Scene& scene, const RunOptions& options) {
@@ -138,6 +155,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     std::vector<FramePart> frameParts;
     for (BodyId id = 0; id < w.bodyCount(); ++id) frameParts.push_back({scene.parts[id].name, &w.part(id)});
     std::vector<std::pair<double, std::string>> vtkFrames;
+    std::set<std::string> frameNames;  // this run's frames, and frames.pvd
     std::vector<double> deformations(w.bodyCount(), 0.0);  // by body, this step's
     ProgressBar bar("run " + std::filesystem::path(scene.source).filename().string(), options.progress);
     const auto start = Clock::now();
@@ -170,13 +188,13 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         if (w.coupling().active) s.maxCouplingForce = std::max(s.maxCouplingForce, w.coupling().force.norm());
         if (csv.is_open() && (i + 1) % std::uint64_t(std::max(1, options.csvEvery)) == 0) csv << csvRow(scene, w, deformations);
         if (objStride && !options.out.empty() && (i + 1) % objStride == 0)
-            writeObjFrame(files.add(options.out / fmt::format("frame_{:06d}.obj", i + 1)), w, scene);
+            writeObjFrame(files.add(options.out / *frameNames.insert(fmt::format("frame_{:06d}.obj", i + 1)).first), w, scene);
         if (vtkStride && !options.out.empty() && (i + 1) % vtkStride == 0) {
-            vtkFrames.emplace_back(w.time(), fmt::format("frame_{:06d}.vtp", i + 1));
+            vtkFrames.emplace_back(w.time(), *frameNames.insert(fmt::format("frame_{:06d}.vtp", i + 1)).first);
             writeVtkFrame(files.add(options.out / vtkFrames.back().second), frameParts);
         }
         if (glbStride && !options.out.empty() && (i + 1) % glbStride == 0)
-            writeGlbFrame(files.add(options.out / fmt::format("frame_{:06d}.glb", i + 1)), frameParts);
+            writeGlbFrame(files.add(options.out / *frameNames.insert(fmt::format("frame_{:06d}.glb", i + 1)).first), frameParts);
         bar.update(double(i + 1) / double(steps));
     }
     bar.finish();
@@ -189,10 +207,11 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     for (BodyId id = 0; id < w.bodyCount(); ++id) s.finalCentres.push_back(w.centreOfMass(id));
     if (!options.out.empty()) {
         writeTextFile(files.add(options.out / "summary.json"), summaryJson(scene, s));
-        if (!vtkFrames.empty()) writeVtkCollection(files.add(options.out / "frames.pvd"), vtkFrames);
+        if (!vtkFrames.empty()) writeVtkCollection(files.add(options.out / *frameNames.insert("frames.pvd").first), vtkFrames);
         csv.close();
         if (!csv) throw InputError(csvPath.string(), 0, "write failed");
         files.commit();
+        removeEarlierFrames(options.out, frameNames);
     }
     return s;
 }
