@@ -110,6 +110,8 @@ MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSou
 MeshReadResult readMesh(const std::filesystem::path& path, const MeshReadOptions& options) {
     if (options.weldTolerance && !(*options.weldTolerance >= 0.0 && std::isfinite(*options.weldTolerance)))
         throw InputError(path.string(), 0, "weld tolerance must be a finite number >= 0");
+    if (std::error_code ec; std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+        throw InputError(path.string(), 0, "not a regular file (a directory or a device): name a mesh file");
     const std::string ext = lowerExtension(path);
     if (ext == ".tri") return readTri(path, options);
     if (ext == ".obj") return readObj(path, options);

@@ -29,8 +29,10 @@ public:
         : table_(table), what_(std::move(what)), file_(file), warnings_(warnings) {}
 
     [[noreturn]] void fail(const toml::node& at, const std::string& key, const std::string& problem) const {
-        throw InputError(file_, lineOf(at), what_ + ", key '" + key + "': " + problem);
+        throw InputError(file_, lineOf(at), what_ + ", key '" + shown(key) + "': " + problem);
     }
+    // A key as an error names it: at most 80 characters (an unknown key of 5 MB was echoed whole).
+    static std::string shown(const std::string& key) { return key.size() <= 80 ? key : key.substr(0, 77) + "..."; }
     [[noreturn]] void fail(const std::string& problem) const { throw InputError(file_, lineOf(table_), what_ + ": " + problem); }
 
     bool has(const std::string& key) const { return table_.contains(key); }
@@ -243,6 +245,7 @@ struct PartMeshes {
 
 PartMeshes readPartMesh(Table& t, const std::filesystem::path& base, const SceneReadOptions& options, std::vector<SceneWarning>& warnings) {
     const std::string file = t.text("mesh", "");
+    if (file.empty()) t.fail(*t.node("mesh"), "mesh", "an empty path: name the part's mesh file");
     const std::filesystem::path path = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : base / file;
     const std::size_t line = t.line("mesh");
     MeshReadOptions read;

@@ -295,6 +295,18 @@ TEST(SceneFile, ADensityWithNoFiniteMassIsReportedAtItsLine) {
     EXPECT_NE(e.find(":21: part 2, key 'density': density 1e+300 x the volume"), std::string::npos) << e;
 }
 
+TEST(SceneFile, AnEmptyMeshPathAndAnOverlongUnknownKeyAreReportedPlainly) {
+    std::string text = kBall;
+    const std::string generator = "generator = { type = \"sphere\", radius = 8.5, level = 2 }";
+    text.replace(text.find(generator), generator.size(), "mesh = \"\"");
+    const std::string empty = errorOf(text);
+    EXPECT_NE(empty.find(":18: part 2, key 'mesh': an empty path"), std::string::npos) << empty;
+    const std::string key(5000, 'k');
+    const std::string unknown = errorOf(withLine("name = \"ball\"", key + " = 1"));
+    EXPECT_NE(unknown.find("key '" + key.substr(0, 77) + "...': unknown key"), std::string::npos) << unknown.substr(0, 300);
+    EXPECT_LT(unknown.size(), 300u);
+}
+
 TEST(SceneFile, EmptySceneIsRefused) {
     const std::string e = errorOf("[world]\ntime_step = 0.001\n");
     EXPECT_NE(e.find("scene.toml:1: scene: no [[part]]"), std::string::npos) << e;
