@@ -63,7 +63,9 @@ ModeBounds boundModes(const PartModel& model, const SimulationSettings& s) {
 // Largest h with h^2 w^2 + 2 c h < 4.
 double symplecticLimit(double omega2, double c) {
     if (omega2 <= 0.0) return c > 0.0 ? 2.0 / c : kInf;
-    return (-c + std::sqrt(c * c + 4.0 * omega2)) / omega2;
+    // (-c + sqrt(c^2 + 4 omega^2)) / omega^2, rationalised: with damping far above the stiffness
+    // (a mass of 1e-100) the difference cancelled to 0, and beyond 1e154 c^2 overflowed to NaN.
+    return 4.0 / (c + std::hypot(c, 2.0 * std::sqrt(omega2)));
 }
 
 }  // namespace
@@ -93,6 +95,8 @@ StabilityReport analyzeStability(const PartModel& model, const SimulationSetting
              << report.omegaLower << " rad/s) is unstable above " << report.unstableTimeStep << " s";
         if (report.unstableTimeStep == 0.0)
             text << " (explicit Euler always blows up without damping); add damping or use the implicit integrator (unconditionally stable)";
+        else if (!(report.safeTimeStep > 0.0))  // the bound underflowed: masses of 1e-300 against ordinary springs
+            text << "; no time step this small is usable: use the implicit integrator (unconditionally stable) or masses that fit the springs";
         else
             text << "; use a time step below " << report.safeTimeStep << " s or the implicit integrator (unconditionally stable)";
     } else if (report.possiblyUnstable) {

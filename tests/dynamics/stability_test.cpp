@@ -95,3 +95,21 @@ TEST(Stability, StiffMaterialIsRejectedAndItsBoundHolds) {
     for (std::size_t i = 0; i < model->massCount(); ++i)
         ASSERT_LT((state.positions[i] - model->restPositions[i]).norm(), 1.0) << "mass " << i;
 }
+
+// Masses far below the springs' scale: the bound is damping-dominated, where (-c + sqrt(c^2 +
+// 4 w^2)) / w^2 cancelled to 0 (mass 1e-100) or read NaN (1e-300: c^2 overflows). The bound
+// stays finite and below the unstable step (positive where it can be), and no message prints a
+// NaN.
+TEST(Stability, TinyMassesGiveAFiniteBoundAndAMessageWithoutNaN) {
+    for (const double mass : {1e-100, 1e-300}) {
+        const auto model = buildPartModel(makeTorus1(), {Material{1.0, 0.1}, mass, {}, {}, {}, {}});
+        const StabilityReport report = analyzeStability(*model, with(Integrator::SemiImplicitEuler, 1e-3));
+        EXPECT_TRUE(report.certainlyUnstable) << mass;
+        EXPECT_TRUE(std::isfinite(report.safeTimeStep)) << mass;
+        EXPECT_LE(report.safeTimeStep, report.unstableTimeStep) << mass;
+        if (mass == 1e-100) {
+            EXPECT_GT(report.safeTimeStep, 0.0);
+        }
+        EXPECT_EQ(report.message.find("nan"), std::string::npos) << report.message;
+    }
+}
