@@ -565,7 +565,6 @@ SceneAction readAction(Table& t, Scene& scene) {
             if (!t.has("force")) t.fail("missing key 'force'");
             a.force = t.vec3("force", Vec3::Zero());
             a.duration = t.nonNegative("duration", 0.0);
-            if (part.body.motion == MotionType::Static) t.fail(*t.node("part"), "part", "a static part does not move: a push has no effect on it");
             break;
         case Kind::Force:
             if (!t.has("force")) t.fail("missing key 'force'");
@@ -580,8 +579,6 @@ SceneAction readAction(Table& t, Scene& scene) {
         case Kind::Velocity:
             a.linear = t.vec3("linear", Vec3::Zero());
             a.angular = t.vec3("angular", Vec3::Zero());
-            if (part.body.motion == MotionType::Static)
-                t.fail(*t.node("part"), "part", "a static part does not move: a velocity has no effect on it");
             break;
         case Kind::Kick:
             if (!t.has("velocity")) t.fail("missing key 'velocity' (the masses' velocity change)");
@@ -592,6 +589,10 @@ SceneAction readAction(Table& t, Scene& scene) {
             break;
     }
     t.finish();
+    // Said, not refused: a sweep may make the part static in some runs (a grab there cannot be).
+    if ((a.kind == Kind::Push || a.kind == Kind::Velocity) && part.body.motion == MotionType::Static)
+        scene.warnings.push_back({t.line("part"), t.what() + ", key 'part': a static part does not move: the " + toString(a.kind) +
+                                                      " has no effect on it"});
     if (a.time >= scene.duration)
         scene.warnings.push_back({t.line("time"), t.what() + ", key 'time': at or after the scene's duration (" + formatSeconds(scene.duration) +
                                                       " s): the action runs only in a longer run"});
