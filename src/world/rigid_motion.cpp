@@ -170,11 +170,17 @@ bool settleMove(BodyId id, double dt, double slop, double bound, const StepConte
     Part& part = *bodies.parts[id];
     const RigidBody& body = bodies.rigid[id];
     const double pieces = std::ceil(travelOver(dt, body) / bound);
-    if (!(pieces <= kMaxPieces))  // NaN too
+    if (!(pieces <= kMaxPieces)) {  // NaN too
+        const double travel = travelOver(step.timeStep, body);
+        const std::string cause = "; likely cause: a force, speed or kinematic jump beyond what max_substeps sub-steps can follow";
+        if (!std::isfinite(travel))  // a speed overflowed (an angular velocity of 1e300): no distance to quote
+            throw DivergenceError(id, step.time, "its velocity or angular velocity is no longer finite (speed " +
+                                                     std::to_string(body.linearVelocity.norm()) + ", angular speed " +
+                                                     std::to_string(body.angularVelocity.norm()) + " rad/s)" + cause);
         throw DivergenceError(id, step.time,
-                              "moves " + std::to_string(travelOver(step.timeStep, body)) + " units in one step, more than " +
-                                  std::to_string(int(kMaxPieces)) + " travel bounds of " + std::to_string(bound) +
-                                  " per sub-step; likely cause: a force, speed or kinematic jump beyond what max_substeps sub-steps can follow");
+                              "moves " + std::to_string(travel) + " units in one step, more than " + std::to_string(int(kMaxPieces)) +
+                                  " travel bounds of " + std::to_string(bound) + " per sub-step" + cause);
+    }
     const Pose start = s.subStart[id];
     s.cachedBody.reset();
     auto fits = [&](double fraction) {

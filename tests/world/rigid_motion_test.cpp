@@ -48,6 +48,23 @@ TEST(RigidMotion, TorqueFreeRotationConservesAngularMomentum) {
     EXPECT_LT((momentum() - l0).norm() / l0.norm(), 2e-2);
 }
 
+// A spin whose motion overflows in one step leaves no distance to quote: the error says the
+// speeds are no longer finite (it printed "moves -nan units in one step").
+TEST(RigidMotion, ASpinThatOverflowsIsADivergenceNamingTheSpeeds) {
+    World world(WorldSettings{1e-3, Vec3::Zero(), {}, 0.25, 4096, 4});
+    BodySettings b = dynamicBody();
+    b.angularVelocity = Vec3(1e300, 0, 0);
+    world.add(buildPartModel(makeIcoSphere(1.0, 1)), rigidPart(), b, Pose{});
+    try {
+        for (int i = 0; i < 3; ++i) world.step();
+        ADD_FAILURE() << "no divergence";
+    } catch (const DivergenceError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("body 0 diverged at t = 0 s: its velocity or angular velocity is no longer finite"), std::string::npos) << what;
+        EXPECT_EQ(what.find("units in one step"), std::string::npos) << what;
+    }
+}
+
 TEST(RigidMotion, BallWiderThanTheOpeningRestsOnTheRim) {
     BallTorus scene(17.0, 2e-3, Vec3::Zero());
     for (int i = 0; i < 1000; ++i) scene.world.step();
