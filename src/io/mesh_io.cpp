@@ -81,8 +81,15 @@ MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSou
     FileVertices file{{}, mesh.vertices};
     if (welds) {  // indices change: the lines no longer match the faces
         const std::size_t before = mesh.vertices.size();
+        const std::size_t faces = mesh.faces.size();
         result.collapsedFaces = weldVertices(mesh, options.weldTolerance.value_or(0.0), &file.meshVertex);
         result.weldedVertices = before - mesh.vertices.size();
+        if (mesh.faces.empty() && faces > 0) {  // said before the emptiness check names only its result
+            char tolerance[32];
+            std::snprintf(tolerance, sizeof tolerance, "%.6g", options.weldTolerance.value_or(0.0));
+            throw InputError(source, 0, std::string("welding within ") + tolerance + " collapsed all " + std::to_string(faces) +
+                                            " faces: the weld tolerance is as large as the mesh");
+        }
     }
     if (formatWelding == FormatWelding::PerCorner) file = {{}, mesh.vertices};  // numbered as welded
     const MeshSourceLines none;

@@ -252,6 +252,13 @@ TEST(MeshIo, ReadMeshTriWeldingCollapsesFaces) {
     EXPECT_EQ(r.collapsedFaces, 1u);
     EXPECT_EQ(r.mesh.faces.size(), 4u);
     EXPECT_TRUE(r.diagnostics.closed());
+    // A tolerance as large as the mesh collapses every face: said so, not "empty mesh".
+    try {
+        readMesh(file, MeshReadOptions{1e300});
+        ADD_FAILURE() << "every face collapsed, yet the mesh was read";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.problem(), "welding within 1e+300 collapsed all 5 faces: the weld tolerance is as large as the mesh");
+    }
 }
 
 TEST(MeshIo, ReadMeshTriWeldingThatMakesDuplicatesIsRepairedOrRefused) {
