@@ -220,7 +220,14 @@ MeshRepairs repairMesh(TriMesh& mesh, double weldTolerance, const std::string& s
     r.duplicateFaces = dropDuplicateFaces(mesh.faces);
     r.flippedFaces = orientConsistently(mesh.faces, r.nonOrientablePieces);
     r.unreferencedVertices = removeUnreferencedVertices(mesh, removed);
-    if (mesh.faces.empty()) throw InputError(source, 0, "no face is left after dropping the degenerate and duplicate ones");
+    if (mesh.faces.empty()) {
+        std::ostringstream text;
+        text << "no face is left after dropping the degenerate and duplicate ones";
+        if (r.weldedVertices > 0)  // the near-duplicate weld scales with the mesh: one vertex far out makes it swallow the rest
+            text << " (" << plural(r.weldedVertices, "vertex", "vertices") << " welded within " << r.weldTolerance
+                 << ", a share of the mesh's size: a vertex far from the others makes that size, and the weld, huge)";
+        throw InputError(source, 0, text.str());
+    }
     if (r.weldedVertices > 0 || r.unreferencedVertices > 0) {
         r.vertexMap = std::move(welded);
         composeVertexMap(r.vertexMap, removed);

@@ -241,6 +241,21 @@ TEST(MeshRepair, RandomSoupsComeOutValidOrRefused) {
     }
 }
 
+// One vertex 1e19 away makes the mesh's size, and the near-duplicate weld that scales with it,
+// huge: every other vertex welds into one and no face is left. The error says why.
+TEST(MeshRepair, AFarVertexThatMakesTheWeldSwallowTheMeshIsNamedAsTheCause) {
+    TriMesh mesh = makeBox(Vec3(0.5, 0.5, 0.5), 1);
+    mesh.vertices.back().x() = 1e19;
+    try {
+        repairMesh(mesh, -1.0, "far", {});
+        ADD_FAILURE() << "faces were left";
+    } catch (const InputError& e) {
+        EXPECT_NE(e.problem().find("no face is left"), std::string::npos) << e.problem();
+        EXPECT_NE(e.problem().find("welded within 1e+13"), std::string::npos) << e.problem();
+        EXPECT_NE(e.problem().find("a vertex far from the others"), std::string::npos) << e.problem();
+    }
+}
+
 TEST(MeshRepair, CorruptInputIsNotRepaired) {
     TriMesh nan = makeIcoSphere(1.0, 1);
     nan.vertices[3].y() = std::numeric_limits<double>::quiet_NaN();
