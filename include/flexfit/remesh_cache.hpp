@@ -58,7 +58,8 @@ std::size_t trimRemeshCache(const std::filesystem::path& directory, std::uintmax
 struct CachedRemesh {
     RemeshResult result;
     bool hit = false;     // read from the cache
-    std::string problem;  // why the cache could not be read or written (empty: it was, or it is off)
+    bool stored = false;  // remeshed now and written to the cache
+    std::string problem;  // why the cache could not be read or written, or its size limit not read (empty: none, or it is off)
 };
 
 // remeshForSimulation(mesh, options, source) through the cache in `directory` (created when

@@ -295,6 +295,7 @@ CachedRemesh remeshCached(const TriMesh& mesh, const RemeshOptions& options, con
     out.problem = error ? "could not create the remesh cache directory " + directory.string() + " (" + error.message() + ")"
                         : writeAtomically(file, serialise(key, out.result));
     if (!out.problem.empty()) return out;
+    out.stored = true;
     const RemeshCacheLimit limit = defaultRemeshCacheLimit();
     out.problem = limit.problem;
     if (limit.bytes > 0) trimRemeshCache(directory, limit.bytes, file);

@@ -228,7 +228,8 @@ TriMesh remeshPart(Table& t, const TriMesh& mesh, const PartRemesh& remesh, cons
         remesh.cache ? options.remeshCache.value_or(defaultRemeshCacheDirectory()) : std::filesystem::path();
     CachedRemesh cached = remeshCached(mesh, remesh.options, source, directory);
     if (!cached.problem.empty())
-        warnings.push_back({t.line("remesh"), t.what() + ", key 'remesh': " + cached.problem + "; the part is remeshed at every load"});
+        warnings.push_back({t.line("remesh"), t.what() + ", key 'remesh': " + cached.problem +
+                                                  (cached.hit || cached.stored ? "" : "; the part is remeshed at every load")});
     return std::move(cached.result.mesh);
 }
 

@@ -150,6 +150,7 @@ TEST(RemeshCache, ADirectoryThatCannotBeWrittenIsReportedAndTheSurfaceStillMade)
     const TriMesh input = cacheInput();
     const CachedRemesh r = remeshCached(input, cacheOptions(), "box", notADirectory / "cache");
     EXPECT_FALSE(r.hit);
+    EXPECT_FALSE(r.stored);
     EXPECT_NE(r.problem.find("could not create the remesh cache directory " + (notADirectory / "cache").string()), std::string::npos)
         << r.problem;
     expectSameRemesh(r.result, remeshForSimulation(input, cacheOptions(), "box"));
@@ -300,6 +301,7 @@ TEST(RemeshCache, TheLimitFollowsTheEnvironment) {
     ScopedVariable limit("FLEXFIT_CACHE_MAX", "lots");
     const CachedRemesh written = remeshCached(cacheInput(), cacheOptions(), "box", dir.path());
     EXPECT_NE(written.problem.find("FLEXFIT_CACHE_MAX: 'lots' is not a size"), std::string::npos) << written.problem;
+    EXPECT_TRUE(written.stored);  // so a scene does not say the part is remeshed at every load
     EXPECT_EQ(filesIn(dir.path()).size(), 1u);
 }
 
