@@ -122,6 +122,10 @@ public:
     Pose pose(const std::string& positionKey, const std::string& rotationKey) {
         Pose p;
         p.translation = vec3(positionKey, Vec3::Zero());
+        // As far as a mesh's coordinates may go (mesh.hpp): a ball placed at y = 1e300 stayed there,
+        // every step's fall lost to rounding, and collision's products would overflow.
+        if (!(p.translation.cwiseAbs().maxCoeff() <= kMaxMeshCoordinate))
+            fail(*node(positionKey), positionKey, "a coordinate beyond 1e+20 units, farther than a mesh's may go (mesh.hpp)");
         p.rotation = rotation(rotationKey);
         return p;
     }

@@ -310,6 +310,16 @@ TEST(SceneFile, AnEmptyMeshPathAndAnOverlongUnknownKeyAreReportedPlainly) {
     EXPECT_LT(unknown.size(), 300u);
 }
 
+TEST(SceneFile, APositionBeyondAMeshsCoordinatesIsReported) {
+    std::string text = kBall;
+    text.replace(text.find("position = [0, 11, 0]"), 21, "position = [0, 1e300, 0]");
+    const std::string e = errorOf(text);
+    EXPECT_NE(e.find(":22: part 2, key 'position': a coordinate beyond 1e+20 units"), std::string::npos) << e;
+    text = kBall;
+    text.replace(text.find("position = [0, 11, 0]"), 21, "position = [0, 1e19, 0]");
+    EXPECT_EQ(errorOf(text), "");
+}
+
 TEST(SceneFile, EmptySceneIsRefused) {
     const std::string e = errorOf("[world]\ntime_step = 0.001\n");
     EXPECT_NE(e.find("scene.toml:1: scene: no [[part]]"), std::string::npos) << e;
