@@ -97,7 +97,8 @@ public:
     void updateBound(BodyId id);
     // Broad-phase candidate pairs (a < b), from the last update.
     const std::vector<std::pair<BodyId, BodyId>>& candidatePairs() const { return pairs_; }
-    // The broad phase's hierarchy of part spheres (world frame), as of the last update.
+    // The broad phase's hierarchy of part spheres (world frame), as of the last update (parts
+    // added since are in it from the next update on).
     const Bvh<Sphere>& broadPhaseTree() const { return broadPhase_; }
 
     // --- Narrow phase (narrow_phase.cpp) ---
@@ -169,6 +170,7 @@ private:
     std::vector<bool> fieldTried_;        // (nbody) a field was built, or the mesh has no inside
     std::vector<Sphere> partSpheres_;                                 // (nbody) world frame
     Bvh<Sphere> broadPhase_;
+    bool broadPhaseBuilt_ = false;  // for the parts added so far (add() leaves it to the next update: adding n parts builds it once)
     std::vector<std::pair<BodyId, BodyId>> pairs_;
     std::vector<Contact> contacts_;
     std::vector<Contact> bodyContacts_;  // contactsOf()

@@ -22,9 +22,10 @@ void CollisionWorld::update() {
 
 void CollisionWorld::updatePairs() {
     updateBounds();
-    if (settings_.broadPhase == BroadPhaseUpdate::Rebuild)
+    if (settings_.broadPhase == BroadPhaseUpdate::Rebuild || !broadPhaseBuilt_) {
         broadPhase_.build(partSpheres_);
-    else
+        broadPhaseBuilt_ = true;
+    } else
         broadPhase_.refitAll([&](Index i) { return partSpheres_[i]; });
     // Each body's sphere against the tree, depth-first.
     pairs_.clear();

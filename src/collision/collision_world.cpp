@@ -90,9 +90,7 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
             features[r] = std::make_shared<const SharpFeatures>(findSharpFeatures(*parts[r], radius[r], settings_.exactTest));
     std::vector<Sphere> spheres = partSpheres_;
     spheres.push_back(collider.worldSphere(part));
-    Bvh<Sphere> tree;
-    tree.build(spheres);  // the tree's shape changes with the set of parts
-    colliders_.reserve(n);
+    if (colliders_.capacity() < n) colliders_.reserve(std::max(n, 2 * colliders_.capacity()));  // geometric: an exact reserve moved every collider on every add
     refitted_.growTo(n);
     // Nothing below throws.
     parts_ = std::move(parts);
@@ -103,7 +101,7 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     restResolution_ = std::move(resolution);
     fieldTried_ = std::move(tried);
     partSpheres_ = std::move(spheres);
-    broadPhase_ = std::move(tree);
+    broadPhaseBuilt_ = false;  // the tree's shape changes with the set of parts: built at the next update, once for any number of adds
 }
 
 void CollisionWorld::setExactTest(ExactTest test) {

@@ -3,6 +3,7 @@
 
 #include "flexfit/mass_properties.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -65,10 +66,15 @@ BodyId Bodies::add(std::unique_ptr<Part> part, const RigidBody& body) {
 }
 
 void Bodies::reserve(std::size_t count) {
-    parts.reserve(count);
-    rigid.reserve(count);
-    kinematicTargets.reserve(count);
-    massAdr.reserve(count + 1);
+    // Grown geometrically: World::add asks for one more each time, and an exact reserve moved
+    // every body on every add (4,000 static parts took 2.8 s to load, 20,000 over a minute).
+    const auto grow = [count](auto& v, std::size_t wanted) {
+        if (v.capacity() < wanted) v.reserve(std::max(wanted, 2 * v.capacity()));
+    };
+    grow(parts, count);
+    grow(rigid, count);
+    grow(kinematicTargets, count);
+    grow(massAdr, count + 1);
 }
 
 void clearRefittedChanges(const CollisionWorld& collision, Bodies& bodies) {

@@ -40,6 +40,31 @@ TEST(BroadPhase, EqualsBruteForceAndRefitEqualsRebuild) {
     }
 }
 
+// Parts added between updates (a scene of thousands of parts: the tree was rebuilt at every
+// add, 20,000 static parts took over a minute to load) join the tree at the next update, with
+// the refit update as with the rebuilding one: the pairs equal brute force's after each round.
+TEST(BroadPhase, PartsAddedBetweenUpdatesJoinTheTreeAtTheNext) {
+    const auto model = buildPartModel(makeIcoSphere(1.0, 1));
+    std::vector<std::unique_ptr<Part>> parts;
+    CollisionWorld world(CollisionSettings{ExactTest::TriangleTriangle, BroadPhaseUpdate::Refit});
+    using PairSet = std::set<std::pair<BodyId, BodyId>>;
+    for (int round = 0; round < 4; ++round) {
+        for (int k = 0; k < 3; ++k) {  // a row of touching balls, three more each round
+            parts.push_back(std::make_unique<Part>(model));
+            parts.back()->translate(Vec3(1.9 * double(parts.size()), 0, 0));
+            world.add(BodyId(parts.size() - 1), *parts.back());
+        }
+        world.update();
+        std::size_t leaves = 0;
+        for (const auto& node : world.broadPhaseTree().nodes()) leaves += node.isLeaf();
+        EXPECT_EQ(leaves, parts.size());
+        PairSet expected;
+        for (BodyId i = 0; i + 1 < parts.size(); ++i) expected.insert({i, i + 1});
+        const auto& got = world.candidatePairs();
+        EXPECT_EQ(PairSet(got.begin(), got.end()), expected) << "round " << round;
+    }
+}
+
 // torus1 with no restoration (its deformation stays) in a collision world, with its bounding
 // radius at rest and the brute-force largest displacement of its moving masses.
 struct LooseTorus {
