@@ -131,8 +131,6 @@ MeshReadResult loadMesh(const std::filesystem::path& path, const MeshReadOptions
     return result;
 }
 
-void writeTextFile(const std::filesystem::path& path, const std::string& text) { writeWholeFile(path, text); }
-
 void writePartsObj(const std::filesystem::path& path, const std::string& header, const std::vector<NamedPart>& parts) {
     std::ostringstream obj;
     obj << "# " << header << "\n";
@@ -145,7 +143,7 @@ void writePartsObj(const std::filesystem::path& path, const std::string& header,
         for (const Face& f : named.part->model().drawnMesh().faces) obj << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
         base += world.size();
     }
-    writeTextFile(path, obj.str());
+    writeWholeFile(path, obj.str());
 }
 
 void makeDirectory(const std::filesystem::path& dir) {

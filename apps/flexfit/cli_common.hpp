@@ -75,8 +75,6 @@ void addSceneOptions(CLI::App* cmd, SceneOptions& options);
 // Reads any supported mesh and prints its warnings (repairs first) to stderr.
 MeshReadResult loadMesh(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
-// Writes `text` to `path`; throws InputError when it cannot.
-void writeTextFile(const std::filesystem::path& path, const std::string& text);
 // One object of a multi-part OBJ frame.
 struct NamedPart {
     std::string name;

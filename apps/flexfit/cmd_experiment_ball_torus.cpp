@@ -367,9 +367,9 @@ void run(Options opt) {
     std::string index = "run,torus,diameter,load,friction,area,result,snap_jump_distance,snap_jump_degrees,snap_from_y,csv\n";
     for (const std::vector<Row>* set : {&rows, &held})
         for (const Row& r : *set) index += csvRow(r);
-    writeTextFile(dir / "runs.csv", index);
+    writeWholeFile(dir / "runs.csv", index);
     const std::string md = table(rows, held, opt);
-    writeTextFile(dir / "summary.md", md);
+    writeWholeFile(dir / "summary.md", md);
     fmt::print("{}", md);
     if (opt.plots) runPlotScript("plot_ball_torus.py", {(dir / "runs.csv").string(), dir.string()});
 }

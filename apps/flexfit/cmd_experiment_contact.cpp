@@ -109,7 +109,7 @@ void run(const ContactOptions& opt) {
         }
     }
     bar.finish();
-    writeTextFile(dir / "contact.csv", csv.str());
+    writeWholeFile(dir / "contact.csv", csv.str());
     const Profile& profile = world.profile();
     const double perStep = 1e6 / double(std::max<std::uint64_t>(1, profile.steps));
     double collideSeconds = 0.0;
@@ -145,7 +145,7 @@ void run(const ContactOptions& opt) {
     md << fmt::format("| blue zones (dynamics + retirement) per step | {:.1f} µs |\n\n", perStep * stepSeconds);
     md << "The penetration is measured against the analytic torus, so it includes the chord error of the flat faces "
           "(up to 0.02 on this tube).\n\n![metrics](contact.png)\n\nOBJ frames: `frame_*.obj` (two objects each).\n";
-    writeTextFile(dir / "summary.md", md.str());
+    writeWholeFile(dir / "summary.md", md.str());
     if (opt.plots) runPlotScript("plot_contact.py", {(dir / "contact.csv").string(), dir.string()});
     fmt::print("{}", md.str());
 }

@@ -297,7 +297,7 @@ void writeCalibrationCsv(const std::filesystem::path& file, const std::vector<Ca
                                m.result.trackers[0].maxActive(), m.result.trackers[0].totalDistinct(), m.result.trackers[1].maxActive(),
                                m.result.trackers[1].totalDistinct(), c.rmsResidual);
         }
-    writeTextFile(file, csv.str());
+    writeWholeFile(file, csv.str());
 }
 
 void run(const ExperimentOptions& opt) {
@@ -309,7 +309,7 @@ void run(const ExperimentOptions& opt) {
     runs.push_back(runMaterial("rigid", Material::rigid(), opt, series));
     runs.push_back(runMaterial("elastic", Material::elastic(), opt, series));
     runs.push_back(runMaterial("superelastic", Material::superelastic(), opt, series));
-    writeTextFile(dir / "active_springs.csv", series.str());
+    writeWholeFile(dir / "active_springs.csv", series.str());
 
     std::ostringstream table;
     table << "material,stiffness,damping,threshold,restoration_time_s,max_active,total_active,steps\n";
@@ -319,13 +319,13 @@ void run(const ExperimentOptions& opt) {
             table << fmt::format("{},{},{},{},{},{},{},{}\n", r.name, r.material.stiffness, r.material.damping, t.threshold(),
                                  rt ? fmt::format("{:.3f}", *rt) : "", t.maxActive(), t.totalDistinct(), r.result.steps);
         }
-    writeTextFile(dir / "table_4_2.csv", table.str());
+    writeWholeFile(dir / "table_4_2.csv", table.str());
 
     const auto cost = measureRestorationCost(opt);
     std::ostringstream costCsv;
     costCsv << "restoration,steps_per_second\n";
     for (const auto& [name, rate] : cost) costCsv << fmt::format("{},{:.1f}\n", name, rate);
-    writeTextFile(dir / "restoration_cost.csv", costCsv.str());
+    writeWholeFile(dir / "restoration_cost.csv", costCsv.str());
 
     std::string md = summary(opt, runs, cost);
     if (opt.calibrate && !opt.kicks.empty() && !opt.kickTimeSteps.empty()) {
@@ -333,7 +333,7 @@ void run(const ExperimentOptions& opt) {
         writeCalibrationCsv(dir / "kick_calibration.csv", grid);
         md += "\n" + calibrationSummary(opt, grid);
     }
-    writeTextFile(dir / "summary.md", md);
+    writeWholeFile(dir / "summary.md", md);
     if (opt.plots) runPlotScript("plot_restoration.py", {(dir / "active_springs.csv").string(), dir.string()});
     fmt::print("{}", md);
 }

@@ -192,9 +192,9 @@ void run(const ZonesOptions& opt) {
         csv << fmt::format("{},{},{},{},{},{:.1f},{:.1f},{:.4f}\n", m.model, m.zones, m.level, m.movingMasses, m.computedSprings,
                            m.stepsPerSecond, full, m.stepsPerSecond / full);
     }
-    writeTextFile(dir / "zones.csv", csv.str());
+    writeWholeFile(dir / "zones.csv", csv.str());
     const std::string md = summary(rows, opt);
-    writeTextFile(dir / "summary.md", md);
+    writeWholeFile(dir / "summary.md", md);
     if (opt.plots) runPlotScript("plot_zones.py", {(dir / "zones.csv").string(), dir.string()});
     fmt::print("{}", md);
 }

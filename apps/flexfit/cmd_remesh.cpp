@@ -62,7 +62,7 @@ void registerRemesh(CLI::App& app) {
         if (r.droppedFaces > 0) warn(fmt::format("{}: {} degenerate output faces dropped (where sharp polylines meet)", opt->in, r.droppedFaces));
         fmt::print("  Hausdorff distance {:.4g} ({:.3f} % of the bounding-box diagonal {:.4g})\n", r.hausdorff, 100.0 * r.hausdorffShare(),
                    r.diagonal);
-        if (opt->remesh.targetEdge > 0.1 * r.diagonal)  // the short side is refused; the long one is legal, but rarely meant
+        if (opt->remesh.targetEdge > kCoarseRemeshEdgeShare * r.diagonal)  // the short side is refused; the long one is legal, but rarely meant
             warn(fmt::format("{}: the target edge {:.4g} is {:.0f} % of the part's bounding-box diagonal: {} faces are left, {:.1f} % of the "
                              "diagonal from the input (a unit mistaken?)",
                              opt->in, opt->remesh.targetEdge, 100.0 * opt->remesh.targetEdge / r.diagonal, r.mesh.faces.size(),

@@ -206,7 +206,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     s.stateHash = w.stateHash();
     for (BodyId id = 0; id < w.bodyCount(); ++id) s.finalCentres.push_back(w.centreOfMass(id));
     if (!options.out.empty()) {
-        writeTextFile(files.add(options.out / "summary.json"), summaryJson(scene, s));
+        writeWholeFile(files.add(options.out / "summary.json"), summaryJson(scene, s));
         if (!vtkFrames.empty()) writeVtkCollection(files.add(options.out / *frameNames.insert("frames.pvd").first), vtkFrames);
         csv.close();
         if (!csv) throw InputError(csvPath.string(), 0, "write failed");

@@ -95,7 +95,7 @@ bool runSweepRun(const Sweep& sweep, std::size_t run, const std::filesystem::pat
         row = failedRow(sweep, run, scene, "diverged", e.what());
     }
     PendingFiles files;  // the row appears whole or not at all
-    writeTextFile(files.add(rowPath(sweep, run, out)), row);
+    writeWholeFile(files.add(rowPath(sweep, run, out)), row);
     files.commit();
     return true;
 }
@@ -123,7 +123,7 @@ std::filesystem::path writeSweepTable(const Sweep& sweep, const std::filesystem:
     }
     const std::filesystem::path path = out / "results.csv";
     PendingFiles files;
-    writeTextFile(files.add(path), table);
+    writeWholeFile(files.add(path), table);
     files.commit();
     return path;
 }

@@ -80,6 +80,10 @@ inline constexpr EnumName<ThinFeatures> kThinFeaturesNames[] = {
 };
 template <> inline constexpr std::span<const EnumName<ThinFeatures>> kEnumNames<ThinFeatures> = kThinFeaturesNames;
 
+// A target edge beyond this share of the bounding-box diagonal is coarse: legal, but rarely meant
+// (flexfit remesh warns of it), and the Hausdorff distance is then sampled at this share's scale.
+inline constexpr double kCoarseRemeshEdgeShare = 0.1;
+
 struct RemeshOptions {
     double targetEdge = 0.0;     // > 0, in the mesh's units
     int iterations = 5;          // split / collapse / flip / relax rounds

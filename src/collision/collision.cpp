@@ -203,8 +203,6 @@ struct Reboxed {
     std::vector<Vec3> positions;  // the part's, in the other part's frame
 };
 
-// `tree` (of `part`, its leaves as a triangle query builds them) boxed in the frame
-// x' = rotation x + translation.
 constexpr double kReboxSlack = 1e-12;  // far above a turn's rounding (a few 1e-16 of the coordinates)
 
 // `tree` (of `part`, its leaves as a triangle query builds them) boxed in the frame

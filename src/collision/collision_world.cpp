@@ -1,6 +1,7 @@
 // The collision world's registry and settings (collision_world.hpp); its stages are in
 // broad_phase.cpp and narrow_phase.cpp.
 #include "flexfit/collision_world.hpp"
+#include "core/reserve.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -90,7 +91,7 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
             features[r] = std::make_shared<const SharpFeatures>(findSharpFeatures(*parts[r], radius[r], settings_.exactTest));
     std::vector<Sphere> spheres = partSpheres_;
     spheres.push_back(collider.worldSphere(part));
-    if (colliders_.capacity() < n) colliders_.reserve(std::max(n, 2 * colliders_.capacity()));  // geometric: an exact reserve moved every collider on every add
+    detail::reserveGrowing(colliders_, n);
     refitted_.growTo(n);
     // Nothing below throws.
     parts_ = std::move(parts);

@@ -381,11 +381,10 @@ FinishedSurface finish(const WorkSurface& s, const std::string& name, const std:
 
 // The Hausdorff distance's samples: vertices, and points at most this share of the target edge
 // apart along every edge and across every face (deterministic, unlike random sampling), and at
-// most kSampleShare of kCoarseEdgeShare of the diagonal: a target edge far beyond the part's size
+// most kSampleShare of kCoarseRemeshEdgeShare (remesh.hpp) of the diagonal: a target edge far beyond the part's size
 // (1e6 on a torus of diagonal 36) spaced them so far apart that the distance read 5.8 where
 // a target of 50 read 7.7 on the same output.
 constexpr double kSampleShare = 0.25;
-constexpr double kCoarseEdgeShare = 0.1;
 
 // Points of segment ab strictly between its ends, at most `spacing` apart.
 void sampleBetween(const Point& a, const Point& b, double spacing, std::vector<Point>& out) {
@@ -564,7 +563,7 @@ RemeshResult remeshChecked(const TriMesh& mesh, const RemeshOptions& options, co
     PatchProjection projection(input, work.patch, patches);
     remeshIterations(work, options, projection);
     removeCapsAndNeedles(work, options.targetEdge);
-    const HausdorffFrom fromInput(input, kSampleShare * std::min(options.targetEdge, kCoarseEdgeShare * r.diagonal));
+    const HausdorffFrom fromInput(input, kSampleShare * std::min(options.targetEdge, kCoarseRemeshEdgeShare * r.diagonal));
     r.hausdorff = fromInput.to(work.mesh);
     FinishedSurface result = finish(work, mesh.name, source);
     const bool round = options.thinFeatures == ThinFeatures::Round;

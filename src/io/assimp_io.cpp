@@ -147,24 +147,37 @@ std::size_t lineOfNonFiniteToken(const std::filesystem::path& path) {
     return 0;
 }
 
-// Whether the file is an ASCII STL: it starts with "solid" and is not a binary STL by its size
-// (84 + 50 n bytes, n at offset 80; some exporters start a binary header with "solid" too).
-bool isAsciiStl(const std::filesystem::path& path) {
-    std::error_code ec;
-    if (lowerExtension(path) != ".stl" || !std::filesystem::is_regular_file(path, ec)) return false;  // assimp names what else is wrong
-    const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec) return false;
-    std::ifstream in(path, std::ios::binary);
-    std::string head(std::size_t(std::min<std::uintmax_t>(size, 84)), '\0');
-    in.read(head.data(), std::streamsize(head.size()));
-    const std::size_t first = head.find_first_not_of(" \t\r\n");
-    if (first == std::string::npos || head.compare(first, 5, "solid") != 0) return false;
-    if (head.size() == 84) {
+// A regular .stl file's size and first 84 bytes (a binary STL's header and facet count), read
+// once for both checks below; nullopt for anything else (assimp names what else is wrong).
+struct StlStart {
+    std::uintmax_t size = 0;
+    std::string head;
+    // The size a binary STL of the count at offset 80 has (84 + 50 n); 0 when shorter than 84 bytes.
+    std::uint64_t binarySize() const {
+        if (head.size() < 84) return 0;
         std::uint32_t facets = 0;
         std::memcpy(&facets, head.data() + 80, 4);
-        if (size == 84 + 50 * std::uint64_t(facets)) return false;  // binary, whatever its header says
+        return 84 + 50 * std::uint64_t(facets);
     }
-    return true;
+    std::uint32_t facets() const { return binarySize() == 0 ? 0 : std::uint32_t((binarySize() - 84) / 50); }
+    // An ASCII STL starts with "solid" and is not a binary STL by its size (some exporters start
+    // a binary header with "solid" too).
+    bool ascii() const {
+        const std::size_t first = head.find_first_not_of(" \t\r\n");
+        return first != std::string::npos && head.compare(first, 5, "solid") == 0 && size != binarySize();
+    }
+};
+
+std::optional<StlStart> stlStart(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (lowerExtension(path) != ".stl" || !std::filesystem::is_regular_file(path, ec)) return std::nullopt;
+    StlStart s;
+    s.size = std::filesystem::file_size(path, ec);
+    if (ec) return std::nullopt;
+    std::ifstream in(path, std::ios::binary);
+    s.head.assign(std::size_t(std::min<std::uintmax_t>(s.size, 84)), '\0');
+    in.read(s.head.data(), std::streamsize(s.head.size()));
+    return s;
 }
 
 // An ASCII STL's structure, checked line by line before assimp reads it: solid, then facets of
@@ -174,7 +187,6 @@ bool isAsciiStl(const std::filesystem::path& path) {
 // when a loop has other than three vertices or facets and vertices disagree (upstream issue
 // 5946); here each is refused at its line, and assimp only ever sees well-formed files.
 void checkAsciiStl(const std::filesystem::path& path) {
-    if (!isAsciiStl(path)) return;
     const std::string text = detail::readTextFile(path);
     const std::string file = path.string();
     enum class At { Start, Solid, Facet, Loop, LoopEnd, AfterSolid } at = At::Start;
@@ -215,11 +227,12 @@ void checkAsciiStl(const std::filesystem::path& path) {
             if (key == "vertex") {
                 if (++vertices > 3) fail("a facet with more than three vertices: STL facets are triangles");
                 expectNumbers(1, "vertex");
-                for (std::size_t i = 1; i < 4; ++i)
-                    if (isNonFiniteToken(line.tokens[i]))
-                        fail(wholeNumber(line.tokens[i])->outOfRange || std::isfinite(wholeNumber(line.tokens[i])->value)
-                                 ? "coordinate '" + std::string(line.tokens[i]) + "' is beyond single precision (STL holds 32-bit floats, about 3.4e38 at most)"
-                                 : std::string("a vertex has a NaN or infinite coordinate"));
+                for (std::size_t i = 1; i < 4; ++i) {
+                    if (!isNonFiniteToken(line.tokens[i])) continue;
+                    const WholeNumber n = *wholeNumber(line.tokens[i]);  // a number: expectNumbers checked it
+                    if (!n.outOfRange && !std::isfinite(n.value)) fail("a vertex has a NaN or infinite coordinate");
+                    fail("coordinate '" + std::string(line.tokens[i]) + "' is beyond single precision (STL holds 32-bit floats, about 3.4e38 at most)");
+                }
             } else if (key == "endloop") {
                 if (vertices != 3) fail("a facet with " + std::to_string(vertices) + " vertices: STL facets are triangles");
                 at = At::LoopEnd;
@@ -237,23 +250,24 @@ void checkAsciiStl(const std::filesystem::path& path) {
 // A .stl that is not an ASCII STL must be a binary one: an 80-byte header, the facet count n,
 // then 50 bytes a facet. Checked here, so a file cut short or with a wrong count is named as
 // such (assimp says only "Failed to determine STL storage representation").
-void checkBinaryStl(const std::filesystem::path& path) {
-    std::error_code ec;
-    if (lowerExtension(path) != ".stl" || !std::filesystem::is_regular_file(path, ec) || isAsciiStl(path)) return;
-    const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec) return;  // assimp names what else is wrong
+void checkBinaryStl(const std::filesystem::path& path, const StlStart& s) {
     const std::string file = path.string();
     const std::string neither = "neither an ASCII STL (a first line 'solid', keywords in lower case) nor a binary STL";
-    if (size < 84) throw InputError(file, 0, neither + " (an 84-byte header, then 50 bytes a facet): " + std::to_string(size) + " bytes");
-    std::ifstream in(path, std::ios::binary);
-    char header[84];
-    in.read(header, 84);
-    std::uint32_t facets = 0;
-    std::memcpy(&facets, header + 80, 4);
-    const std::uint64_t expected = 84 + 50 * std::uint64_t(facets);
-    if (size != expected)
-        throw InputError(file, 0, neither + ": as binary, its header counts " + std::to_string(facets) + " facets (" + std::to_string(expected) +
-                                      " bytes) but the file has " + std::to_string(size) + " bytes (cut short, or damaged)");
+    if (s.size < 84) throw InputError(file, 0, neither + " (an 84-byte header, then 50 bytes a facet): " + std::to_string(s.size) + " bytes");
+    if (s.size != s.binarySize())
+        throw InputError(file, 0, neither + ": as binary, its header counts " + std::to_string(s.facets()) + " facets (" +
+                                      std::to_string(s.binarySize()) + " bytes) but the file has " + std::to_string(s.size) +
+                                      " bytes (cut short, or damaged)");
+}
+
+// An STL's structure, checked before assimp reads it: as ASCII or as binary, whichever it is.
+void checkStl(const std::filesystem::path& path) {
+    const std::optional<StlStart> start = stlStart(path);
+    if (!start) return;
+    if (start->ascii())
+        checkAsciiStl(path);
+    else
+        checkBinaryStl(path, *start);
 }
 
 }  // namespace
@@ -266,8 +280,7 @@ ScopedImportTimeLimit::~ScopedImportTimeLimit() { importSecondsOverride.store(0.
 MeshReadResult readWithAssimp(const std::filesystem::path& path, const MeshReadOptions& options) {
     const std::string file = path.string();
     if (!std::filesystem::exists(path)) throw InputError(file, 0, "cannot open the file for reading: it does not exist");
-    checkAsciiStl(path);
-    checkBinaryStl(path);
+    checkStl(path);
     const double seconds = importSeconds(path);
     std::string bytes;
     try {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 namespace flexfit {
 
@@ -85,10 +86,10 @@ MeshReadResult finishRead(TriMesh mesh, const std::string& source, const MeshSou
         result.collapsedFaces = weldVertices(mesh, options.weldTolerance.value_or(0.0), &file.meshVertex);
         result.weldedVertices = before - mesh.vertices.size();
         if (mesh.faces.empty() && faces > 0) {  // said before the emptiness check names only its result
-            char tolerance[32];
-            std::snprintf(tolerance, sizeof tolerance, "%.6g", options.weldTolerance.value_or(0.0));
-            throw InputError(source, 0, std::string("welding within ") + tolerance + " collapsed all " + std::to_string(faces) +
-                                            " faces: the weld tolerance is as large as the mesh");
+            std::ostringstream text;
+            text << "welding within " << options.weldTolerance.value_or(0.0) << " collapsed all " << faces
+                 << " faces: the weld tolerance is as large as the mesh";
+            throw InputError(source, 0, text.str());
         }
     }
     if (formatWelding == FormatWelding::PerCorner) file = {{}, mesh.vertices};  // numbered as welded

@@ -1,22 +1,15 @@
 // Bodies and their mass properties (body.hpp, bodies.hpp).
 #include "bodies.hpp"
 
+#include "core/reserve.hpp"
 #include "flexfit/mass_properties.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
+#include <sstream>
 
 namespace flexfit {
-namespace {
-std::string shortNumber(double x) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g", x);
-    return text;
-}
-}  // namespace
-
 RigidBody makeRigidBody(const PartModel& model, const BodySettings& settings) {
     const std::string source = "world";
     if (!(settings.density > 0.0) || !std::isfinite(settings.density))
@@ -40,9 +33,12 @@ RigidBody makeRigidBody(const PartModel& model, const BodySettings& settings) {
         body.inverseInertia = (settings.density * mp.inertia).inverse();
         // A density far beyond the mesh's scale overflows the mass or underflows it to 0 (and
         // the step would turn every contact into NaN): refused here, not found diverged later.
-        if (!(std::isfinite(body.mass) && body.mass > 0.0 && std::isfinite(body.inverseMass) && body.inverseInertia.allFinite()))
-            throw InputError(source, 0, "density " + shortNumber(settings.density) + " x the volume " + shortNumber(mp.volume) + " of '" +
-                                            model.name + "' gives no finite, positive mass and inertia: a density far beyond the mesh's scale");
+        if (!(std::isfinite(body.mass) && body.mass > 0.0 && std::isfinite(body.inverseMass) && body.inverseInertia.allFinite())) {
+            std::ostringstream text;
+            text << "density " << settings.density << " x the volume " << mp.volume << " of '" << model.name
+                 << "' gives no finite, positive mass and inertia: a density far beyond the mesh's scale";
+            throw InputError(source, 0, text.str());
+        }
     }
     for (const Vec3& p : model.restPositions) body.boundingRadius = std::max(body.boundingRadius, (p - body.centreOfMass).norm());
     body.linearVelocity = settings.linearVelocity;
@@ -66,15 +62,10 @@ BodyId Bodies::add(std::unique_ptr<Part> part, const RigidBody& body) {
 }
 
 void Bodies::reserve(std::size_t count) {
-    // Grown geometrically: World::add asks for one more each time, and an exact reserve moved
-    // every body on every add (4,000 static parts took 2.8 s to load, 20,000 over a minute).
-    const auto grow = [count](auto& v, std::size_t wanted) {
-        if (v.capacity() < wanted) v.reserve(std::max(wanted, 2 * v.capacity()));
-    };
-    grow(parts, count);
-    grow(rigid, count);
-    grow(kinematicTargets, count);
-    grow(massAdr, count + 1);
+    reserveGrowing(parts, count);
+    reserveGrowing(rigid, count);
+    reserveGrowing(kinematicTargets, count);
+    reserveGrowing(massAdr, count + 1);
 }
 
 void clearRefittedChanges(const CollisionWorld& collision, Bodies& bodies) {

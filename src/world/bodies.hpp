@@ -32,7 +32,7 @@ struct Bodies {
 
     // Registers a body; does not throw once reserve(size() + 1) has been called.
     BodyId add(std::unique_ptr<Part> part, const RigidBody& body);
-    void reserve(std::size_t count);
+    void reserve(std::size_t count);  // grown geometrically (reserveGrowing)
     // World position of a body's centre of mass.
     Vec3 centreOfMass(BodyId id) const { return parts[id]->pose().apply(rigid[id].centreOfMass); }
     // The thinnest body's thickness (the no-tunnelling bound's scale). Flat parts (thickness 0:

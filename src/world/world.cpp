@@ -3,13 +3,13 @@
 #include "flexfit/world.hpp"
 
 #include "core/fnv1a.hpp"
+#include "core/reserve.hpp"
 #include "divergence_check.hpp"
 #include "rigid_motion.hpp"
 #include "step_profiler.hpp"
 #include "world_data.hpp"
 #include "zone_dynamics.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -60,8 +60,8 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
     part->setPose(pose);
     const double stiffness = detail::effectiveContactStiffness(*part, d.settings.timeStep);
     const BodyId id = BodyId(d.bodies.size());
-    d.bodies.reserve(id + 1);  // geometric growth (Bodies::reserve), so adding n bodies stays O(n) in moves
-    if (d.response.stiffness.capacity() < id + 1u) d.response.stiffness.reserve(std::max<std::size_t>(id + 1u, 2 * d.response.stiffness.capacity()));
+    d.bodies.reserve(id + 1);
+    detail::reserveGrowing(d.response.stiffness, id + 1u);
     d.collision.add(id, *part, settings.boundingVolume);  // strong: registers all or nothing
     d.bodies.add(std::move(part), body);                   // no throw after the reserve
     d.response.stiffness.push_back(stiffness);
