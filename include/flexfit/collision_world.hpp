@@ -145,7 +145,7 @@ private:
     bool pressesFirst(BodyId a, BodyId b) const;
     // Whether the settings let the point shell answer a rigid part against a deformable part,
     // given their mean rest edges (Auto: the deformable part strictly finer).
-    bool pointShellServes(std::size_t rigid, std::size_t deformable, std::span<const double> meanEdge) const;
+    bool pointShellServes(double rigidMeanEdge, double deformableMeanEdge) const;
     // Whether the pair (a presses b) is answered by the point shell.
     bool usesPointShell(BodyId a, BodyId b) const;
     // The point shell's contacts of the pair (a rigid with a field, b deforming), with those of
@@ -169,6 +169,7 @@ private:
     std::vector<double> restResolution_;  // (nbody) of deformable parts the point shell may serve (restResolution), else 0
     std::vector<bool> fieldTried_;        // (nbody) a field was built, or the mesh has no inside
     std::vector<Sphere> partSpheres_;                                 // (nbody) world frame
+    std::vector<BodyId> rigidParts_, deformingParts_;                 // the bodies of each kind, in order (add() pairs only across them)
     Bvh<Sphere> broadPhase_;
     bool broadPhaseBuilt_ = false;  // for the parts added so far (add() leaves it to the next update: adding n parts builds it once)
     std::vector<std::pair<BodyId, BodyId>> pairs_;

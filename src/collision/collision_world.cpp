@@ -48,60 +48,75 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     const RigidDeformableQuery query = settings_.rigidDeformable;
     const bool shellable = query != RigidDeformableQuery::Faces && part.deforms();
     if (shellable) collider.buildRestPointTree(part);
-    // The registry with this part in it (index self), in copies until nothing can throw.
-    const std::size_t self = parts_.size(), n = self + 1;
-    std::vector<const Part*> parts = parts_;
-    parts.push_back(&part);
-    std::vector<double> meanEdge = meanEdge_, resolution = restResolution_;
-    meanEdge.push_back(meanRestEdge(part));
-    resolution.push_back(shellable ? restResolution(part) : 0.0);
-    // A rigid part's features are found at the scale of the coarsest deformable part its point
-    // shell may serve: the scale they have, grown to the new part's where it deforms; all of
-    // those it may serve, where it is the rigid one.
-    std::vector<double> radius(n, 0.0);
-    for (std::size_t r = 0; r < self; ++r) radius[r] = features_[r] ? features_[r]->radius : 0.0;
-    auto serves = [&](std::size_t r, std::size_t b) {
-        return !parts[r]->deforms() && parts[b]->deforms() && pointShellServes(r, b, meanEdge);
+    // What the new part changes, built before anything is registered: its own entries, and the
+    // parts whose point-shell service it changes. A rigid part's features are found at the scale
+    // of the coarsest deformable part its point shell may serve: the scale they have, grown to
+    // the new part's where it deforms; all of those it may serve, where it is the rigid one.
+    // Only the parts of the other kind can change (O(their count), not O(all parts)).
+    const std::size_t self = parts_.size();
+    const double newMeanEdge = meanRestEdge(part), newResolution = shellable ? restResolution(part) : 0.0;
+    struct Served {
+        std::size_t part;
+        double radius;
+        std::shared_ptr<const SignedDistanceField> field;
+        bool tried;
+        std::shared_ptr<const SharpFeatures> features;
     };
-    std::vector<bool> servesNew(n, false);  // rigid parts the new part makes the point shell serve
-    for (std::size_t r = 0; r < self; ++r) {
-        if (serves(r, self)) {
-            servesNew[r] = true;
-            radius[r] = std::max(radius[r], resolution[self]);
-        }
-        if (serves(self, r)) {
-            servesNew[self] = true;
-            radius[self] = std::max(radius[self], resolution[r]);
+    std::vector<Served> served;  // rigid parts the new part makes the point shell serve
+    Served added{self, 0.0, nullptr, false, nullptr};
+    bool addedServes = false;
+    if (query != RigidDeformableQuery::Faces) {
+        for (const BodyId other : part.deforms() ? rigidParts_ : deformingParts_) {
+            const std::size_t r = part.deforms() ? other : self, b = part.deforms() ? self : other;
+            const double rigidEdge = r == self ? newMeanEdge : meanEdge_[r], deformableEdge = b == self ? newMeanEdge : meanEdge_[b];
+            if (!pointShellServes(rigidEdge, deformableEdge)) continue;
+            if (r == self) {
+                addedServes = true;
+                added.radius = std::max(added.radius, restResolution_[b]);
+            } else {
+                served.push_back({r, std::max(features_[r] ? features_[r]->radius : 0.0, newResolution), fields_[r], fieldTried_[r], features_[r]});
+            }
         }
     }
-    // Fields for the rigid parts the point shell may serve (under PointShell all of them).
-    std::vector<std::shared_ptr<const SignedDistanceField>> fields = fields_;
-    std::vector<bool> tried = fieldTried_;
-    fields.push_back(nullptr);
-    tried.push_back(false);
-    for (std::size_t r = 0; r < n && query != RigidDeformableQuery::Faces; ++r) {
-        if (parts[r]->deforms() || tried[r] || (query == RigidDeformableQuery::Auto && !servesNew[r])) continue;
-        fields[r] = buildDistanceField(*parts[r]);
-        tried[r] = true;
-    }
-    std::vector<std::shared_ptr<const SharpFeatures>> features = features_;
-    features.push_back(nullptr);
-    for (std::size_t r = 0; r < n; ++r)
-        if (fields[r] && (!features[r] || features[r]->radius != radius[r]))
-            features[r] = std::make_shared<const SharpFeatures>(findSharpFeatures(*parts[r], radius[r], settings_.exactTest));
-    std::vector<Sphere> spheres = partSpheres_;
-    spheres.push_back(collider.worldSphere(part));
+    // Fields for the rigid parts the point shell may serve (under PointShell all of them), and
+    // their features at the scale they now serve.
+    auto equip = [&](Served& s, const Part& rigid, bool serves) {
+        if (query == RigidDeformableQuery::Faces || rigid.deforms()) return;
+        if (!s.tried && (query != RigidDeformableQuery::Auto || serves)) {
+            s.field = buildDistanceField(rigid);
+            s.tried = true;
+        }
+        if (s.field && (!s.features || s.features->radius != s.radius))
+            s.features = std::make_shared<const SharpFeatures>(findSharpFeatures(rigid, s.radius, settings_.exactTest));
+    };
+    for (Served& s : served) equip(s, *parts_[s.part], true);
+    equip(added, part, addedServes);
+    const std::size_t n = self + 1;
+    for (auto* v : {&meanEdge_, &restResolution_}) detail::reserveGrowing(*v, n);
+    detail::reserveGrowing(parts_, n);
     detail::reserveGrowing(colliders_, n);
+    detail::reserveGrowing(fields_, n);
+    detail::reserveGrowing(features_, n);
+    detail::reserveGrowing(fieldTried_, n);
+    detail::reserveGrowing(partSpheres_, n);
+    detail::reserveGrowing(part.deforms() ? deformingParts_ : rigidParts_, (part.deforms() ? deformingParts_ : rigidParts_).size() + 1);
+    const Sphere sphere = collider.worldSphere(part);
     refitted_.growTo(n);
     // Nothing below throws.
-    parts_ = std::move(parts);
+    parts_.push_back(&part);
     colliders_.push_back(std::move(collider));
-    fields_ = std::move(fields);
-    features_ = std::move(features);
-    meanEdge_ = std::move(meanEdge);
-    restResolution_ = std::move(resolution);
-    fieldTried_ = std::move(tried);
-    partSpheres_ = std::move(spheres);
+    meanEdge_.push_back(newMeanEdge);
+    restResolution_.push_back(newResolution);
+    fields_.push_back(std::move(added.field));
+    fieldTried_.push_back(added.tried);
+    features_.push_back(std::move(added.features));
+    partSpheres_.push_back(sphere);
+    (part.deforms() ? deformingParts_ : rigidParts_).push_back(BodyId(self));
+    for (Served& s : served) {
+        fields_[s.part] = std::move(s.field);
+        fieldTried_[s.part] = s.tried;
+        features_[s.part] = std::move(s.features);
+    }
     broadPhaseBuilt_ = false;  // the tree's shape changes with the set of parts: built at the next update, once for any number of adds
 }
 
@@ -126,17 +141,17 @@ bool CollisionWorld::pressesFirst(BodyId a, BodyId b) const {
     return da == db ? a < b : !da;
 }
 
-bool CollisionWorld::pointShellServes(std::size_t rigid, std::size_t deformable, std::span<const double> meanEdge) const {
+bool CollisionWorld::pointShellServes(double rigidMeanEdge, double deformableMeanEdge) const {
     switch (settings_.rigidDeformable) {
         case RigidDeformableQuery::Faces: return false;
         case RigidDeformableQuery::PointShell: return true;
-        case RigidDeformableQuery::Auto: return meanEdge[deformable] < meanEdge[rigid];
+        case RigidDeformableQuery::Auto: return deformableMeanEdge < rigidMeanEdge;
     }
     return false;
 }
 
 bool CollisionWorld::usesPointShell(BodyId a, BodyId b) const {
-    return fields_[a] && parts_[b]->deforms() && pointShellServes(a, b, meanEdge_);
+    return fields_[a] && parts_[b]->deforms() && pointShellServes(meanEdge_[a], meanEdge_[b]);
 }
 
 }  // namespace flexfit

@@ -16,6 +16,7 @@
 #include <optional>
 #include <cmath>
 #include <set>
+#include <unordered_map>
 
 namespace flexfit {
 namespace {
@@ -464,9 +465,12 @@ ScenePart readPart(Table& t, const std::filesystem::path& base, const SceneReadO
     return p;
 }
 
-BodyId partId(Table& t, const std::string& key, const Scene& scene) {
+// The scene's parts by name, as read so far (Scene::find scans: a scene of n parts read in O(n)).
+using PartIds = std::unordered_map<std::string, BodyId>;
+
+BodyId partId(Table& t, const std::string& key, const PartIds& parts) {
     const std::string name = t.requiredText(key);
-    if (auto id = scene.find(name)) return *id;
+    if (const auto found = parts.find(name); found != parts.end()) return found->second;
     t.fail(*t.node(key), key, "no part named '" + name + "'");
 }
 
@@ -495,7 +499,7 @@ AssemblyArea readArea(Table& t) {
     return a;
 }
 
-AssemblyRule readAssembly(Table& t, const Scene& scene) {
+AssemblyRule readAssembly(Table& t, const Scene& scene, const PartIds& parts) {
     AssemblyRule r;
     r.name = t.name("name", "assembly " + std::to_string(scene.assemblies.size()));
     for (const AssemblyRule& other : scene.assemblies)
@@ -504,8 +508,8 @@ AssemblyRule readAssembly(Table& t, const Scene& scene) {
             if (t.has("name")) t.fail(*t.node("name"), "name", problem);
             t.fail(problem + " (the default name of the assembly at this place)");
         }
-    r.primary = partId(t, "primary", scene);
-    r.secondary = partId(t, "secondary", scene);
+    r.primary = partId(t, "primary", parts);
+    r.secondary = partId(t, "secondary", parts);
     if (r.primary == r.secondary) t.fail(*t.node("secondary"), "secondary", "must differ from the primary");
     r.technique = t.choice("technique", SnapTechnique::ZoneSnap);
     r.finalRelativePose = t.pose("final_position", "final_rotation");
@@ -540,7 +544,7 @@ std::string formatSeconds(double seconds) {
     return text;
 }
 
-SceneAction readAction(Table& t, Scene& scene) {
+SceneAction readAction(Table& t, Scene& scene, const PartIds& parts) {
     using Kind = SceneAction::Kind;
     SceneAction a;
     a.line = t.line();
@@ -548,7 +552,7 @@ SceneAction readAction(Table& t, Scene& scene) {
     a.time = t.nonNegative("time", 0.0);
     if (!t.has("type")) t.fail("missing key 'type'");
     a.kind = t.choice("type", Kind::Push);
-    a.body = partId(t, "part", scene);
+    a.body = partId(t, "part", parts);
     const ScenePart& part = scene.parts[a.body];
     switch (a.kind) {
         case Kind::Grab:
@@ -675,14 +679,12 @@ Scene parseScene(std::string_view text, const std::string& source, const std::fi
 
 AssemblyRule detail::readAssemblyTable(const toml::table& table, const std::string& source, const std::vector<std::string>& partNames,
                                        std::vector<SceneWarning>& warnings) {
-    Scene scene;  // only the parts' names: readAssembly looks the rule's bodies up by name
+    Scene scene;  // no other rules; readAssembly looks the rule's bodies up by name
     scene.source = source;
-    for (const std::string& name : partNames) {
-        scene.parts.emplace_back();
-        scene.parts.back().name = name;
-    }
+    PartIds parts;
+    for (BodyId id = 0; id < partNames.size(); ++id) parts.emplace(partNames[id], id);  // the first of a name, as Scene::find
     Table t(table, "assembly", scene.source, warnings);
-    return readAssembly(t, scene);
+    return readAssembly(t, scene, parts);
 }
 
 namespace {
@@ -707,21 +709,23 @@ Scene detail::readSceneDocument(const toml::table& document, const std::string& 
     scene.source = source;
     Table root(document, "scene", scene.source, scene.warnings);
     readWorld(root, scene);
+    PartIds ids;
     for (const toml::table* t : tables(root, "part")) {
         Table part(*t, "part " + std::to_string(scene.parts.size() + 1), scene.source, scene.warnings);
         ScenePart p = readPart(part, baseDirectory, options, scene.warnings);
-        if (scene.find(p.name)) part.fail(*t->get("name"), "name", "duplicate part name '" + p.name + "'");
+        if (ids.contains(p.name)) part.fail(*t->get("name"), "name", "duplicate part name '" + p.name + "'");
         warnOfPerStepRestoration(part, p, scene);
+        ids.emplace(p.name, BodyId(scene.parts.size()));
         scene.parts.push_back(std::move(p));
     }
     if (scene.parts.empty()) root.fail("no [[part]]: a scene needs at least one part");
     for (const toml::table* t : tables(root, "assembly")) {
         Table a(*t, "assembly " + std::to_string(scene.assemblies.size() + 1), scene.source, scene.warnings);
-        scene.assemblies.push_back(readAssembly(a, scene));
+        scene.assemblies.push_back(readAssembly(a, scene, ids));
     }
     for (const toml::table* t : tables(root, "action")) {
         Table a(*t, "action " + std::to_string(scene.actions.size() + 1), scene.source, scene.warnings);
-        scene.actions.push_back(readAction(a, scene));
+        scene.actions.push_back(readAction(a, scene, ids));
     }
     std::stable_sort(scene.actions.begin(), scene.actions.end(), [](const SceneAction& a, const SceneAction& b) { return a.time < b.time; });
     checkOperatorScript(scene);
