@@ -46,10 +46,10 @@ public:
     explicit ActiveRegion(const PartModel& model);
 
     // One zone more covers `mass`. At the first, the mass moves and its springs are computed;
-    // returns true then.
+    // returns true then. InputError for a mass out of range or covered 65,535 times already.
     bool cover(Index mass);
-    // One zone fewer covers `mass` (which must be covered). At the last, the mass stops moving
-    // and its springs with no other moving end stop being computed; returns true then.
+    // One zone fewer covers `mass` (InputError unless covered). At the last, the mass stops
+    // moving and its springs with no other moving end stop being computed; returns true then.
     bool uncover(Index mass);
 
     // One zone fewer covers `mass`, unless it is the last: then nothing changes and it returns
@@ -66,7 +66,8 @@ public:
     // spring), so that covering and uncovering never allocate (Part::reserveZones).
     void reserveWholeModel();
 
-    bool moves(Index mass) const { return coverCount_[mass] != 0; }
+    bool moves(Index mass) const { return coverCount_[mass] != 0; }  // mass < the model's count (unchecked: hot)
+    bool builtFor(const PartModel& model) const { return model_ == &model; }
     bool empty() const { return masses_.empty(); }
     bool coversEveryMass() const { return masses_.size() == coverCount_.size(); }
     const IndexSet& masses() const { return masses_; }    // the moving masses
@@ -119,6 +120,7 @@ private:
         void leave(Index member, Index group, MemberOf memberOf, InRegion inRegion);
     };
     static constexpr Index kNoGroup = ~Index(0);
+    void requireMass(Index mass, const char* what) const;  // InputError naming `what` when out of range
     void springJoins(Index spring);
     void springLeaves(Index spring);
     Index blockOf(Index spring) const;                 // its block, or kNoGroup

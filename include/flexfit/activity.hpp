@@ -13,6 +13,7 @@
 
 namespace flexfit {
 
+// InputError unless there is one position per mass.
 std::size_t countActiveSprings(const PartModel& model, std::span<const Vec3> positions, double threshold);
 
 class ActivityTracker {
@@ -20,6 +21,7 @@ public:
     ActivityTracker(const PartModel& model, double threshold);
 
     // Counts the active springs of `state` and folds them into the run totals; returns the count.
+    // InputError for a state, model or spring that does not fit the tracker's model.
     std::size_t observe(const PartModel& model, const PartState& state);
     // The same, checking only `springs`: for a rigid-deformable part, its computed springs
     // (every other spring joins two masses at rest and is inactive by construction).
@@ -42,6 +44,8 @@ public:
 
 private:
     void countIfActive(const PartModel& model, const PartState& state, Index spring);
+    // InputError unless the state and the tracker fit the model.
+    void requireObservable(const PartModel& model, const PartState& state) const;
     std::size_t finishObservation(const PartState& state);
 
     double threshold_;

@@ -117,7 +117,8 @@ public:
     // The contacts of one body with every body whose sphere touches its own, without updating
     // the broad-phase tree or querying other pairs: for a body moving in sub-steps while the
     // others wait. Same pairs and order as update() + narrowPhase() restricted to that body;
-    // with rigidPartnersOnly, pairs with deformable parts are skipped.
+    // with rigidPartnersOnly, pairs with deformable parts are skipped. std::invalid_argument
+    // for a body not added.
     const std::vector<Contact>& contactsOf(BodyId id, bool rigidPartnersOnly = false);
     // update(), then every candidate pair's query run for its coherence alone: what the pair's
     // first query would traverse (a point shell's walk of the rest masses near the rigid part,

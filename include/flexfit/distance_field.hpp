@@ -60,7 +60,8 @@ public:
         Vec3 normal = Vec3::UnitY(); // unit, outward at the closest point: p = closest + distance * normal
     };
 
-    // cellSize <= 0 picks an eighth of the mean edge length.
+    // cellSize <= 0 picks an eighth of the mean edge length; a NaN one, or one beyond the
+    // mesh's extent, is std::invalid_argument.
     SignedDistanceField(const TriMesh& mesh, const Topology& topology, double cellSize = 0.0);
 
     // Exact signed distance, closest point and normal.
@@ -70,7 +71,7 @@ public:
         double distance = 0.0;
         Vec3 gradient = Vec3::Zero();
     };
-    // The grid's interpolation at p (clamped into the grid).
+    // The grid's interpolation at p (clamped into the grid; a NaN coordinate gives NaN values).
     Interpolated sample(const Vec3& p) const;
     // sample() at each of `points` (each must be inGrid, so finite), into `out` (at least as
     // many; std::invalid_argument otherwise): the same values bit for bit. On CPUs with AVX2, four points a vector (the same operations in the same order, each

@@ -87,6 +87,10 @@ struct FileVertices {
 TriMesh inFileOrder(const TriMesh& mesh, const FileVertices& file);
 // For each mesh vertex, the first file vertex that became it (kNoVertex: none did).
 VertexMap firstFileVertices(const FileVertices& file, std::size_t meshVertexCount);
+// InputError unless `file` fits a mesh of that many vertices: a position for each file vertex,
+// each finite, each going to a vertex of the mesh or removed. inFileOrder and
+// firstFileVertices check it.
+void checkFileVertices(const FileVertices& file, std::size_t meshVertexCount);
 
 // Axis-aligned bounds of the vertices.
 Eigen::AlignedBox3d boundingBox(const TriMesh& mesh);

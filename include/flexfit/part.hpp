@@ -95,6 +95,14 @@ inline constexpr ZoneId kNoZone = 0;
 
 class KRingWalker;
 
+class Part;
+namespace detail {
+// Part::setPose without its check, for the world's rigid motion and snapping: a pose they
+// compute from a diverging body is reported by the world's divergence check, which names the
+// body and the likely cause.
+void setPoseUnchecked(Part& part, const Pose& pose);
+}  // namespace detail
+
 class Part {
 public:
     // Throws InputError for invalid settings.
@@ -116,6 +124,8 @@ public:
     void setSettings(const PartSettings& settings);
 
     // --- Pose (O(1)) ---
+    // setPose and translate throw InputError for a pose that is not one (checkPose, pose.hpp),
+    // the rotations for a non-finite or zero axis, angle or point; the pose is then unchanged.
     const Pose& pose() const { return pose_; }
     void setPose(const Pose& pose);
     void translate(const Vec3& offset);
@@ -127,8 +137,9 @@ public:
 
     // --- Zones ---
     // Opens a zone; returns kNoZone in Rigid and FullDeformable modes. Throws InputError for a
-    // seed out of range or a level outside [0, 255].
+    // seed out of range, a level outside [0, 255], or kMaxOpenZones zones already open.
     ZoneId openZone(ZoneSeed seed, int level);
+    static constexpr std::size_t kMaxOpenZones = 65535;  // a mass's cover count is 16 bits
     void setZoneLevel(ZoneId zone, int level);
     void retireZone(ZoneId zone);
     std::size_t zoneCount() const;
@@ -196,9 +207,10 @@ public:
     const ActiveRegion& region() const { return region_; }
     std::span<const Index> movingMasses() const { return region_.masses().members(); }
     std::span<const Index> computedSprings() const { return region_.springs().members(); }
-    bool isMoving(Index mass) const { return region_.moves(mass); }
+    // Throws InputError for a mass out of range (region().moves() does not check).
+    bool isMoving(Index mass) const;
     const PartState& state() const { return state_; }  // part frame; non-moving masses at rest
-    Vec3 worldPosition(Index mass) const { return pose_.apply(state_.positions[mass]); }
+    Vec3 worldPosition(Index mass) const;  // InputError for a mass out of range
     void worldPositions(std::vector<Vec3>& out) const;
     // The vertices of model().drawnMesh() as the part looks now, in the part frame / the world
     // (the mass positions in the user's vertex order, PartModel::userMesh(), when the model has
@@ -215,6 +227,7 @@ public:
     double time() const { return state_.time; }
 
 private:
+    friend void detail::setPoseUnchecked(Part& part, const Pose& pose);
     // Part-frame points to the world, in place.
     void toWorld(std::vector<Vec3>& points) const;
     struct Zone;  // its seeds, level and members (part.cpp)
@@ -231,6 +244,7 @@ private:
     void collectMembers(Zone& zone);
     bool zoneAtRest(const Zone& zone) const;
     void markChanged(Index mass);
+    void requireMass(Index mass, const char* what) const;  // InputError naming `what` when out of range
     // Whether displaceMass moves this mass: in range, moving, and the part not Rigid.
     bool displaces(Index mass) const {
         return mass < model_->massCount() && region_.moves(mass) && settings_.mode != PartMode::Rigid;

@@ -48,7 +48,7 @@ struct Topology {
     }
 };
 
-// Faces must hold indices < vertexCount (validateMesh guarantees it).
+// Faces must hold indices < vertexCount (validateMesh guarantees it; InputError otherwise).
 Topology buildTopology(std::span<const Face> faces, std::size_t vertexCount);
 
 // Whether a mesh bounds a solid: closed and manifold (every edge on two faces), consistently

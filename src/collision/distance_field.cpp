@@ -33,6 +33,11 @@ double angleAt(const Vec3& corner, const Vec3& u, const Vec3& v) {
 SignedDistanceField::SignedDistanceField(const TriMesh& mesh, const Topology& topology, double cellSize)
     : vertices_(mesh.vertices), faces_(mesh.faces) {
     if (faces_.empty()) throw std::invalid_argument("signed distance field: the mesh has no faces");
+    const Aabb meshBox = Aabb::around(vertices_);
+    const double extent = (meshBox.max - meshBox.min).maxCoeff();
+    if (std::isnan(cellSize) || cellSize > extent)  // <= 0: the default, from the mesh's edges
+        throw std::invalid_argument("signed distance field: the cell size " + std::to_string(cellSize) +
+                                    " must be at most the mesh's extent " + std::to_string(extent) + " (or <= 0: chosen from the edges)");
     switch (solidDefect(vertices_, faces_, topology)) {
     case SolidDefect::None: break;
     case SolidDefect::Open: throw std::invalid_argument("signed distance field: the mesh '" + mesh.name + "' is not closed and manifold");
@@ -92,6 +97,10 @@ void SignedDistanceField::setUpGrid(Grid& grid, double cell, std::size_t maxNode
             nodes *= count;
         }
         if (nodes <= double(maxNodes)) break;
+        if (!std::isfinite(nodes)) {  // a cell so small the count overflows: start from one that fits
+            cell = (meshBox.max - meshBox.min).maxCoeff() / std::cbrt(double(maxNodes));
+            continue;
+        }
         cell *= std::cbrt(nodes / double(maxNodes)) * 1.01;
     }
     grid.cell = cell;
@@ -200,8 +209,9 @@ SignedDistanceField::Cell SignedDistanceField::cellAt(Grid& grid, const Vec3& p,
     int base[3];
     Cell cell;
     for (int d = 0; d < 3; ++d) {
-        // Clamped as a double first: a far or non-finite point must not overflow the int.
-        base[d] = int(std::clamp(std::floor(g[d]), 0.0, double(grid.dims[std::size_t(d)] - 2)));
+        // Clamped as a double first: a far point must not overflow the int, a NaN one reads cell 0.
+        const double lower = std::floor(g[d]);
+        base[d] = lower > 0.0 ? int(std::min(lower, double(grid.dims[std::size_t(d)] - 2))) : 0;
         cell.t[d] = std::clamp(g[d] - base[d], 0.0, 1.0);
     }
     const std::size_t sx = 1, sy = std::size_t(grid.dims[0]), sz = sy * std::size_t(grid.dims[1]);

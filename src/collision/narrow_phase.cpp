@@ -3,6 +3,8 @@
 #include "flexfit/collision_world.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 namespace flexfit {
 const std::vector<Contact>& CollisionWorld::narrowPhase(const KnownContacts* known) {
@@ -49,6 +51,9 @@ const std::vector<Contact>& CollisionWorld::findContacts() {
 }
 
 const std::vector<Contact>& CollisionWorld::contactsOf(BodyId id, bool rigidPartnersOnly) {
+    if (id >= parts_.size())
+        throw std::invalid_argument("CollisionWorld::contactsOf: no body " + std::to_string(id) + " (" + std::to_string(parts_.size()) +
+                                    " added)");
     refitted_.clear();
     bodyContacts_.clear();
     const RelativePose identity;

@@ -184,7 +184,7 @@ public:
     bool rigid() const { return part_.mode() == PartMode::Rigid; }
     bool atRest(Index face) const {
         const Face& f = part_.model().mesh.faces[face];
-        return rigid() || !(part_.isMoving(f[0]) || part_.isMoving(f[1]) || part_.isMoving(f[2]));
+        return rigid() || !(part_.region().moves(f[0]) || part_.region().moves(f[1]) || part_.region().moves(f[2]));
     }
     // The face's planes in the other frame; the reference holds until the next call.
     const Planes& of(Index face) {

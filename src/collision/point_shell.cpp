@@ -309,7 +309,7 @@ void queryPointShell(std::uint32_t idA, const Part& a, const SignedDistanceField
     if (!restPointsB.empty()) {
         std::vector<std::int32_t> stack(1, 0);
         stats.volumeTests += walkRestPoints(fieldA, restPointsB, bInA, 0.0, stack, std::numeric_limits<std::size_t>::max(), 1, [&](Index m) {
-            if (!b.isMoving(m)) sampler.queue(m, sampler.pointOf(m));
+            if (!b.region().moves(m)) sampler.queue(m, sampler.pointOf(m));
         });
     }
     sampler.sampleQueued([](std::size_t, double) {});
@@ -382,7 +382,7 @@ void queryPointShellCoherent(std::uint32_t idA, const Part& a, const SignedDista
     }
     const double clearAbove = fieldA.clearDistance(motion);  // staysClear(distance, motion), once
     for (const auto& [m, distance] : c.restMasses) {
-        if (distance > clearAbove || b.isMoving(m)) continue;
+        if (distance > clearAbove || b.region().moves(m)) continue;
         sampler.queue(m, sampler.pointOf(m));
     }
     sampler.sampleQueued(keepMovingSamples);

@@ -3,6 +3,9 @@
 
 #include "model/spring_blocks.hpp"
 
+#include <limits>
+#include <string>
+
 namespace flexfit {
 
 void ActiveRegion::LooseSprings::reset(const PartModel& m) {
@@ -82,7 +85,16 @@ void ActiveRegion::reserveWholeModel() {
     blockGroups_.loose.list.reserve(model_->springCount());
 }
 
+void ActiveRegion::requireMass(Index mass, const char* what) const {
+    if (mass >= coverCount_.size())
+        throw InputError("active region", 0, std::string(what) + ": mass " + std::to_string(mass) + " does not exist (the region has " +
+                                                 std::to_string(coverCount_.size()) + " masses)");
+}
+
 bool ActiveRegion::cover(Index mass) {
+    requireMass(mass, "cover");
+    if (coverCount_[mass] == std::numeric_limits<std::uint16_t>::max())
+        throw InputError("active region", 0, "cover: mass " + std::to_string(mass) + " is covered by 65,535 zones already");
     if (coverCount_[mass]++ != 0) return false;
     masses_.insert(mass);
     octets_.join(mass, octetOf(mass), massOfOctet);
@@ -92,6 +104,8 @@ bool ActiveRegion::cover(Index mass) {
 }
 
 bool ActiveRegion::uncover(Index mass) {
+    requireMass(mass, "uncover");
+    if (coverCount_[mass] == 0) throw InputError("active region", 0, "uncover: mass " + std::to_string(mass) + " is not covered");
     if (--coverCount_[mass] != 0) return false;
     masses_.erase(mass);
     octets_.leave(mass, octetOf(mass), massOfOctet, [this](Index m) { return moves(m); });

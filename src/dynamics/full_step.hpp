@@ -18,6 +18,12 @@
 
 namespace flexfit::detail {
 
+// The public step functions' checks: valid settings, a state of the model's size, a region
+// built for the model (when given), loads on existing masses with finite forces; InputError
+// naming `what` otherwise, before anything changes. O(1 + loads).
+void requireStepInputs(const PartModel& model, const SimulationSettings& settings, const PartState& state,
+                       const ActiveRegion* region, std::span<const PointLoad> loads, const char* what);
+
 enum class BlockKernel { Scalar, Avx2, Avx512 };
 
 // Compiled in and supported by this CPU.

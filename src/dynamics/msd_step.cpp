@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 namespace flexfit {
@@ -15,6 +16,8 @@ namespace flexfit {
 void validateSettings(const SimulationSettings& s) {
     const std::string source = "simulation settings";
     if (!std::isfinite(s.timeStep) || s.timeStep <= 0.0) throw InputError(source, 0, "time step must be finite and > 0");
+    if (!(s.timeStep >= std::numeric_limits<double>::min()))  // its inverse (h/m, c/h) would overflow
+        throw InputError(source, 0, "time step " + std::to_string(s.timeStep) + " is below the smallest normal double");
     if (!s.gravity.allFinite()) throw InputError(source, 0, "gravity must be finite");
     if (!std::isfinite(s.globalDamping) || s.globalDamping < 0.0)
         throw InputError(source, 0, "global damping must be finite and >= 0");
@@ -68,8 +71,25 @@ std::string describe(const DefaultFractionElsewhere& d, const FractionKeys& keys
            " a stiffness independent of the step";
 }
 
+void detail::requireStepInputs(const PartModel& model, const SimulationSettings& settings, const PartState& state,
+                               const ActiveRegion* region, std::span<const PointLoad> loads, const char* what) {
+    validateSettings(settings);
+    const std::string_view source = what;  // a std::string only when thrown: the steps allocate nothing
+    const std::size_t n = model.massCount();
+    if (state.positions.size() != n || state.velocities.size() != n || state.forces.size() != n)
+        throw InputError(std::string(source), 0, "the state has " + std::to_string(state.positions.size()) + " masses, the model " + std::to_string(n));
+    if (region != nullptr && !region->builtFor(model)) throw InputError(std::string(source), 0, "the active region was built for another model");
+    for (const PointLoad& load : loads) {
+        if (load.mass >= n)
+            throw InputError(std::string(source), 0, "a load on mass " + std::to_string(load.mass) + ", which does not exist (the model has " +
+                                            std::to_string(n) + " masses)");
+        if (!load.force.allFinite()) throw InputError(std::string(source), 0, "the load on mass " + std::to_string(load.mass) + " is not finite");
+    }
+}
+
 void stepFullModel(const PartModel& model, const SimulationSettings& settings, std::span<const PointLoad> loads,
                    PartState& state, StepCounters* counters) {
+    detail::requireStepInputs(model, settings, state, nullptr, loads, "stepFullModel");
     detail::stepAllMasses(model, settings, loads, nullptr, state, counters);
 }
 
@@ -100,6 +120,7 @@ void detail::stepAllMasses(const PartModel& model, const SimulationSettings& set
 }
 
 double totalEnergy(const PartModel& model, const SimulationSettings& settings, const PartState& state) {
+    detail::requireStepInputs(model, settings, state, nullptr, {}, "totalEnergy");
     double energy = 0.0;
     for (std::size_t i = 0; i < model.massCount(); ++i) energy += 0.5 * model.mass[i] * state.velocities[i].squaredNorm();
     for (std::size_t e = 0; e < model.springCount(); ++e) {

@@ -57,8 +57,15 @@ std::optional<DefaultFractionElsewhere> defaultFractionAt(const PartSettings& pa
     return defaultFractionAt(part.simulation.restoration, timeStep);
 }
 
+namespace {
+std::shared_ptr<const PartModel> requireModel(std::shared_ptr<const PartModel> model) {
+    if (!model) throw InputError(kPartSource, 0, "a part needs a model (given none)");
+    return model;
+}
+}  // namespace
+
 Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
-    : model_(std::move(model)),
+    : model_(requireModel(std::move(model))),
       settings_(settings),
       state_(PartState::atRest(*model_)),
       walker_(std::make_unique<KRingWalker>(model_->massCount())),
@@ -108,14 +115,23 @@ void Part::setSettings(const PartSettings& settings) {
 // --- Pose ---
 
 void Part::setPose(const Pose& pose) {
-    pose_ = pose;
-    pose_.rotation.normalize();
+    checkPose(pose, "part: setPose");
+    detail::setPoseUnchecked(*this, pose);
 }
 
-void Part::translate(const Vec3& offset) { pose_.translation += offset; }
+void detail::setPoseUnchecked(Part& part, const Pose& pose) {
+    part.pose_ = pose;
+    part.pose_.rotation.normalize();
+}
+
+void Part::translate(const Vec3& offset) {
+    if (!(pose_.translation + offset).allFinite()) throw InputError(kPartSource, 0, "translate: the offset must be finite, and the position stay so");
+    pose_.translation += offset;
+}
 
 void Part::rotateAbout(const Vec3& axis, double angle, const Vec3& point) {
-    if (!(axis.norm() > 0.0) || !axis.allFinite() || !std::isfinite(angle) || !point.allFinite())
+    const double length = axis.norm();
+    if (!(length > 0.0) || !std::isfinite(length) || !std::isfinite(angle) || !point.allFinite())
         throw InputError(kPartSource, 0, "rotation needs a finite non-zero axis, angle and point");
     Pose turn;
     turn.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized()));
@@ -124,6 +140,22 @@ void Part::rotateAbout(const Vec3& axis, double angle, const Vec3& point) {
 }
 
 void Part::rotate(const Vec3& axis, double angle) { rotateAbout(axis, angle, centre()); }
+
+bool Part::isMoving(Index mass) const {
+    requireMass(mass, "isMoving");
+    return region_.moves(mass);
+}
+
+Vec3 Part::worldPosition(Index mass) const {
+    requireMass(mass, "worldPosition");
+    return pose_.apply(state_.positions[mass]);
+}
+
+void Part::requireMass(Index mass, const char* what) const {
+    if (mass >= model_->massCount())
+        throw InputError(kPartSource, 0, std::string(what) + ": mass " + std::to_string(mass) + " does not exist (the model has " +
+                                             std::to_string(model_->massCount()) + " masses)");
+}
 
 Vec3 Part::centre() const { return pose_.apply(boundingBox(model_->mesh).center()); }
 
@@ -192,6 +224,8 @@ void Part::collectMembers(Zone& zone) {
 
 ZoneId Part::openZone(ZoneSeed seed, int level) {
     if (level < 0 || level > 255) throw InputError(kPartSource, 0, "zone level " + std::to_string(level) + " is outside [0, 255]");
+    if (zones_.size() >= kMaxOpenZones)  // a mass counts the zones covering it in 16 bits
+        throw InputError(kPartSource, 0, "a part keeps at most " + std::to_string(kMaxOpenZones) + " zones open at once");
     Zone zone = spareZone();
     zone.id = nextZoneId_;
     zone.level = level;
@@ -366,6 +400,7 @@ void Part::touchFace(Index face) {
 }
 
 void Part::displaceMass(Index mass, const Vec3& worldDisplacement) {
+    if (!worldDisplacement.allFinite()) throw InputError(kPartSource, 0, "displaceMass: the displacement must be finite");
     if (!displaces(mass)) return;
     const Vec3 d = pose_.rotateInverse(worldDisplacement);
     state_.positions[mass] += d;

@@ -56,6 +56,7 @@ void integrateRegion(const PartModel& model, const detail::MassUpdate& p, const 
 
 void stepActiveRegion(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                       PartState& state, StepCounters* counters) {
+    detail::requireStepInputs(model, settings, state, &region, {}, "stepActiveRegion");
     detail::stepRegion(model, settings, region, state, counters, nullptr);
 }
 
@@ -92,6 +93,7 @@ void detail::stepRegionByFullModelFromRest(const PartModel& model, const Simulat
 
 void stepRegionByFullModel(const PartModel& model, const SimulationSettings& settings, const ActiveRegion& region,
                            PartState& state, StepCounters* counters) {
+    detail::requireStepInputs(model, settings, state, &region, {}, "stepRegionByFullModel");
     detail::stepRegionByFullModelFromRest(model, settings, region, state, counters);
     // The groups the explicit kernels skipped as at rest may not have been: every held mass back
     // to rest (a selection: the same bits wherever they already were). The implicit step puts

@@ -246,7 +246,20 @@ void composeVertexMap(VertexMap& map, const VertexMap& then) {
         if (v != kNoVertex) v = then[v];
 }
 
+void checkFileVertices(const FileVertices& file, std::size_t meshVertexCount) {
+    const auto fail = [](const std::string& problem) { throw InputError("file vertices", 0, problem); };
+    if (file.positions.size() != file.count())
+        fail(std::to_string(file.count()) + " file vertices but " + std::to_string(file.positions.size()) + " positions");
+    for (std::size_t u = 0; u < file.count(); ++u) {
+        if (file.meshVertex[u] != kNoVertex && file.meshVertex[u] >= meshVertexCount)
+            fail("file vertex " + std::to_string(u) + " goes to vertex " + std::to_string(file.meshVertex[u]) + ", out of range (the mesh has " +
+                 std::to_string(meshVertexCount) + ")");
+        if (!file.positions[u].allFinite()) fail("file vertex " + std::to_string(u) + " has a non-finite position");
+    }
+}
+
 VertexMap firstFileVertices(const FileVertices& file, std::size_t meshVertexCount) {
+    checkFileVertices(file, meshVertexCount);
     VertexMap first(meshVertexCount, kNoVertex);
     for (std::size_t i = file.count(); i-- > 0;)
         if (const Index v = file.meshVertex[i]; v != kNoVertex) first[v] = Index(i);

@@ -1,5 +1,7 @@
 #include "flexfit/pose.hpp"
 
+#include <cmath>
+
 #include <Eigen/SVD>
 
 namespace flexfit {
@@ -25,6 +27,12 @@ Pose Pose::fromMatrix(const Eigen::Matrix4d& m) {
     pose.rotation = Eigen::Quaterniond(r).normalized();
     pose.translation = m.topRightCorner<3, 1>();
     return pose;
+}
+
+void checkPose(const Pose& pose, std::string_view what) {
+    const double norm2 = pose.rotation.squaredNorm();
+    if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite() || !(norm2 > 0.0) || !std::isfinite(norm2))
+        throw InputError(std::string(what), 0, "the pose must be finite, with a rotation quaternion of finite non-zero norm");
 }
 
 Pose Pose::then(const Pose& after) const {

@@ -15,6 +15,8 @@ const std::string kSettingsSource = "part model settings";
 
 bool positiveFinite(double x) { return std::isfinite(x) && x > 0.0; }
 bool nonNegativeFinite(double x) { return std::isfinite(x) && x >= 0.0; }
+// A mass the step can divide by: positive, finite, with a finite inverse (not subnormal).
+bool invertibleMass(double x) { return positiveFinite(x) && std::isfinite(1.0 / x); }
 
 void checkMaterial(const Material& m, const std::string& what) {
     if (!nonNegativeFinite(m.stiffness)) throw InputError(kSettingsSource, 0, what + " stiffness must be finite and >= 0");
@@ -23,13 +25,14 @@ void checkMaterial(const Material& m, const std::string& what) {
 
 void checkSettings(const PartModelSettings& s, std::size_t vertices, std::size_t springs) {
     checkMaterial(s.material, "material");
-    if (!positiveFinite(s.vertexMass)) throw InputError(kSettingsSource, 0, "vertex mass must be finite and > 0");
+    if (!invertibleMass(s.vertexMass))
+        throw InputError(kSettingsSource, 0, "vertex mass must be finite and > 0, with a finite inverse (not subnormal)");
     if (!s.vertexMasses.empty() && s.vertexMasses.size() != vertices)
         throw InputError(kSettingsSource, 0, "per-vertex masses: " + std::to_string(s.vertexMasses.size()) +
                                                  " values for " + std::to_string(vertices) + " vertices");
     for (std::size_t v = 0; v < s.vertexMasses.size(); ++v)
-        if (!positiveFinite(s.vertexMasses[v]))
-            throw InputError(kSettingsSource, 0, "mass of vertex " + std::to_string(v) + " must be finite and > 0");
+        if (!invertibleMass(s.vertexMasses[v]))
+            throw InputError(kSettingsSource, 0, "mass of vertex " + std::to_string(v) + " must be finite and > 0, with a finite inverse (not subnormal)");
     if (!s.springMaterials.empty() && s.springMaterials.size() != springs)
         throw InputError(kSettingsSource, 0, "per-spring materials: " + std::to_string(s.springMaterials.size()) +
                                                  " values for " + std::to_string(springs) + " springs");
@@ -252,13 +255,10 @@ std::shared_ptr<PartModel> renumberedForLocality(const PartModel& given, const P
 // a vertex of the mesh or is removed, and every mesh vertex comes from one.
 std::shared_ptr<const FileNumbering> fileNumbering(const FileVertices& file, const TriMesh& given) {
     const auto fail = [](const std::string& problem) { throw InputError(kSettingsSource, 0, "file vertices: " + problem); };
-    if (file.positions.size() != file.count())
-        fail(std::to_string(file.count()) + " file vertices but " + std::to_string(file.positions.size()) + " positions");
-    for (std::size_t u = 0; u < file.count(); ++u) {
-        if (file.meshVertex[u] != kNoVertex && file.meshVertex[u] >= given.vertices.size())
-            fail("file vertex " + std::to_string(u) + " goes to vertex " + std::to_string(file.meshVertex[u]) + ", out of range (the mesh has " +
-                 std::to_string(given.vertices.size()) + ")");
-        if (!file.positions[u].allFinite()) fail("file vertex " + std::to_string(u) + " has a non-finite position");
+    try {
+        checkFileVertices(file, given.vertices.size());
+    } catch (const InputError& e) {
+        fail(e.problem());
     }
     auto numbering = std::make_shared<FileNumbering>();
     numbering->vertices = file;

@@ -1,6 +1,7 @@
 #include "flexfit/topology.hpp"
 
 #include <algorithm>
+#include <string>
 
 namespace flexfit {
 namespace {
@@ -99,6 +100,11 @@ void buildFaceNeighbours(std::vector<std::uint64_t>& pairs, Topology& topo) {
 }  // namespace
 
 Topology buildTopology(std::span<const Face> faces, std::size_t vertexCount) {
+    for (std::size_t f = 0; f < faces.size(); ++f)
+        for (const Index v : faces[f])
+            if (v >= vertexCount)
+                throw InputError("topology", 0, "face " + std::to_string(f) + " names vertex " + std::to_string(v) + " of " +
+                                                    std::to_string(vertexCount));
     Topology topo;
     topo.vertexCount = vertexCount;
     topo.faceCount = faces.size();

@@ -90,6 +90,16 @@ std::size_t addRule(const AssemblyRule& rule, std::size_t bodyCount, AssemblySta
     for (const AssemblyVector* v : {&rule.primaryVector, &rule.secondaryVector})
         if (!v->origin.allFinite() || !v->end.allFinite() || v->origin == v->end)
             throw InputError("world", 0, "assembly rule '" + rule.name + "': a vector's origin and end must be finite and differ (zero length has no direction)");
+    const std::string what = "world: assembly rule '" + rule.name + "'";
+    checkPose(rule.finalRelativePose, what + ": final relative pose");
+    checkPose(rule.area.frame, what + ": area frame");
+    for (const double tolerance : {rule.distanceTolerance, rule.angleTolerance, rule.vectorTolerance})
+        if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
+            throw InputError("world", 0, "assembly rule '" + rule.name + "': its distance, angle and vector tolerances must be finite and >= 0");
+    const AssemblyArea& area = rule.area;
+    if (!area.halfExtents.allFinite() || !(area.halfExtents.minCoeff() >= 0.0) || !(area.radius >= 0.0) || !std::isfinite(area.radius) ||
+        !(area.halfHeight >= 0.0) || !std::isfinite(area.halfHeight))
+        throw InputError("world", 0, "assembly rule '" + rule.name + "': the area's half extents, radius and half height must be finite and >= 0");
     RuleState state;
     state.rule = rule;
     assembly.rules.push_back(state);
@@ -108,7 +118,7 @@ void assemble(const StepContext& step, std::span<const Contact> contacts, Assemb
             startSnap(step, target, state, assembly, bodies, op);
         }
         const double s = rule.snapDuration > 0.0 ? (step.time + step.timeStep - state.start) / rule.snapDuration : 1.0;
-        primary.setPose(interpolate(state.from, target, s));
+        detail::setPoseUnchecked(primary, interpolate(state.from, target, s));
         ++bodies.poseEpoch;
         if (s >= 1.0) state.phase = RuleState::Phase::Assembled;  // and stays attached
     }

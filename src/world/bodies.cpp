@@ -26,6 +26,12 @@ RigidBody makeRigidBody(const PartModel& model, const BodySettings& settings) {
     body.thickness = settings.thickness > 0.0 ? settings.thickness : 0.5 * box.sizes().minCoeff();
     body.centreOfMass = box.center();
     if (settings.motion == MotionType::Dynamic) {
+        if (const SolidDefect defect = solidDefect(model.mesh.vertices, model.mesh.faces, model.topology); defect != SolidDefect::None)
+            throw InputError(source, 0, "a dynamic body needs a closed, consistently oriented mesh (its mass comes from the volume): '" +
+                                            model.name + "' " +
+                                            (defect == SolidDefect::Open           ? "is open or not manifold (an edge not on two faces)"
+                                             : defect == SolidDefect::Inconsistent ? "has faces wound inconsistently"
+                                                                                   : "is inside out (negative volume)"));
         const MassProperties mp = computeMassProperties(model.mesh, model.name);
         body.mass = settings.density * mp.volume;
         body.inverseMass = 1.0 / body.mass;

@@ -184,7 +184,7 @@ bool settleMove(BodyId id, double dt, double slop, double bound, const StepConte
     const Pose start = s.subStart[id];
     s.cachedBody.reset();
     auto fits = [&](double fraction) {
-        part.setPose(advancedPose(start, fraction * dt, body));
+        detail::setPoseUnchecked(part, advancedPose(start, fraction * dt, body));
         const std::span<const Contact> contacts = rigidContactsOf(id, bodies, collision, s, profiler);
         if (tooDeep(id, contacts, slop, bodies, s)) return false;
         s.cached.assign(contacts.begin(), contacts.end());  // the contacts at the pose reached
@@ -208,7 +208,7 @@ bool settleMove(BodyId id, double dt, double slop, double bound, const StepConte
         const double middle = 0.5 * (reached + blocked);
         (fits(middle) ? reached : blocked) = middle;
     }
-    part.setPose(reached > 0.0 ? advancedPose(start, reached * dt, body) : start);
+    detail::setPoseUnchecked(part, reached > 0.0 ? advancedPose(start, reached * dt, body) : start);
     if (reached > 0.0) keepCache(id, bodies, s);
     return false;
 }
@@ -300,7 +300,7 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
         profiler.enter(Stage::RigidMotion);
         for (BodyId id : s.moving) {
             s.subStart[id] = bodies.parts[id]->pose();
-            bodies.parts[id]->setPose(advancedPose(s.subStart[id], dt, bodies.rigid[id]));
+            detail::setPoseUnchecked(*bodies.parts[id], advancedPose(s.subStart[id], dt, bodies.rigid[id]));
         }
         for (BodyId id : settleAll(dt, slop, bound, step, bodies, collision, s, profiler)) {
             s.stopped[id] = 1;
@@ -323,7 +323,7 @@ void moveRigidBodies(const StepContext& step, const WorldSettings& settings, Bod
             const Pose& target = *bodies.kinematicTargets[id];
             const Pose& now = bodies.parts[id]->pose();
             if (!samePose(target, now)) s.cachedBody.reset();
-            bodies.parts[id]->setPose(target);
+            detail::setPoseUnchecked(*bodies.parts[id], target);
         }
         bodies.kinematicTargets[id].reset();
         RigidBody& body = bodies.rigid[id];

@@ -19,8 +19,11 @@ namespace {
 const std::string kSource = "world";
 
 void checkPose(const Pose& pose, const char* what) {
-    if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite() || !(pose.rotation.norm() > 0.0))
-        throw InputError(kSource, 0, std::string(what) + ": the pose must be finite, with a non-zero rotation quaternion");
+    try {
+        flexfit::checkPose(pose, what);
+    } catch (const InputError& e) {
+        throw InputError(kSource, 0, std::string(what) + ": " + e.problem());
+    }
 }
 
 // World::warnings(): a deforming part's restoration constraint left at its per-step default

@@ -38,3 +38,11 @@ TEST(CollisionWorld, SwitchingTheExactTestRebuildsEveryHierarchyAndKeepsTheConta
     EXPECT_GT(triangles, 0u);
     EXPECT_GT(world.findContacts().size(), 0u);
 }
+
+TEST(CollisionWorld, ContactsOfABodyNotAddedIsAnError) {
+    CollisionWorld world;
+    Part ball(buildPartModel(makeIcoSphere(1.0, 1)));
+    world.add(0, ball);
+    EXPECT_TRUE(world.contactsOf(0).empty());
+    EXPECT_THROW((void)world.contactsOf(7), std::invalid_argument);
+}

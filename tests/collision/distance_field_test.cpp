@@ -356,3 +356,19 @@ TEST(SignedDistanceField, LowerBoundsFourLaneAndScalarPathsAgree) {
     const detail::ScopedScalarSampling scalar;
     expectLowerBoundsBelowTheSamples();
 }
+
+TEST(SignedDistanceField, BadCellSizesAreRefusedAndTinyOnesFitTheGrid) {
+    const TriMesh cube = unitCube();
+    const Topology topology = buildTopology(cube.faces, cube.vertices.size());
+    // NaN and cells beyond the mesh: refused (a cell of 1e300 gave NaN samples).
+    for (const double bad : {std::nan(""), 1e300, double(INFINITY), 1.5})
+        EXPECT_THROW(SignedDistanceField(cube, topology, bad), std::invalid_argument) << bad;
+    // A cell so small the node count overflows (it looped forever): the grid's largest cell
+    // count instead, and the field is still exact at the nodes near the faces.
+    const SignedDistanceField tiny(cube, topology, 1e-300);
+    const Vec3 inside(0.5, 0.5, 0.25);  // 0.25 inside the face z = 0
+    const SignedDistanceField::Sample exact = tiny.query(inside);
+    EXPECT_NEAR(tiny.sample(inside).distance, exact.distance, 0.05);
+    // A NaN point (it indexed the grid with int(NaN)): NaN values, no read outside the grid.
+    EXPECT_TRUE(std::isnan(tiny.sample(Vec3(std::nan(""), 0.0, 0.0)).distance));
+}

@@ -265,3 +265,17 @@ TEST(ActiveRegion, ADeferredBatchOfUncoversMakesTheSameListsAsUncoveringAtOnce) 
         }
     }
 }
+
+TEST(ActiveRegion, CoveringAMassOutOfRangeOrUncoveringOneNotCoveredIsAnError) {
+    const auto model = buildPartModel(makeIcoSphere(1.0, 1));
+    ActiveRegion region(*model);
+    EXPECT_THROW((void)region.cover(Index(model->massCount())), InputError);
+    EXPECT_THROW((void)region.uncover(3), InputError);  // covered by no zone
+    EXPECT_TRUE(region.cover(3));
+    EXPECT_TRUE(region.uncover(3));
+    EXPECT_TRUE(region.empty());
+    // 65,535 zones on one mass fill its 16-bit count: one more is refused, not wrapped to 0.
+    for (int k = 0; k < 65535; ++k) (void)region.cover(5);
+    EXPECT_THROW((void)region.cover(5), InputError);
+    EXPECT_TRUE(region.moves(5));
+}

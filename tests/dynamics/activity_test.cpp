@@ -87,3 +87,19 @@ TEST(Activity, RejectsBadThreshold) {
     EXPECT_THROW(ActivityTracker(*model, 0.0), InputError);
     EXPECT_THROW(ActivityTracker(*model, std::nan("")), InputError);
 }
+
+TEST(Activity, AStateOrSpringNotOfTheModelIsAnError) {
+    const auto model = triangle();
+    const PartState state = PartState::atRest(*model);
+    ActivityTracker tracker(*model, 0.01);
+    const std::vector<Vec3> two(2, Vec3::Zero());
+    EXPECT_THROW((void)countActiveSprings(*model, two, 0.01), InputError);
+    const Index missing[] = {0, 99999};
+    EXPECT_THROW((void)tracker.observe(*model, state, missing), InputError);
+    PartState small = state;
+    small.positions.pop_back();
+    EXPECT_THROW((void)tracker.observe(*model, small), InputError);
+    const auto other = buildPartModel(makeIcoSphere(1.0, 1));
+    EXPECT_THROW((void)tracker.observe(*other, PartState::atRest(*other)), InputError);  // a tracker of 3 springs
+    EXPECT_EQ(tracker.observe(*model, state), 0u);
+}

@@ -455,3 +455,46 @@ TEST(MsdStep, ARestorationRateRestoresInTheSameTimeAtEveryTimeStep) {
     EXPECT_NEAR(restorationTime(fraction, 1e-3), atOne, 1.5e-3);  // the same c up to rounding: within a step
     EXPECT_LT(restorationTime(fraction, 2.5e-4), 0.5 * atOne);  // 4 times the steps a second
 }
+
+TEST(MsdStep, InputsThatDoNotFitTheModelAreErrorsAndChangeNothing) {
+    const auto model = buildPartModel(makeIcoSphere(1.0, 1));
+    const auto other = buildPartModel(makeIcoSphere(1.0, 0));
+    const SimulationSettings settings = plain(1e-3);
+    PartState state = PartState::atRest(*model);
+    const PartState before = state;
+    auto expectRefused = [&](auto step, const std::string& words) {
+        try {
+            step();
+            ADD_FAILURE() << "accepted: " << words;
+        } catch (const InputError& e) {
+            EXPECT_TRUE(flexfit::testing::contains(e.what(), words)) << e.what();
+        }
+        EXPECT_EQ(state.positions, before.positions);
+        EXPECT_EQ(state.forces, before.forces);
+        EXPECT_EQ(state.stepCount, before.stepCount);
+    };
+    // A load on a mass beyond the model (it wrote outside the forces), or not finite: no
+    // load is applied, not even the good one before it.
+    const PointLoad beyond[] = {{0, Vec3(1, 0, 0)}, {9999, Vec3(1, 0, 0)}};
+    expectRefused([&] { stepFullModel(*model, settings, beyond, state); }, "mass 9999, which does not exist");
+    const PointLoad infinite[] = {{0, Vec3(1, 0, 0)}, {1, Vec3(INFINITY, 0, 0)}};
+    expectRefused([&] { stepFullModel(*model, settings, infinite, state); }, "not finite");
+    // Another model's state or region (they corrupted the heap).
+    PartState small = PartState::atRest(*other);
+    try {
+        stepFullModel(*model, settings, {}, small);
+        ADD_FAILURE() << "another model's state accepted";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(flexfit::testing::contains(e.what(), "the state has 12 masses, the model 42")) << e.what();
+    }
+    const ActiveRegion foreign(*other);
+    expectRefused([&] { stepActiveRegion(*model, settings, foreign, state); }, "built for another model");
+    expectRefused([&] { stepRegionByFullModel(*model, settings, foreign, state); }, "built for another model");
+    EXPECT_THROW((void)totalEnergy(*model, settings, small), InputError);
+    // Settings the step cannot run with, unchecked before: a negative, NaN or subnormal step.
+    for (const double h : {-1e-3, std::nan(""), 1e-320}) {
+        SimulationSettings bad = settings;
+        bad.timeStep = h;
+        expectRefused([&] { stepFullModel(*model, bad, {}, state); }, "time step");
+    }
+}

@@ -741,3 +741,46 @@ TEST(Part, DisplaceMassesEqualsDisplaceMassOneByOne) {
     EXPECT_EQ(changed(batch), changed(single));
     EXPECT_THROW(batch.displaceMasses(masses, std::span<const Vec3>(pushes).first(3)), InputError);
 }
+
+TEST(Part, BadArgumentsAreErrorsAndLeaveThePartAsItWas) {
+    EXPECT_THROW(Part(nullptr), InputError);
+    const auto model = buildPartModel(makeIcoSphere(1.0, 1));
+    Part part(model, zoneSettings());
+    const Index beyond = Index(model->massCount());
+    EXPECT_THROW((void)part.worldPosition(beyond), InputError);
+    EXPECT_THROW((void)part.isMoving(beyond), InputError);
+    // Poses: a NaN or infinite translation, a quaternion that does not normalise; the pose
+    // stays where it was.
+    const Pose start{Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vec3::UnitZ())), Vec3(1, 2, 3)};
+    part.setPose(start);
+    const Pose kept = part.pose();  // normalised
+    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+    for (const Pose& bad : {Pose{Eigen::Quaterniond(0, 0, 0, 0), Vec3::Zero()}, Pose{Eigen::Quaterniond(1e200, 0, 0, 0), Vec3::Zero()},
+                            Pose{Eigen::Quaterniond(nan, 0, 0, 0), Vec3::Zero()}, Pose{Eigen::Quaterniond::Identity(), Vec3(inf, 0, 0)}})
+        EXPECT_THROW(part.setPose(bad), InputError);
+    EXPECT_THROW(part.translate(Vec3(nan, 0, 0)), InputError);
+    EXPECT_THROW(part.translate(Vec3(inf, 0, 0)), InputError);
+    Part far(model, zoneSettings());
+    far.translate(Vec3(1.7e308, 0, 0));
+    EXPECT_THROW(far.translate(Vec3(1.7e308, 0, 0)), InputError);  // the position would overflow
+    EXPECT_EQ(far.pose().translation.x(), 1.7e308);
+    EXPECT_THROW(part.rotate(Vec3(1e308, 1e308, 0), 1.0), InputError);  // its norm overflows: no direction
+    EXPECT_TRUE(samePose(part.pose(), kept));
+    // A displacement that is not finite; then a moving mass displaced by a finite one.
+    part.openZone(ZoneSeed::mass(0), 1);
+    EXPECT_THROW(part.displaceMass(0, Vec3(nan, 0, 0)), InputError);
+    EXPECT_TRUE(part.state().positions[0].allFinite());
+    part.displaceMass(0, Vec3(0.01, 0, 0));
+    EXPECT_NE(part.state().positions[0], model->restPositions[0]);
+}
+
+TEST(Part, AtMostKMaxOpenZonesAreOpenAtOnce) {
+    // A mass counts the zones covering it in 16 bits: the 65,536th zone on it wrapped the
+    // count to 0 and the mass stopped moving while listed as moving.
+    const auto model = buildPartModel(makeIcoSphere(1.0, 0));
+    Part part(model, zoneSettings());
+    for (std::size_t k = 0; k < Part::kMaxOpenZones; ++k) (void)part.openZone(ZoneSeed::mass(0), 1);
+    EXPECT_THROW((void)part.openZone(ZoneSeed::mass(0), 1), InputError);
+    EXPECT_TRUE(part.isMoving(0));
+    EXPECT_EQ(part.movingMasses().size(), 1u);
+}

@@ -548,3 +548,19 @@ TEST(WeldVertices, ToleranceModeMatchesBruteForceOnDenseUniformClouds) {
 
 }  // namespace
 }  // namespace flexfit
+
+TEST(Mesh, InFileOrderRefusesFileVerticesThatDoNotFitTheMesh) {
+    // A public helper given a map that names a vertex the mesh does not have, or fewer
+    // positions than file vertices: an error, not a read or write outside the arrays.
+    TriMesh tet;
+    tet.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    tet.faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    FileVertices file;
+    file.meshVertex = {0, 9};
+    file.positions = {Vec3::Zero(), Vec3::Zero()};
+    EXPECT_THROW((void)inFileOrder(tet, file), InputError);
+    file.meshVertex = {0, 1};
+    file.positions = {Vec3::Zero()};
+    EXPECT_THROW((void)inFileOrder(tet, file), InputError);
+    EXPECT_THROW((void)firstFileVertices(file, 4), InputError);
+}

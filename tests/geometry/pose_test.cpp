@@ -63,3 +63,26 @@ TEST(Pose, MillionRigidUpdatesStayOrthonormal) {
     EXPECT_LT((r.transpose() * r - Eigen::Matrix3d::Identity()).norm(), 1e-6);
     EXPECT_NEAR(r.determinant(), 1.0, 1e-6);
 }
+
+TEST(Pose, CheckPoseRefusesWhatIsNoPose) {
+    // A finite translation and a quaternion that normalises: accepted, whatever its length.
+    checkPose(Pose{}, "test");
+    checkPose(Pose{Eigen::Quaterniond(3.0, 0.0, 4.0, 0.0), Vec3(1e10, -2.0, 0.5)}, "test");
+    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+    const Pose bad[] = {
+        {Eigen::Quaterniond(0, 0, 0, 0), Vec3::Zero()},       // no rotation
+        {Eigen::Quaterniond(1e200, 0, 0, 0), Vec3::Zero()},   // its squared norm overflows: normalises to zeros
+        {Eigen::Quaterniond(1e-200, 0, 0, 0), Vec3::Zero()},  // underflows to 0: normalises to NaN
+        {Eigen::Quaterniond(nan, 0, 0, 0), Vec3::Zero()},
+        {Eigen::Quaterniond::Identity(), Vec3(0, inf, 0)},
+        {Eigen::Quaterniond::Identity(), Vec3(nan, 0, 0)},
+    };
+    for (const Pose& p : bad) {
+        try {
+            checkPose(p, "the test's pose");
+            ADD_FAILURE() << p.rotation.coeffs().transpose() << " / " << p.translation.transpose() << " accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("the test's pose"), std::string::npos) << e.what();
+        }
+    }
+}

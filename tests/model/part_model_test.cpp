@@ -202,6 +202,8 @@ TEST(PartModel, BadSettingsThrowInputError) {
         {"negative uniform mass", withMass(-1.0), "vertex mass"},
         {"NaN uniform mass", withMass(nan), "vertex mass"},
         {"infinite uniform mass", withMass(inf), "vertex mass"},
+        {"subnormal uniform mass", withMass(1e-320), "not subnormal"},  // its inverse overflows
+        {"subnormal mass", withMasses({1, 1e-320, 1, 1}), "mass of vertex 1"},
         {"negative stiffness", withMaterial({-0.1, 0.01}), "stiffness"},
         {"NaN stiffness", withMaterial({nan, 0.01}), "stiffness"},
         {"infinite stiffness", withMaterial({inf, 0.01}), "stiffness"},

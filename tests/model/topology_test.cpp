@@ -263,3 +263,15 @@ TEST(Topology, SpringCountEqualsUniqueEdgeCount) {
 
 }  // namespace
 }  // namespace flexfit
+
+TEST(Topology, AFaceNamingAMissingVertexIsAnError) {
+    // validateMesh guards the readers; buildTopology is public too, and must not write past
+    // its arrays when given a face beyond the vertex count.
+    const std::vector<Face> faces = {{0, 1, 2}, {0, 1, 7}};
+    try {
+        (void)buildTopology(faces, 3);
+        ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("face 1 names vertex 7 of 3"), std::string::npos) << e.what();
+    }
+}

@@ -158,6 +158,29 @@ TEST(Assembly, RulesAreCountedAndARefusedRuleIsNotAdded) {
     r.primaryVector = AssemblyVector{};
     r.secondaryVector.origin = Vec3(0.0, std::nan(""), 0.0);
     EXPECT_THROW(world.addAssembly(r), InputError);
+    r.secondaryVector = AssemblyVector{};
+    // A final pose or area frame that is not a pose, a tolerance or area size that is not a
+    // length: each refused (a NaN pose snapped the primary to NaN; a zero quaternion to none).
+    const AssemblyRule good = r;
+    for (const Eigen::Quaterniond& q : {Eigen::Quaterniond(0, 0, 0, 0), Eigen::Quaterniond(std::nan(""), 0, 0, 0),
+                                        Eigen::Quaterniond(1e200, 0, 0, 0)}) {
+        r = good;
+        r.finalRelativePose.rotation = q;
+        EXPECT_THROW(world.addAssembly(r), InputError);
+        r = good;
+        r.area.frame.rotation = q;
+        EXPECT_THROW(world.addAssembly(r), InputError);
+    }
+    r = good;
+    r.finalRelativePose.translation.x() = INFINITY;
+    EXPECT_THROW(world.addAssembly(r), InputError);
+    for (double* field : {&r.distanceTolerance, &r.angleTolerance, &r.vectorTolerance, &r.area.radius, &r.area.halfHeight,
+                          &r.area.halfExtents.x()})
+        for (const double bad : {-1.0, std::nan(""), double(INFINITY)}) {
+            r = good;  // the pointers stay into r
+            *field = bad;
+            EXPECT_THROW(world.addAssembly(r), InputError) << bad;
+        }
     EXPECT_EQ(world.assemblyCount(), 1u);
     EXPECT_THROW((void)world.assembled(1), InputError);
 }

@@ -54,6 +54,16 @@ TEST(Bodies, BadSettingsAreRefused) {
     sheet.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     sheet.faces = {{0, 1, 2}};
     EXPECT_THROW(makeRigidBody(*buildPartModel(sheet), open), InputError);
+    // A box with a face missing still encloses a positive "volume" by the divergence theorem:
+    // refused as open, not given a mass from it.
+    TriMesh box = makeBox(Vec3::Ones(), 1);
+    box.faces.pop_back();
+    try {
+        (void)makeRigidBody(*buildPartModel(box), open);
+        ADD_FAILURE() << "an open box made a dynamic body";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("closed"), std::string::npos) << e.what();
+    }
     // A density whose mass overflows, or underflows to 0: refused, not a NaN in the first step.
     BodySettings dynamic;
     dynamic.motion = MotionType::Dynamic;
