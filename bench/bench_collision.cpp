@@ -486,7 +486,46 @@ void BM_BroadPhase(benchmark::State& state) {
     setQueryCounters(state, settings.broadPhase == BroadPhaseUpdate::Refit ? "200 parts / refit" : "200 parts / rebuild", pairs, 0, true);
 }
 
+// A ball moving over a floor of N static boxes (rigid, 0.9 x 0.2 x 0.9 on a 1-unit grid: each
+// box's sphere reaches its neighbours'), one update and narrow phase a step: range(0) N,
+// range(1) 0 the boxes registered Fixed (as the world registers static rigid bodies), 1 Moving
+// (as every body was before Mobility). The ball touches the boxes below it.
+void BM_BallOverStaticParts(benchmark::State& state) {
+    const int count = int(state.range(0));
+    const Mobility mobility = state.range(1) == 0 ? Mobility::Fixed : Mobility::Moving;
+    PartSettings rigid;
+    rigid.mode = PartMode::Rigid;
+    const auto boxModel = buildPartModel(makeBox(Vec3(0.45, 0.1, 0.45), 1));
+    std::vector<std::unique_ptr<Part>> parts;
+    CollisionWorld world;
+    const int side = int(std::ceil(std::sqrt(double(count))));
+    for (int i = 0; i < count; ++i) {
+        parts.push_back(std::make_unique<Part>(boxModel, rigid));
+        parts.back()->translate(Vec3(i % side, 0.0, i / side));
+        world.add(BodyId(i), *parts.back(), BoundingVolumeKind::Aabb, mobility);
+    }
+    parts.push_back(std::make_unique<Part>(buildPartModel(makeIcoSphere(0.3, 2)), rigid));
+    Part& ball = *parts.back();
+    world.add(BodyId(count), ball);
+    auto placeBall = [&](double t) {
+        ball.setPose(Pose{Eigen::Quaterniond::Identity(), Vec3(0.5 * side + 0.3 * std::sin(t), 0.35, 0.5 * side + 0.3 * std::cos(t))});
+    };
+    double t = 0.0;
+    for (auto _ : state) {
+        placeBall(t += 0.001);
+        world.update();
+        benchmark::DoNotOptimize(world.narrowPhase().size());
+    }
+    placeBall(0.5);  // the counters at one pose, the same for both mobilities
+    world.update();
+    const std::size_t contacts = world.narrowPhase().size(), pairs = world.candidatePairs().size();
+    state.SetLabel(fmt::format("ball over {} static boxes / {}", count, mobility == Mobility::Fixed ? "fixed" : "moving"));
+    state.counters["contacts"] = double(contacts);
+    state.counters["pairs"] = double(pairs);
+}
+
 BENCHMARK(BM_FlexfitQuery)->ArgsProduct({{0, 1, 2, 3}, {0, 1}, {1, 4}});
+BENCHMARK(BM_BallOverStaticParts)->ArgsProduct({{100, 500, 2000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FclObbrssQuery)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 BENCHMARK(BM_FlexfitRefitLocal)->Arg(0)->Arg(1);
 BENCHMARK(BM_FclAabbRefit);

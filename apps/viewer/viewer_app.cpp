@@ -281,13 +281,14 @@ std::vector<LineVertex> App::overlayLines() const {
                         addCircle(lines, c, pose.rotate(Vec3::UnitY()), pose.rotate(Vec3::UnitZ()), node.volume.radius, Vec3(0.3, 0.85, 0.95));
                     }
         }
-    if (overlays.partSpheres)  // the broad phase's hierarchy: part spheres (white), their groups (grey)
-        for (const auto& node : w.collision().broadPhaseTree().nodes()) {
-            const Vec3 colour = node.isLeaf() ? Vec3(0.9, 0.9, 0.9) : Vec3(0.55, 0.55, 0.6);
-            addCircle(lines, node.volume.centre, Vec3::UnitX(), Vec3::UnitY(), node.volume.radius, colour);
-            addCircle(lines, node.volume.centre, Vec3::UnitY(), Vec3::UnitZ(), node.volume.radius, colour);
-            addCircle(lines, node.volume.centre, Vec3::UnitZ(), Vec3::UnitX(), node.volume.radius, colour);
-        }
+    if (overlays.partSpheres)  // the broad phase's hierarchies (moving and fixed parts): part spheres (white), their groups (grey)
+        for (const Bvh<Sphere>* tree : {&w.collision().broadPhaseTree(), &w.collision().fixedBroadPhaseTree()})
+            for (const auto& node : tree->nodes()) {
+                const Vec3 colour = node.isLeaf() ? Vec3(0.9, 0.9, 0.9) : Vec3(0.55, 0.55, 0.6);
+                addCircle(lines, node.volume.centre, Vec3::UnitX(), Vec3::UnitY(), node.volume.radius, colour);
+                addCircle(lines, node.volume.centre, Vec3::UnitY(), Vec3::UnitZ(), node.volume.radius, colour);
+                addCircle(lines, node.volume.centre, Vec3::UnitZ(), Vec3::UnitX(), node.volume.radius, colour);
+            }
     if (overlays.contacts)
         for (const Contact& c : w.contacts()) addSegment(lines, c.point, c.point + scale * c.normal, Vec3(1.0, 0.2, 0.9));
     if (overlays.assembly)

@@ -5,8 +5,9 @@
 //
 // Broad phase (thesis 4.3): a hierarchy of the parts' bounding spheres in the world, built
 // top-down like the face hierarchies; each part's sphere is tested against it depth-first and
-// gives candidate pairs. Parts move every step: the tree is rebuilt by default, or refitted
-// bottom-up (BroadPhaseUpdate::Refit, O(parts)). Measured with 200 moving parts (bench/results/
+// gives candidate pairs. Moving parts' tree is rebuilt every update by default, or refitted
+// bottom-up (BroadPhaseUpdate::Refit, O(moving parts)); fixed parts (Mobility) have a tree of
+// their own, built when that set changes. Measured with 200 moving parts (bench/results/
 // collision.csv): rebuild 105.6 us, refit 116.5 us per update, because merged spheres are looser
 // than the top-down enclosure and the queries then visit more nodes.
 //
@@ -63,6 +64,14 @@ inline constexpr EnumName<RigidDeformableQuery> kRigidDeformableQueryNames[] = {
 };
 template <> inline constexpr std::span<const EnumName<RigidDeformableQuery>> kEnumNames<RigidDeformableQuery> = kRigidDeformableQueryNames;
 
+// How a body takes part in the broad phase. Fixed: its part neither moves nor deforms (a
+// static rigid body; the caller keeps it so). Its sphere is computed once, it sits in a tree of
+// the fixed bodies built when that set changes, and two fixed bodies are never a candidate pair
+// (neither could respond to a contact), so a world of many fixed parts costs each update
+// O(moving parts x log(fixed parts)), not a rebuild over every part. The world fixes its
+// static rigid bodies, except an assembly's primary (a snap moves it).
+enum class Mobility { Moving, Fixed };
+
 struct CollisionSettings {
     ExactTest exactTest = ExactTest::TriangleTriangle;
     BroadPhaseUpdate broadPhase = BroadPhaseUpdate::Rebuild;
@@ -80,8 +89,11 @@ public:
 
     // Registers body `id` with a read-only view of its part, which must outlive the collision
     // world. Ids come in order, 0, 1, 2, ... (the world's body ids); throws
-    // std::invalid_argument otherwise.
-    void add(BodyId id, const Part& part, BoundingVolumeKind kind = BoundingVolumeKind::Aabb);
+    // std::invalid_argument otherwise, or for a Fixed part that deforms.
+    void add(BodyId id, const Part& part, BoundingVolumeKind kind = BoundingVolumeKind::Aabb, Mobility mobility = Mobility::Moving);
+    // A fixed body becomes a moving one from the next update on (its part is about to move).
+    void setMoving(BodyId id);
+    bool fixed(BodyId id) const { return fixed_[id]; }
     std::size_t bodyCount() const { return parts_.size(); }
     // The body's collider as of its last refit. Reading it changes nothing.
     const PartCollider& collider(BodyId id) const { return colliders_[id]; }
@@ -90,16 +102,18 @@ public:
     void setExactTest(ExactTest test);
 
     // --- Broad phase (broad_phase.cpp) ---
-    // Updates every body's bounding sphere, then the broad-phase tree and its pairs.
+    // Updates every moving body's bounding sphere, then the broad-phase trees and their pairs.
     void update();
-    // Updates every body's bounding sphere (the first half of update()), or one body's.
+    // Updates every moving body's bounding sphere (the first half of update()), or one body's.
     void updateBounds();
     void updateBound(BodyId id);
     // Broad-phase candidate pairs (a < b), from the last update.
     const std::vector<std::pair<BodyId, BodyId>>& candidatePairs() const { return pairs_; }
-    // The broad phase's hierarchy of part spheres (world frame), as of the last update (parts
-    // added since are in it from the next update on).
+    // The broad phase's hierarchies of part spheres (world frame), as of the last update (parts
+    // added since are in them from the next update on): the moving bodies' and the fixed
+    // bodies'. A leaf's item is the body's place among the moving or the fixed bodies, in id order.
     const Bvh<Sphere>& broadPhaseTree() const { return broadPhase_; }
+    const Bvh<Sphere>& fixedBroadPhaseTree() const { return fixedTree_; }
 
     // --- Narrow phase (narrow_phase.cpp) ---
     // Contacts already found at the current poses: contactsOf(body, true)'s answer. The narrow
@@ -171,8 +185,19 @@ private:
     std::vector<bool> fieldTried_;        // (nbody) a field was built, or the mesh has no inside
     std::vector<Sphere> partSpheres_;                                 // (nbody) world frame
     std::vector<BodyId> rigidParts_, deformingParts_;                 // the bodies of each kind, in order (add() pairs only across them)
-    Bvh<Sphere> broadPhase_;
+    std::vector<bool> fixed_;                                         // (nbody) Mobility::Fixed
+    std::vector<BodyId> movingIds_, fixedIds_;                        // the bodies of each mobility, in order (room for every body)
+    std::vector<Sphere> treeSpheres_;                                 // scratch: the spheres a tree is built over
+    std::vector<BodyId> partners_;                                    // scratch: contactsOf's bodies in reach
+    Bvh<Sphere> fixedTree_;
+    bool fixedTreeBuilt_ = false;
+    Bvh<Sphere> broadPhase_;        // the moving bodies' spheres
     bool broadPhaseBuilt_ = false;  // for the parts added so far (add() leaves it to the next update: adding n parts builds it once)
+    // The items of the leaves of `tree` whose spheres overlap `sphere`, depth-first, into
+    // `items` (cleared first).
+    void overlappingLeaves(const Bvh<Sphere>& tree, const Sphere& sphere, std::vector<Index>& items);
+    std::vector<Index> leafItems_;  // scratch of overlappingLeaves' callers
+    void buildFixedTree();
     std::vector<std::pair<BodyId, BodyId>> pairs_;
     std::vector<Contact> contacts_;
     std::vector<Contact> bodyContacts_;  // contactsOf()

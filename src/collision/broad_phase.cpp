@@ -12,7 +12,7 @@ void CollisionWorld::updateBound(BodyId id) {
 }
 
 void CollisionWorld::updateBounds() {
-    for (BodyId i = 0; i < parts_.size(); ++i) updateBound(i);
+    for (const BodyId i : movingIds_) updateBound(i);  // a fixed body's sphere is its sphere at add()
 }
 
 void CollisionWorld::update() {
@@ -20,30 +20,52 @@ void CollisionWorld::update() {
     dropStaleCoherence();
 }
 
+void CollisionWorld::overlappingLeaves(const Bvh<Sphere>& tree, const Sphere& sphere, std::vector<Index>& items) {
+    items.clear();
+    const RelativePose identity;
+    const auto& nodes = tree.nodes();
+    if (nodes.empty()) return;
+    stack_.assign(1, 0);
+    while (!stack_.empty()) {
+        const auto& node = nodes[std::size_t(stack_.back())];
+        stack_.pop_back();
+        if (!overlap(sphere, node.volume, identity)) continue;
+        if (!node.isLeaf()) {
+            stack_.push_back(node.right);
+            stack_.push_back(node.left);
+        } else {
+            items.push_back(node.item);
+        }
+    }
+}
+
+void CollisionWorld::buildFixedTree() {
+    treeSpheres_.clear();
+    for (const BodyId f : fixedIds_) treeSpheres_.push_back(partSpheres_[f]);
+    fixedTree_.build(treeSpheres_);
+    fixedTreeBuilt_ = true;
+}
+
 void CollisionWorld::updatePairs() {
     updateBounds();
+    if (!fixedTreeBuilt_) buildFixedTree();
     if (settings_.broadPhase == BroadPhaseUpdate::Rebuild || !broadPhaseBuilt_) {
-        broadPhase_.build(partSpheres_);
+        treeSpheres_.clear();
+        for (const BodyId i : movingIds_) treeSpheres_.push_back(partSpheres_[i]);
+        broadPhase_.build(treeSpheres_);
         broadPhaseBuilt_ = true;
-    } else
-        broadPhase_.refitAll([&](Index i) { return partSpheres_[i]; });
-    // Each body's sphere against the tree, depth-first.
+    } else {
+        broadPhase_.refitAll([&](Index k) { return partSpheres_[movingIds_[k]]; });
+    }
+    // Each moving body's sphere against the moving tree (its later partners) and the fixed tree.
     pairs_.clear();
-    const RelativePose identity;
-    const auto& nodes = broadPhase_.nodes();
-    for (BodyId i = 0; i < partSpheres_.size(); ++i) {
-        stack_.assign(1, 0);
-        while (!stack_.empty()) {
-            const auto& node = nodes[std::size_t(stack_.back())];
-            stack_.pop_back();
-            if (!overlap(partSpheres_[i], node.volume, identity)) continue;
-            if (!node.isLeaf()) {
-                stack_.push_back(node.right);
-                stack_.push_back(node.left);
-            } else if (node.item > i) {
-                pairs_.emplace_back(i, node.item);
-            }
-        }
+    for (std::size_t k = 0; k < movingIds_.size(); ++k) {
+        const BodyId i = movingIds_[k];
+        overlappingLeaves(broadPhase_, partSpheres_[i], leafItems_);
+        for (const Index item : leafItems_)
+            if (item > k) pairs_.emplace_back(i, movingIds_[item]);
+        overlappingLeaves(fixedTree_, partSpheres_[i], leafItems_);
+        for (const Index item : leafItems_) pairs_.emplace_back(std::min(i, fixedIds_[item]), std::max(i, fixedIds_[item]));
     }
     std::sort(pairs_.begin(), pairs_.end());
 }

@@ -37,10 +37,12 @@ double meanRestEdge(const Part& part) {
 
 }  // namespace
 
-void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
+void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind, Mobility mobility) {
     if (id != parts_.size())
         throw std::invalid_argument("CollisionWorld::add: body " + std::to_string(id) + " out of order (expected " +
                                     std::to_string(parts_.size()) + ")");
+    const bool isFixed = mobility == Mobility::Fixed;
+    if (isFixed && part.deforms()) throw std::invalid_argument("CollisionWorld::add: body " + std::to_string(id) + " deforms: it cannot be fixed");
     // Everything is built before anything is registered: a failure (out of memory) leaves the
     // collision world as it was. Fields, sharp features and rest-point trees are built now
     // rather than at the first contact, where they would stall a haptic loop.
@@ -99,6 +101,9 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     detail::reserveGrowing(features_, n);
     detail::reserveGrowing(fieldTried_, n);
     detail::reserveGrowing(partSpheres_, n);
+    detail::reserveGrowing(fixed_, n);
+    detail::reserveGrowing(movingIds_, n);  // room for every body: setMoving never allocates
+    detail::reserveGrowing(fixedIds_, n);
     detail::reserveGrowing(part.deforms() ? deformingParts_ : rigidParts_, (part.deforms() ? deformingParts_ : rigidParts_).size() + 1);
     const Sphere sphere = collider.worldSphere(part);
     refitted_.growTo(n);
@@ -112,12 +117,23 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind) {
     features_.push_back(std::move(added.features));
     partSpheres_.push_back(sphere);
     (part.deforms() ? deformingParts_ : rigidParts_).push_back(BodyId(self));
+    fixed_.push_back(isFixed);
+    (isFixed ? fixedIds_ : movingIds_).push_back(BodyId(self));
+    (isFixed ? fixedTreeBuilt_ : broadPhaseBuilt_) = false;
     for (Served& s : served) {
         fields_[s.part] = std::move(s.field);
         fieldTried_[s.part] = s.tried;
         features_[s.part] = std::move(s.features);
     }
-    broadPhaseBuilt_ = false;  // the tree's shape changes with the set of parts: built at the next update, once for any number of adds
+}
+
+void CollisionWorld::setMoving(BodyId id) {
+    if (id >= parts_.size()) throw std::invalid_argument("CollisionWorld::setMoving: no body " + std::to_string(id));
+    if (!fixed_[id]) return;
+    fixed_[id] = false;
+    fixedIds_.erase(std::find(fixedIds_.begin(), fixedIds_.end(), id));
+    movingIds_.insert(std::upper_bound(movingIds_.begin(), movingIds_.end(), id), id);  // within the room add() kept
+    fixedTreeBuilt_ = broadPhaseBuilt_ = false;
 }
 
 void CollisionWorld::setExactTest(ExactTest test) {

@@ -57,14 +57,23 @@ const std::vector<Contact>& CollisionWorld::contactsOf(BodyId id, bool rigidPart
     refitted_.clear();
     bodyContacts_.clear();
     const RelativePose identity;
-    updateBound(id);
+    if (!fixed_[id]) updateBound(id);
     // Other bodies in ascending id: the same pairs, in the same order, as the broad phase gives.
     // Only the bounds this query reads are brought up to date (a deforming part's costs
-    // O(its moving masses)).
-    for (BodyId other = 0; other < parts_.size(); ++other) {
+    // O(its moving masses)); fixed bodies come from their tree (none for a fixed body).
+    partners_.clear();
+    for (const BodyId other : movingIds_) {
         if (other == id || (rigidPartnersOnly && parts_[other]->deforms())) continue;
         updateBound(other);
-        if (!overlap(partSpheres_[id], partSpheres_[other], identity)) continue;
+        if (overlap(partSpheres_[id], partSpheres_[other], identity)) partners_.push_back(other);
+    }
+    if (!fixed_[id]) {
+        if (!fixedTreeBuilt_) buildFixedTree();
+        overlappingLeaves(fixedTree_, partSpheres_[id], leafItems_);
+        for (const Index item : leafItems_) partners_.push_back(fixedIds_[item]);
+    }
+    std::sort(partners_.begin(), partners_.end());
+    for (const BodyId other : partners_) {
         BodyId a = std::min(id, other), b = std::max(id, other);
         if (!pressesFirst(a, b)) std::swap(a, b);
         QueryStats ignored;

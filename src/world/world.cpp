@@ -65,7 +65,10 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
     const BodyId id = BodyId(d.bodies.size());
     d.bodies.reserve(id + 1);
     detail::reserveGrowing(d.response.stiffness, id + 1u);
-    d.collision.add(id, *part, settings.boundingVolume);  // strong: registers all or nothing
+    // A static rigid body never moves nor deforms (an assembly's primary is made moving when
+    // its rule is added): fixed in the broad phase.
+    const Mobility mobility = settings.motion == MotionType::Static && !part->deforms() ? Mobility::Fixed : Mobility::Moving;
+    d.collision.add(id, *part, settings.boundingVolume, mobility);  // strong: registers all or nothing
     d.bodies.add(std::move(part), body);                   // no throw after the reserve
     d.response.stiffness.push_back(stiffness);
     noteDefaultFraction(d, id, partSettings);
@@ -198,7 +201,11 @@ void World::applyFaceForce(BodyId id, Index face, const Vec3& worldForce) {
 
 // --- Assembly ---
 
-std::size_t World::addAssembly(const AssemblyRule& rule) { return detail::addRule(rule, data_->bodies.size(), data_->assembly); }
+std::size_t World::addAssembly(const AssemblyRule& rule) {
+    const std::size_t index = detail::addRule(rule, data_->bodies.size(), data_->assembly);
+    data_->collision.setMoving(rule.primary);  // a snap will move it, static or not
+    return index;
+}
 std::size_t World::assemblyCount() const { return data_->assembly.rules.size(); }
 const std::vector<AssemblyEvent>& World::assemblyEvents() const { return data_->assembly.events; }
 bool World::assembled(std::size_t rule) const {

@@ -118,3 +118,85 @@ TEST(BroadPhase, TheDisplacementBoundIsTheLargestMoveWhereverItLies) {
         EXPECT_EQ(t.world.collider(0).localSphere().radius, t.restRadius + largest) << "largest at " << k << " of " << moving.size();
     }
 }
+
+// Fixed bodies (Mobility::Fixed: static rigid parts) sit in a tree of their own and are never
+// paired with each other: the pairs are brute force's minus those of two fixed bodies, with
+// either update, and a fixed body made moving is paired with the fixed ones from the next
+// update on. contactsOf gives a body the narrow phase's contacts in the same order.
+TEST(BroadPhase, FixedBodiesArePairedOnlyWithMovingOnes) {
+    std::mt19937 rng(21);
+    std::uniform_real_distribution<double> u(-8, 8);
+    const auto model = buildPartModel(makeIcoSphere(2.0, 1));
+    PartSettings rigid;
+    rigid.mode = PartMode::Rigid;
+    std::vector<std::unique_ptr<Part>> parts;
+    std::vector<bool> fixed;
+    CollisionWorld refit(CollisionSettings{ExactTest::TriangleTriangle, BroadPhaseUpdate::Refit}),
+        rebuild(CollisionSettings{ExactTest::TriangleTriangle, BroadPhaseUpdate::Rebuild});
+    for (BodyId i = 0; i < 40; ++i) {
+        parts.push_back(std::make_unique<Part>(model, rigid));
+        parts.back()->translate(Vec3(u(rng), u(rng), u(rng)));
+        fixed.push_back(i % 3 != 0);  // two in three fixed, ids interleaved
+        const Mobility mobility = fixed.back() ? Mobility::Fixed : Mobility::Moving;
+        refit.add(i, *parts.back(), BoundingVolumeKind::Aabb, mobility);
+        rebuild.add(i, *parts.back(), BoundingVolumeKind::Aabb, mobility);
+    }
+    using PairSet = std::set<std::pair<BodyId, BodyId>>;
+    auto expectedPairs = [&] {
+        PairSet expected;
+        for (BodyId i = 0; i < parts.size(); ++i)
+            for (BodyId j = i + 1; j < parts.size(); ++j) {
+                const Sphere a = refit.collider(i).worldSphere(*parts[i]), b = refit.collider(j).worldSphere(*parts[j]);
+                if ((a.centre - b.centre).norm() <= a.radius + b.radius && !(fixed[i] && fixed[j])) expected.insert({i, j});
+            }
+        return expected;
+    };
+    std::size_t fixedPairsSkipped = 0;
+    for (int round = 0; round < 6; ++round) {
+        for (BodyId i = 0; i < parts.size(); ++i)
+            if (!fixed[i]) parts[i]->translate(Vec3(u(rng), u(rng), u(rng)) * 0.3);
+        if (round == 3) {  // body 1 (fixed) starts to move
+            refit.setMoving(1);
+            rebuild.setMoving(1);
+            fixed[1] = false;
+            EXPECT_FALSE(refit.fixed(1));
+        }
+        refit.update();
+        rebuild.update();
+        const PairSet expected = expectedPairs();
+        const auto& got = refit.candidatePairs();
+        EXPECT_EQ(PairSet(got.begin(), got.end()), expected) << "round " << round;
+        EXPECT_EQ(refit.candidatePairs(), rebuild.candidatePairs());
+        EXPECT_TRUE(std::is_sorted(got.begin(), got.end()));
+        for (BodyId i = 0; i < parts.size(); ++i)
+            for (BodyId j = i + 1; j < parts.size(); ++j) {
+                const Sphere a = refit.collider(i).worldSphere(*parts[i]), b = refit.collider(j).worldSphere(*parts[j]);
+                fixedPairsSkipped += fixed[i] && fixed[j] && (a.centre - b.centre).norm() <= a.radius + b.radius;
+            }
+        // Each moving body's contactsOf: the narrow phase's contacts of its pairs, in order.
+        const std::vector<Contact> all = rebuild.narrowPhase();
+        for (BodyId i = 0; i < parts.size(); ++i) {
+            if (fixed[i]) continue;
+            std::vector<Contact> expectedContacts;
+            for (const Contact& c : all)
+                if (c.partA == i || c.partB == i) expectedContacts.push_back(c);
+            const std::vector<Contact> own = rebuild.contactsOf(i);
+            ASSERT_EQ(own.size(), expectedContacts.size()) << "body " << i;
+            for (std::size_t c = 0; c < own.size(); ++c) {
+                EXPECT_EQ(own[c].partA, expectedContacts[c].partA);
+                EXPECT_EQ(own[c].faceB, expectedContacts[c].faceB);
+                EXPECT_EQ(own[c].depth, expectedContacts[c].depth);
+            }
+        }
+    }
+    EXPECT_GT(fixedPairsSkipped, 0u);  // the random layout does put fixed bodies in reach of each other
+}
+
+TEST(BroadPhase, ADeformingPartCannotBeFixed) {
+    CollisionWorld world;
+    Part soft(buildPartModel(makeIcoSphere(1.0, 1)));  // rigid-deformable
+    EXPECT_THROW(world.add(0, soft, BoundingVolumeKind::Aabb, Mobility::Fixed), std::invalid_argument);
+    EXPECT_EQ(world.bodyCount(), 0u);
+    world.add(0, soft);
+    EXPECT_FALSE(world.fixed(0));
+}

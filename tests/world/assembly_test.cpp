@@ -184,3 +184,30 @@ TEST(Assembly, RulesAreCountedAndARefusedRuleIsNotAdded) {
     EXPECT_EQ(world.assemblyCount(), 1u);
     EXPECT_THROW((void)world.assembled(1), InputError);
 }
+
+// The world fixes static rigid bodies in the broad phase (never paired with each other), but
+// not an assembly's primary: a static primary touching a static secondary still snaps by
+// collision, as before fixed bodies existed.
+TEST(Assembly, AStaticPrimaryTouchingAStaticSecondaryStillSnapsByCollision) {
+    World world(WorldSettings{1e-3, Vec3::Zero(), {}, 0.25, 4096, 4});
+    PartSettings rigid;
+    rigid.mode = PartMode::Rigid;
+    BodySettings fixedBody;
+    fixedBody.motion = MotionType::Static;
+    const auto ball = buildPartModel(makeIcoSphere(1.0, 2));
+    const BodyId secondary = world.add(ball, rigid, fixedBody, Pose{});
+    const BodyId primary = world.add(ball, rigid, fixedBody, at(Vec3(1.9, 0, 0)));  // overlapping by 0.1
+    const BodyId bystander = world.add(ball, rigid, fixedBody, at(Vec3(-1.9, 0, 0)));
+    EXPECT_TRUE(world.collision().fixed(primary));
+    AssemblyRule r = rule(SnapTechnique::CollisionSnap);
+    r.primary = primary;
+    r.secondary = secondary;
+    world.addAssembly(r);
+    EXPECT_FALSE(world.collision().fixed(primary));
+    EXPECT_TRUE(world.collision().fixed(bystander));
+    world.step();
+    ASSERT_EQ(world.assemblyEvents().size(), 1u);
+    EXPECT_EQ(world.assemblyEvents()[0].rule, r.name);
+    // The two fixed bodies that touch (secondary and bystander) make no contact.
+    for (const Contact& c : world.contacts()) EXPECT_FALSE((c.partA == secondary && c.partB == bystander) || (c.partA == bystander && c.partB == secondary));
+}
