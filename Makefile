@@ -59,7 +59,7 @@ BENCH_FLAGS := --benchmark_repetitions=12 --benchmark_enable_random_interleaving
 	--benchmark_report_aggregates_only=true --benchmark_min_time=0.2 \
 	--benchmark_out_format=csv
 bench: release
-	@scripts/install-deps.sh --bench
+	@scripts/install-deps.sh
 	@cmake --build --preset release --target benchmarks -j $(JOBS)
 	build/release/bench/bench_msd_step $(BENCH_FLAGS) --benchmark_out=bench/results/msd_step.csv
 	/usr/bin/python3 tools/bench_ratios.py bench/results/msd_step.csv --prefixes BM_FlexfitFullStep BM_NaiveFullStep

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian packages Flexfit needs to build, test and run its demo (with --bench, also
-# what the benchmarks read: third-party meshes).
+# Installs the Debian packages Flexfit needs to build, test and run its demo, third-party
+# meshes the tests read included.
 # Idempotent and quiet: when every package is present it prints nothing and exits 0.
 set -euo pipefail
 
@@ -26,10 +26,8 @@ packages=(
   libgl1-mesa-dri                      # viewer: Mesa software rendering (llvmpipe)
   libpng-dev                           # viewer: PNG screenshots
   xvfb xauth                           # viewer tests: a virtual X server
+  assimp-testmodels                    # third-party meshes: the tests read them (Wuson, damaged files), the benchmarks press tools into them
 )
-if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(assimp-testmodels)        # third-party meshes the benchmarks press tools into
-fi
 
 missing=()
 for p in "${packages[@]}"; do
