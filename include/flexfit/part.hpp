@@ -101,6 +101,9 @@ namespace detail {
 // compute from a diverging body is reported by the world's divergence check, which names the
 // body and the likely cause.
 void setPoseUnchecked(Part& part, const Pose& pose);
+// Part::displaceMasses without its finiteness check, for the world's contact response (the
+// same reason).
+void displaceMassesUnchecked(Part& part, std::span<const Index> masses, std::span<const Vec3> worldDisplacements);
 }  // namespace detail
 
 class Part {
@@ -172,6 +175,7 @@ public:
     void touchFace(Index face);
     // Moves a moving mass by a world-frame displacement and removes the part of its velocity
     // that points against it (the contact is inelastic). Ignored for masses that do not move.
+    // InputError for a displacement that is not finite (displaceMasses: for any, before any moves).
     void displaceMass(Index mass, const Vec3& worldDisplacement);
     // displaceMass for each (masses[i], worldDisplacements[i]), in order: the same bits, 4 distinct
     // moving masses at a time on CPUs with AVX2 (internal lanes256.hpp). The spans must have the
@@ -228,6 +232,9 @@ public:
 
 private:
     friend void detail::setPoseUnchecked(Part& part, const Pose& pose);
+    friend void detail::displaceMassesUnchecked(Part& part, std::span<const Index> masses, std::span<const Vec3> worldDisplacements);
+    void applyDisplacement(Index mass, const Vec3& worldDisplacement);  // displaceMass, unchecked
+    void applyDisplacements(std::span<const Index> masses, std::span<const Vec3> worldDisplacements);
     // Part-frame points to the world, in place.
     void toWorld(std::vector<Vec3>& points) const;
     struct Zone;  // its seeds, level and members (part.cpp)

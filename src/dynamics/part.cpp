@@ -401,6 +401,10 @@ void Part::touchFace(Index face) {
 
 void Part::displaceMass(Index mass, const Vec3& worldDisplacement) {
     if (!worldDisplacement.allFinite()) throw InputError(kPartSource, 0, "displaceMass: the displacement must be finite");
+    applyDisplacement(mass, worldDisplacement);
+}
+
+void Part::applyDisplacement(Index mass, const Vec3& worldDisplacement) {
     if (!displaces(mass)) return;
     const Vec3 d = pose_.rotateInverse(worldDisplacement);
     state_.positions[mass] += d;
@@ -442,9 +446,20 @@ FLEXFIT_AVX2_LANES void displaceFour(const Eigen::Quaterniond& rotation, const I
 #endif
 
 void Part::displaceMasses(std::span<const Index> masses, std::span<const Vec3> worldDisplacements) {
+    for (std::size_t i = 0; i < worldDisplacements.size(); ++i)
+        if (!worldDisplacements[i].allFinite())
+            throw InputError(kPartSource, 0, "displaceMasses: displacement " + std::to_string(i) + " is not finite");
+    detail::displaceMassesUnchecked(*this, masses, worldDisplacements);
+}
+
+void detail::displaceMassesUnchecked(Part& part, std::span<const Index> masses, std::span<const Vec3> worldDisplacements) {
     if (masses.size() != worldDisplacements.size())
         throw InputError(kPartSource, 0, "displaceMasses: " + std::to_string(masses.size()) + " masses but " +
                                              std::to_string(worldDisplacements.size()) + " displacements");
+    part.applyDisplacements(masses, worldDisplacements);
+}
+
+void Part::applyDisplacements(std::span<const Index> masses, std::span<const Vec3> worldDisplacements) {
     std::size_t i = 0;
 #if defined(FLEXFIT_LANES256)
     if (detail::lanesEnabled())
@@ -453,14 +468,14 @@ void Part::displaceMasses(std::span<const Index> masses, std::span<const Vec3> w
             const bool distinct = four[0] != four[1] && four[0] != four[2] && four[0] != four[3] && four[1] != four[2] &&
                                   four[1] != four[3] && four[2] != four[3];
             if (!(distinct && displaces(four[0]) && displaces(four[1]) && displaces(four[2]) && displaces(four[3]))) {
-                for (int j = 0; j < 4; ++j) displaceMass(four[j], worldDisplacements[i + std::size_t(j)]);
+                for (int j = 0; j < 4; ++j) applyDisplacement(four[j], worldDisplacements[i + std::size_t(j)]);
                 continue;
             }
             displaceFour(pose_.rotation, four, &worldDisplacements[i], state_);
             for (int j = 0; j < 4; ++j) markChanged(four[j]);
         }
 #endif
-    for (; i < masses.size(); ++i) displaceMass(masses[i], worldDisplacements[i]);
+    for (; i < masses.size(); ++i) applyDisplacement(masses[i], worldDisplacements[i]);
 }
 
 bool Part::zoneAtRest(const Zone& zone) const {

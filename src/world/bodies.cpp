@@ -62,7 +62,10 @@ BodyId Bodies::add(std::unique_ptr<Part> part, const RigidBody& body) {
     parts.push_back(std::move(part));
     rigid.push_back(body);
     kinematicTargets.emplace_back();
-    if (body.thickness > 0.0) thinnest_ = std::min(thinnest_, body.thickness);
+    if (body.thickness > 0.0 && body.thickness < thinnest_) {
+        thinnest_ = body.thickness;
+        thinnestBody_ = BodyId(parts.size() - 1);
+    }
     ++poseEpoch;
     return BodyId(parts.size() - 1);
 }

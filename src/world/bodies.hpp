@@ -40,9 +40,12 @@ struct Bodies {
     // cannot cross them unseen. Infinity when every part is flat. Kept by add(): thicknesses
     // are fixed when a body is added.
     double minimumThickness() const { return thinnest_; }
+    // The body of that thickness (the first added of it), when any is not flat.
+    std::optional<BodyId> thinnestBody() const { return thinnestBody_; }
 
 private:
     double thinnest_ = std::numeric_limits<double>::infinity();
+    std::optional<BodyId> thinnestBody_;
 };
 
 // The rotation as axis and angle in (-pi, pi]: the short way round.

@@ -79,7 +79,7 @@ void displacePushedMasses(Bodies& bodies, ContactResponse& r) {
     for (std::size_t begin = 0, end = 0; begin < masses.size(); begin = end) {
         const BodyId body = r.pushBodies[begin];
         for (end = begin + 1; end < masses.size() && r.pushBodies[end] == body;) ++end;
-        bodies.parts[body]->displaceMasses(masses.subspan(begin, end - begin), displacements.subspan(begin, end - begin));
+        detail::displaceMassesUnchecked(*bodies.parts[body], masses.subspan(begin, end - begin), displacements.subspan(begin, end - begin));
     }
 }
 

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <sstream>
 #include <string>
 
 namespace flexfit::detail {
@@ -177,9 +179,13 @@ bool settleMove(BodyId id, double dt, double slop, double bound, const StepConte
             throw DivergenceError(id, step.time, "its velocity or angular velocity is no longer finite (speed " +
                                                      std::to_string(body.linearVelocity.norm()) + ", angular speed " +
                                                      std::to_string(body.angularVelocity.norm()) + " rad/s)" + cause);
-        throw DivergenceError(id, step.time,
-                              "moves " + std::to_string(travel) + " units in one step, more than " + std::to_string(int(kMaxPieces)) +
-                                  " travel bounds of " + std::to_string(bound) + " per sub-step" + cause);
+        // The bound is the world's, from the thinnest body: a thin body elsewhere can be the cause.
+        std::ostringstream text;
+        text << "moves " << travel << " units in one step, more than " << int(kMaxPieces) << " travel bounds of " << bound
+             << " per sub-step (the max travel fraction of the thinnest body's thickness, " << bodies.minimumThickness();
+        if (const std::optional<BodyId> thin = bodies.thinnestBody()) text << ": body " << *thin;
+        text << ")" << cause << ", or a body thinner than the others need";
+        throw DivergenceError(id, step.time, text.str());
     }
     const Pose start = s.subStart[id];
     s.cachedBody.reset();

@@ -770,6 +770,12 @@ TEST(Part, BadArgumentsAreErrorsAndLeaveThePartAsItWas) {
     part.openZone(ZoneSeed::mass(0), 1);
     EXPECT_THROW(part.displaceMass(0, Vec3(nan, 0, 0)), InputError);
     EXPECT_TRUE(part.state().positions[0].allFinite());
+    // displaceMasses checks every displacement before it moves any mass.
+    const std::vector<Index> masses{0, 0, 0, 0, 0};
+    const std::vector<Vec3> moves{Vec3(0.01, 0, 0), Vec3(0.01, 0, 0), Vec3(0.01, 0, 0), Vec3(0.01, 0, 0), Vec3(0, inf, 0)};
+    const Vec3 before = part.state().positions[0];
+    EXPECT_THROW(part.displaceMasses(masses, moves), InputError);
+    EXPECT_EQ(part.state().positions[0], before);
     part.displaceMass(0, Vec3(0.01, 0, 0));
     EXPECT_NE(part.state().positions[0], model->restPositions[0]);
 }

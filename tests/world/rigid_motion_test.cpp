@@ -283,3 +283,26 @@ TEST(RigidMotion, AStackSteppedInStepsLongerThanItsGapsComesToRest) {
         top = world.centreOfMass(box).y() + halves[box - 1];
     }
 }
+
+// The no-tunnelling bound is the world's, from its thinnest body: a body far away declared
+// 1e-12 thick holds every sub-step of a falling ball to 1e-12 / 4, and the ball's step then
+// fails. The error names the thin body and its thickness (it named only the ball, with a
+// bound printed as 0.000000).
+TEST(RigidMotion, ABoundTooSmallToFollowNamesTheThinnestBody) {
+    WorldSettings settings;
+    settings.gravity = Vec3(0, -9.81, 0);
+    World world(settings);
+    const auto ball = buildPartModel(makeIcoSphere(1.0, 1));
+    world.add(ball, rigidPart(), dynamicBody(Vec3(0, -5, 0)), at(Vec3(0, 5, 0)));
+    BodySettings thin;
+    thin.motion = MotionType::Static;
+    thin.thickness = 1e-12;
+    world.add(ball, rigidPart(), thin, at(Vec3(100, 0, 0)));
+    try {
+        for (int i = 0; i < 10; ++i) world.step();
+        ADD_FAILURE() << "the ball followed a bound of 1e-12";
+    } catch (const DivergenceError& e) {
+        const std::string text = e.what();
+        EXPECT_NE(text.find("thinnest body's thickness, 1e-12: body 1"), std::string::npos) << text;
+    }
+}
