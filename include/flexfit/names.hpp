@@ -50,6 +50,14 @@ constexpr std::span<const DeprecatedName<Enum>> deprecatedNames() {
     return kDeprecatedNames<Enum>;
 }
 
+// Whether `value` is one of the enum's values (an integer cast to it may be none).
+template <class Enum>
+constexpr bool isNamedValue(Enum value) {
+    for (const EnumName<Enum>& e : enumNames<Enum>())
+        if (e.value == value) return true;
+    return false;
+}
+
 template <class Enum>
 const EnumName<Enum>& entryOf(Enum value) {
     for (const EnumName<Enum>& e : enumNames<Enum>())
@@ -105,6 +113,14 @@ std::vector<std::string> allNames(bool withDeprecated = false) {
     if (withDeprecated)
         for (const DeprecatedName<Enum>& d : deprecatedNames<Enum>()) out.emplace_back(d.name);
     return out;
+}
+
+// For settings checks: throws Error(source, 0, problem) (InputError, core.hpp) unless
+// isNamedValue(value), naming the integer and the values.
+template <class Error, class Enum>
+void requireNamedValue(Enum value, const std::string& source, const std::string& what) {
+    if (!isNamedValue(value))
+        throw Error(source, 0, what + " " + std::to_string(static_cast<long long>(value)) + " is not one of its values (" + nameList<Enum>() + ")");
 }
 
 // The warning for an old spelling: "'anchor' is deprecated: write 'anchors'".

@@ -6,6 +6,7 @@
 #include "flexfit/collision_world.hpp"
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace flexfit {
@@ -31,7 +32,12 @@ struct WorldSettings {
 inline void validateSettings(const WorldSettings& settings) {
     const std::string source = "world";
     if (!std::isfinite(settings.timeStep) || settings.timeStep <= 0.0) throw InputError(source, 0, "time step must be finite and > 0");
+    if (!(settings.timeStep >= std::numeric_limits<double>::min()))  // h/m and 1/h would overflow
+        throw InputError(source, 0, "time step " + std::to_string(settings.timeStep) + " is below the smallest normal double");
     if (!settings.gravity.allFinite()) throw InputError(source, 0, "gravity must be finite");
+    requireNamedValue<InputError>(settings.collision.exactTest, source, "exact test");
+    requireNamedValue<InputError>(settings.collision.broadPhase, source, "broad-phase update");
+    requireNamedValue<InputError>(settings.collision.rigidDeformable, source, "rigid-deformable query");
     if (!(settings.maxTravelFraction > 0.0 && settings.maxTravelFraction <= 1.0))
         throw InputError(source, 0, "max travel fraction must be in (0, 1]");
     if (settings.maxSubsteps < 1 || settings.contactIterations < 1)

@@ -19,6 +19,8 @@ void validateSettings(const SimulationSettings& s) {
     if (!(s.timeStep >= std::numeric_limits<double>::min()))  // its inverse (h/m, c/h) would overflow
         throw InputError(source, 0, "time step " + std::to_string(s.timeStep) + " is below the smallest normal double");
     if (!s.gravity.allFinite()) throw InputError(source, 0, "gravity must be finite");
+    requireNamedValue<InputError>(s.integrator, source, "integrator");
+    requireNamedValue<InputError>(s.restoration.method, source, "restoration method");
     if (!std::isfinite(s.globalDamping) || s.globalDamping < 0.0)
         throw InputError(source, 0, "global damping must be finite and >= 0");
     const RestorationSettings& r = s.restoration;

@@ -72,6 +72,7 @@ Part::Part(std::shared_ptr<const PartModel> model, const PartSettings& settings)
       region_(*model_),
       lastLoadStep_(model_->massCount(), kNeverLoaded),
       changed_(model_->massCount()) {
+    requireNamedValue<InputError>(settings_.mode, kPartSource, "part mode");
     validateSettings(settings_.simulation);
     checkZoneSettings(settings_.zones);
     if (settings_.mode == PartMode::FullDeformable)  // every mass moves, always: the region is the mesh

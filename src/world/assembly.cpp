@@ -85,6 +85,8 @@ void startSnap(const StepContext& step, const Pose& target, RuleState& state, As
 std::size_t addRule(const AssemblyRule& rule, std::size_t bodyCount, AssemblyState& assembly) {
     if (rule.primary >= bodyCount || rule.secondary >= bodyCount || rule.primary == rule.secondary)
         throw InputError("world", 0, "assembly rule '" + rule.name + "' needs two different existing bodies");
+    requireNamedValue<InputError>(rule.technique, "world", "assembly rule '" + rule.name + "': technique");
+    requireNamedValue<InputError>(rule.area.shape, "world", "assembly rule '" + rule.name + "': area shape");
     if (!(rule.snapDuration >= 0.0) || !std::isfinite(rule.snapDuration))
         throw InputError("world", 0, "assembly rule '" + rule.name + "': snap duration must be finite and >= 0");
     for (const AssemblyVector* v : {&rule.primaryVector, &rule.secondaryVector})

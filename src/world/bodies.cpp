@@ -12,6 +12,8 @@
 namespace flexfit {
 RigidBody makeRigidBody(const PartModel& model, const BodySettings& settings) {
     const std::string source = "world";
+    requireNamedValue<InputError>(settings.motion, source, "body motion");
+    requireNamedValue<InputError>(settings.boundingVolume, source, "bounding volume");
     if (!(settings.density > 0.0) || !std::isfinite(settings.density))
         throw InputError(source, 0, "body density must be finite and > 0");
     if (!(settings.thickness >= 0.0) || !std::isfinite(settings.thickness) || !settings.linearVelocity.allFinite() ||

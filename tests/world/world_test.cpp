@@ -361,3 +361,41 @@ TEST(World, WorldsSteppedOnSeveralThreadsAtOnceMatchEachRunAlone) {
     for (std::thread& t : threads) t.join();
     for (int t = 0; t < 4; ++t) EXPECT_EQ(together[t], alone[t % 2]) << "thread " << t;
 }
+
+TEST(World, SettingsWithAnEnumValueThatIsNoneOrASubnormalStepAreRefused) {
+    // An integer cast to an enum (from a binding, a file read by the user's own code) ran as
+    // some value; a subnormal step overflowed h/m. Each is an InputError naming the setting.
+    auto refused = [](auto make, const std::string& words) {
+        try {
+            make();
+            ADD_FAILURE() << "accepted: " << words;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+        }
+    };
+    WorldSettings bad;
+    bad.collision.exactTest = static_cast<ExactTest>(42);
+    refused([&] { World w(bad); }, "exact test 42 is not one of its values");
+    bad = WorldSettings{};
+    bad.timeStep = 1e-320;
+    refused([&] { World w(bad); }, "below the smallest normal double");
+    World world;
+    const auto ball = buildPartModel(makeIcoSphere(1.0, 1));
+    BodySettings body;
+    body.motion = static_cast<MotionType>(9);
+    refused([&] { world.add(ball, rigidPart(), body, Pose{}); }, "body motion 9");
+    PartSettings part = rigidPart();
+    part.mode = static_cast<PartMode>(7);
+    refused([&] { world.add(ball, part, BodySettings{}, Pose{}); }, "part mode 7");
+    part = PartSettings{};
+    part.simulation.integrator = static_cast<Integrator>(42);
+    refused([&] { world.add(ball, part, BodySettings{}, Pose{}); }, "integrator 42");
+    EXPECT_EQ(world.bodyCount(), 0u);
+    world.add(ball, rigidPart(), BodySettings{}, Pose{});
+    world.add(ball, rigidPart(), BodySettings{}, at(Vec3(5, 0, 0)));
+    AssemblyRule rule;
+    rule.primary = 0;
+    rule.secondary = 1;
+    rule.technique = static_cast<SnapTechnique>(12);
+    refused([&] { world.addAssembly(rule); }, "technique 12");
+}
