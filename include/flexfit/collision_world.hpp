@@ -161,6 +161,14 @@ private:
     // Whether the settings let the point shell answer a rigid part against a deformable part,
     // given their mean rest edges (Auto: the deformable part strictly finer).
     bool pointShellServes(double rigidMeanEdge, double deformableMeanEdge) const;
+    // add()'s parts (collision_world.cpp): what a new part changes in the point shell's
+    // service, built before anything is registered; a rigid part's field and features for it;
+    // room in every registry vector for `bodies`.
+    struct ServiceEntry;
+    struct ServiceChange;
+    ServiceChange serviceChange(const Part& part, double meanEdge, double resolution) const;
+    void equip(ServiceEntry& entry, const Part& rigid, bool serves) const;
+    void reserveRegistry(std::size_t bodies, bool deforms);
     // Whether the pair (a presses b) is answered by the point shell.
     bool usesPointShell(BodyId a, BodyId b) const;
     // The point shell's contacts of the pair (a rigid with a field, b deforming), with those of

@@ -34,6 +34,7 @@ struct SurfaceEmbedding {
     std::vector<Vec3> restAnchor;   // (N) anchor(x_rest)
     std::vector<Index> nearestMass; // (N) the face's corner of largest weight (for per-mass data)
     double maxDistance = 0.0;       // farthest drawn vertex from the simulation surface at rest
+    std::size_t simulationVertexCount = 0, simulationFaceCount = 0;  // of the simulation mesh embedded in
 
     std::size_t vertexCount() const { return mesh.vertices.size(); }
 };
@@ -44,6 +45,7 @@ SurfaceEmbedding embedSurface(TriMesh drawn, const TriMesh& simulation, const st
 
 // The drawn mesh's vertices for the simulation mesh's vertex positions x (faces of the
 // simulation mesh, x in any frame in which the rest shape was given): `out` gets N positions.
+// InputError unless x and simulationFaces have the simulation mesh's counts (embedSurface's).
 void embeddedPositions(const SurfaceEmbedding& embedding, std::span<const Face> simulationFaces,
                        std::span<const Vec3> x, std::vector<Vec3>& out);
 

@@ -26,9 +26,14 @@ struct WorldSettings {
     double contactDamping = 1.0;
 };
 
-// Throws InputError (source "world") for a time step that is not finite and positive,
+// The most sub-steps and contact iterations a step may take (a step of 2^31 solver passes never
+// ends); scenes read the same bounds.
+inline constexpr int kMostSubsteps = 1 << 20, kMostContactIterations = 1000;
+
+// Throws InputError (source "world") for a time step that is not finite, positive and normal,
 // non-finite gravity, a travel fraction or contact slop outside (0, 1], sub-steps or
-// iterations below 1, or a negative or non-finite contact damping.
+// iterations outside [1, kMostSubsteps] / [1, kMostContactIterations], a negative or
+// non-finite contact damping, or a collision enum holding none of its values.
 inline void validateSettings(const WorldSettings& settings) {
     const std::string source = "world";
     if (!std::isfinite(settings.timeStep) || settings.timeStep <= 0.0) throw InputError(source, 0, "time step must be finite and > 0");
@@ -40,8 +45,10 @@ inline void validateSettings(const WorldSettings& settings) {
     requireNamedValue<InputError>(settings.collision.rigidDeformable, source, "rigid-deformable query");
     if (!(settings.maxTravelFraction > 0.0 && settings.maxTravelFraction <= 1.0))
         throw InputError(source, 0, "max travel fraction must be in (0, 1]");
-    if (settings.maxSubsteps < 1 || settings.contactIterations < 1)
-        throw InputError(source, 0, "max substeps and contact iterations must be >= 1");
+    if (settings.maxSubsteps < 1 || settings.maxSubsteps > kMostSubsteps || settings.contactIterations < 1 ||
+        settings.contactIterations > kMostContactIterations)
+        throw InputError(source, 0, "max substeps must be in [1, " + std::to_string(kMostSubsteps) + "] and contact iterations in [1, " +
+                                        std::to_string(kMostContactIterations) + "]");
     if (!(settings.contactSlop > 0.0 && settings.contactSlop <= 1.0)) throw InputError(source, 0, "contact slop must be in (0, 1]");
     if (!(settings.contactDamping >= 0.0) || !std::isfinite(settings.contactDamping))
         throw InputError(source, 0, "contact damping must be finite and >= 0");

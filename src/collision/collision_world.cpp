@@ -37,6 +37,72 @@ double meanRestEdge(const Part& part) {
 
 }  // namespace
 
+// What adding a part changes in the point shell's service: the rigid parts it makes the point
+// shell serve (their fields and features), and its own entries.
+struct CollisionWorld::ServiceEntry {
+    std::size_t part = 0;
+    double radius = 0.0;  // the features' scale
+    std::shared_ptr<const SignedDistanceField> field;
+    bool tried = false;
+    std::shared_ptr<const SharpFeatures> features;
+};
+struct CollisionWorld::ServiceChange {
+    std::vector<ServiceEntry> served;  // rigid parts already added
+    ServiceEntry added;                // the new part
+    bool addedServes = false;   // the new part (rigid) serves a deforming part already added
+};
+
+CollisionWorld::ServiceChange CollisionWorld::serviceChange(const Part& part, double meanEdge, double resolution) const {
+    // A rigid part's features are found at the scale of the coarsest deformable part its point
+    // shell may serve: the scale they have, grown to the new part's where it deforms; all of
+    // those it may serve, where it is the rigid one. Only parts of the other kind can change
+    // (O(their count), not O(all parts)).
+    ServiceChange change;
+    const std::size_t self = parts_.size();
+    change.added.part = self;
+    if (settings_.rigidDeformable == RigidDeformableQuery::Faces) return change;
+    for (const BodyId other : part.deforms() ? rigidParts_ : deformingParts_) {
+        if (part.deforms()) {
+            if (pointShellServes(meanEdge_[other], meanEdge))
+                change.served.push_back({other, std::max(features_[other] ? features_[other]->radius : 0.0, resolution), fields_[other],
+                                         fieldTried_[other], features_[other]});
+        } else if (pointShellServes(meanEdge, meanEdge_[other])) {
+            change.addedServes = true;
+            change.added.radius = std::max(change.added.radius, restResolution_[other]);
+        }
+    }
+    for (ServiceEntry& entry : change.served) equip(entry, *parts_[entry.part], true);
+    equip(change.added, part, change.addedServes);
+    return change;
+}
+
+void CollisionWorld::equip(ServiceEntry& entry, const Part& rigid, bool serves) const {
+    // Fields for the rigid parts the point shell may serve (under PointShell all of them), and
+    // their features at the scale they now serve.
+    const RigidDeformableQuery query = settings_.rigidDeformable;
+    if (query == RigidDeformableQuery::Faces || rigid.deforms()) return;
+    if (!entry.tried && (query != RigidDeformableQuery::Auto || serves)) {
+        entry.field = buildDistanceField(rigid);
+        entry.tried = true;
+    }
+    if (entry.field && (!entry.features || entry.features->radius != entry.radius))
+        entry.features = std::make_shared<const SharpFeatures>(findSharpFeatures(rigid, entry.radius, settings_.exactTest));
+}
+
+void CollisionWorld::reserveRegistry(std::size_t bodies, bool deforms) {
+    detail::reserveGrowing(parts_, bodies);
+    detail::reserveGrowing(colliders_, bodies);
+    for (auto* v : {&meanEdge_, &restResolution_}) detail::reserveGrowing(*v, bodies);
+    detail::reserveGrowing(fields_, bodies);
+    detail::reserveGrowing(features_, bodies);
+    for (auto* v : {&fieldTried_, &fixed_}) detail::reserveGrowing(*v, bodies);
+    detail::reserveGrowing(partSpheres_, bodies);
+    for (auto* v : {&movingIds_, &fixedIds_}) detail::reserveGrowing(*v, bodies);  // room for every body: setMoving never allocates
+    std::vector<BodyId>& kind = deforms ? deformingParts_ : rigidParts_;
+    detail::reserveGrowing(kind, kind.size() + 1);
+    refitted_.growTo(bodies);
+}
+
 void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind, Mobility mobility) {
     if (id != parts_.size())
         throw std::invalid_argument("CollisionWorld::add: body " + std::to_string(id) + " out of order (expected " +
@@ -47,83 +113,29 @@ void CollisionWorld::add(BodyId id, const Part& part, BoundingVolumeKind kind, M
     // collision world as it was. Fields, sharp features and rest-point trees are built now
     // rather than at the first contact, where they would stall a haptic loop.
     PartCollider collider(part, kind, settings_.exactTest);
-    const RigidDeformableQuery query = settings_.rigidDeformable;
-    const bool shellable = query != RigidDeformableQuery::Faces && part.deforms();
+    const bool shellable = settings_.rigidDeformable != RigidDeformableQuery::Faces && part.deforms();
     if (shellable) collider.buildRestPointTree(part);
-    // What the new part changes, built before anything is registered: its own entries, and the
-    // parts whose point-shell service it changes. A rigid part's features are found at the scale
-    // of the coarsest deformable part its point shell may serve: the scale they have, grown to
-    // the new part's where it deforms; all of those it may serve, where it is the rigid one.
-    // Only the parts of the other kind can change (O(their count), not O(all parts)).
-    const std::size_t self = parts_.size();
-    const double newMeanEdge = meanRestEdge(part), newResolution = shellable ? restResolution(part) : 0.0;
-    struct Served {
-        std::size_t part;
-        double radius;
-        std::shared_ptr<const SignedDistanceField> field;
-        bool tried;
-        std::shared_ptr<const SharpFeatures> features;
-    };
-    std::vector<Served> served;  // rigid parts the new part makes the point shell serve
-    Served added{self, 0.0, nullptr, false, nullptr};
-    bool addedServes = false;
-    if (query != RigidDeformableQuery::Faces) {
-        for (const BodyId other : part.deforms() ? rigidParts_ : deformingParts_) {
-            const std::size_t r = part.deforms() ? other : self, b = part.deforms() ? self : other;
-            const double rigidEdge = r == self ? newMeanEdge : meanEdge_[r], deformableEdge = b == self ? newMeanEdge : meanEdge_[b];
-            if (!pointShellServes(rigidEdge, deformableEdge)) continue;
-            if (r == self) {
-                addedServes = true;
-                added.radius = std::max(added.radius, restResolution_[b]);
-            } else {
-                served.push_back({r, std::max(features_[r] ? features_[r]->radius : 0.0, newResolution), fields_[r], fieldTried_[r], features_[r]});
-            }
-        }
-    }
-    // Fields for the rigid parts the point shell may serve (under PointShell all of them), and
-    // their features at the scale they now serve.
-    auto equip = [&](Served& s, const Part& rigid, bool serves) {
-        if (query == RigidDeformableQuery::Faces || rigid.deforms()) return;
-        if (!s.tried && (query != RigidDeformableQuery::Auto || serves)) {
-            s.field = buildDistanceField(rigid);
-            s.tried = true;
-        }
-        if (s.field && (!s.features || s.features->radius != s.radius))
-            s.features = std::make_shared<const SharpFeatures>(findSharpFeatures(rigid, s.radius, settings_.exactTest));
-    };
-    for (Served& s : served) equip(s, *parts_[s.part], true);
-    equip(added, part, addedServes);
-    const std::size_t n = self + 1;
-    for (auto* v : {&meanEdge_, &restResolution_}) detail::reserveGrowing(*v, n);
-    detail::reserveGrowing(parts_, n);
-    detail::reserveGrowing(colliders_, n);
-    detail::reserveGrowing(fields_, n);
-    detail::reserveGrowing(features_, n);
-    detail::reserveGrowing(fieldTried_, n);
-    detail::reserveGrowing(partSpheres_, n);
-    detail::reserveGrowing(fixed_, n);
-    detail::reserveGrowing(movingIds_, n);  // room for every body: setMoving never allocates
-    detail::reserveGrowing(fixedIds_, n);
-    detail::reserveGrowing(part.deforms() ? deformingParts_ : rigidParts_, (part.deforms() ? deformingParts_ : rigidParts_).size() + 1);
+    const double meanEdge = meanRestEdge(part), resolution = shellable ? restResolution(part) : 0.0;
+    ServiceChange change = serviceChange(part, meanEdge, resolution);
     const Sphere sphere = collider.worldSphere(part);
-    refitted_.growTo(n);
+    reserveRegistry(parts_.size() + 1, part.deforms());
     // Nothing below throws.
+    (part.deforms() ? deformingParts_ : rigidParts_).push_back(id);
+    (isFixed ? fixedIds_ : movingIds_).push_back(id);
+    (isFixed ? fixedTreeBuilt_ : broadPhaseBuilt_) = false;  // built at the next update, once for any number of adds
     parts_.push_back(&part);
     colliders_.push_back(std::move(collider));
-    meanEdge_.push_back(newMeanEdge);
-    restResolution_.push_back(newResolution);
-    fields_.push_back(std::move(added.field));
-    fieldTried_.push_back(added.tried);
-    features_.push_back(std::move(added.features));
-    partSpheres_.push_back(sphere);
-    (part.deforms() ? deformingParts_ : rigidParts_).push_back(BodyId(self));
+    meanEdge_.push_back(meanEdge);
+    restResolution_.push_back(resolution);
+    fields_.push_back(std::move(change.added.field));
+    fieldTried_.push_back(change.added.tried);
+    features_.push_back(std::move(change.added.features));
     fixed_.push_back(isFixed);
-    (isFixed ? fixedIds_ : movingIds_).push_back(BodyId(self));
-    (isFixed ? fixedTreeBuilt_ : broadPhaseBuilt_) = false;
-    for (Served& s : served) {
-        fields_[s.part] = std::move(s.field);
-        fieldTried_[s.part] = s.tried;
-        features_[s.part] = std::move(s.features);
+    partSpheres_.push_back(sphere);
+    for (ServiceEntry& entry : change.served) {
+        fields_[entry.part] = std::move(entry.field);
+        fieldTried_[entry.part] = entry.tried;
+        features_[entry.part] = std::move(entry.features);
     }
 }
 

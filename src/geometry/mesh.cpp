@@ -242,6 +242,10 @@ std::vector<Index> weldTargets(std::span<const Vec3> vertices, double tolerance)
 }
 
 void composeVertexMap(VertexMap& map, const VertexMap& then) {
+    for (std::size_t i = 0; i < map.size(); ++i)
+        if (map[i] != kNoVertex && map[i] >= then.size())
+            throw InputError("vertex map", 0, "composeVertexMap: entry " + std::to_string(i) + " is " + std::to_string(map[i]) +
+                                                  ", beyond the second map's " + std::to_string(then.size()) + " entries");
     for (Index& v : map)
         if (v != kNoVertex) v = then[v];
 }
@@ -278,6 +282,13 @@ TriMesh inFileOrder(const TriMesh& mesh, const FileVertices& file) {
 }
 
 std::size_t weldVertices(TriMesh& mesh, double tolerance, VertexMap* moved) {
+    if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
+        throw InputError(mesh.name.empty() ? std::string("weld") : mesh.name, 0, "the weld tolerance must be finite and >= 0");
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+        for (const Index v : mesh.faces[f])
+            if (v >= mesh.vertices.size())
+                throw InputError(mesh.name.empty() ? std::string("weld") : mesh.name, 0,
+                                 "face " + std::to_string(f) + " names vertex " + std::to_string(v) + " of " + std::to_string(mesh.vertices.size()));
     const std::vector<Index> target = weldTargets(mesh.vertices, tolerance);
     // Kept vertices in input order; every vertex maps to its target's new index.
     std::vector<Index> remap(mesh.vertices.size());

@@ -51,6 +51,8 @@ SurfaceEmbedding embedSurface(TriMesh drawn, const TriMesh& simulation, const st
 
     SurfaceEmbedding e;
     const std::size_t n = drawn.vertices.size();
+    e.simulationVertexCount = simulation.vertices.size();
+    e.simulationFaceCount = simulation.faces.size();
     e.triangle.resize(n);
     e.weights.resize(n);
     e.offset.resize(n);
@@ -76,6 +78,10 @@ SurfaceEmbedding embedSurface(TriMesh drawn, const TriMesh& simulation, const st
 
 void embeddedPositions(const SurfaceEmbedding& e, std::span<const Face> simulationFaces, std::span<const Vec3> x,
                        std::vector<Vec3>& out) {
+    if (x.size() != e.simulationVertexCount || simulationFaces.size() != e.simulationFaceCount)
+        throw InputError("surface embedding", 0, "embeddedPositions: " + std::to_string(x.size()) + " positions and " +
+                                                     std::to_string(simulationFaces.size()) + " faces for a simulation mesh of " +
+                                                     std::to_string(e.simulationVertexCount) + " and " + std::to_string(e.simulationFaceCount));
     out.resize(e.vertexCount());
     for (std::size_t i = 0; i < out.size(); ++i) {
         const Vec3 moved = anchorOf(x, simulationFaces[e.triangle[i]], e.weights[i], e.offset[i]) - e.restAnchor[i];

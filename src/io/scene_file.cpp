@@ -630,8 +630,8 @@ void readWorld(Table& root, Scene& scene) {
     scene.duration = w.positive("duration", scene.duration);
     s.maxTravelFraction = w.positive("max_travel_fraction", s.maxTravelFraction);
     if (s.maxTravelFraction > 1.0) w.fail(*w.node("max_travel_fraction"), "max_travel_fraction", "must be in (0, 1]");
-    s.maxSubsteps = w.integer("max_substeps", s.maxSubsteps, 1, 1 << 20);
-    s.contactIterations = w.integer("contact_iterations", s.contactIterations, 1, 1000);
+    s.maxSubsteps = w.integer("max_substeps", s.maxSubsteps, 1, kMostSubsteps);
+    s.contactIterations = w.integer("contact_iterations", s.contactIterations, 1, kMostContactIterations);
     s.contactSlop = w.positive("contact_slop", s.contactSlop);
     if (s.contactSlop > 1.0) w.fail(*w.node("contact_slop"), "contact_slop", "must be in (0, 1]");
     s.contactDamping = w.nonNegative("contact_damping", s.contactDamping);

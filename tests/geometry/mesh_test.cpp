@@ -564,3 +564,22 @@ TEST(Mesh, InFileOrderRefusesFileVerticesThatDoNotFitTheMesh) {
     EXPECT_THROW((void)inFileOrder(tet, file), InputError);
     EXPECT_THROW((void)firstFileVertices(file, 4), InputError);
 }
+
+TEST(Mesh, WeldingAndComposingMapsRefuseIndicesBeyondTheirArrays) {
+    // A face naming vertex 1000 of 3, a map entry beyond the map it goes through, a tolerance
+    // that is no length: errors, where they read past the arrays (AddressSanitizer) or welded
+    // everything into one vertex.
+    TriMesh mesh;
+    mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    mesh.faces = {{0, 1, 1000}};
+    EXPECT_THROW((void)weldVertices(mesh, 0.0), InputError);
+    mesh.faces = {{0, 1, 2}};
+    for (const double bad : {std::nan(""), -1.0, double(INFINITY)}) EXPECT_THROW((void)weldVertices(mesh, bad), InputError) << bad;
+    EXPECT_EQ(weldVertices(mesh, 0.0), 0u);
+    VertexMap map{0, 5};
+    EXPECT_THROW(composeVertexMap(map, VertexMap{0}), InputError);
+    EXPECT_EQ(map, (VertexMap{0, 5}));
+    map = {1, kNoVertex};
+    composeVertexMap(map, VertexMap{7, 3});
+    EXPECT_EQ(map, (VertexMap{3, kNoVertex}));
+}

@@ -100,3 +100,16 @@ TEST(SurfaceEmbedding, MeshesWithoutFacesAreRejected) {
     EXPECT_THROW(embedSurface(empty, simulation, "test"), InputError);
     EXPECT_THROW(embedSurface(simulation, empty, "test"), InputError);
 }
+
+TEST(SurfaceEmbedding, PositionsOrFacesOfAnotherMeshAreAnError) {
+    // Positions of another mesh read past their end (found under AddressSanitizer).
+    const TriMesh simulation = makeIcoSphere(1.0, 1);
+    const SurfaceEmbedding e = embedSurface(makeIcoSphere(1.05, 2), simulation, "test");
+    std::vector<Vec3> out;
+    const std::vector<Vec3> two(2, Vec3::Zero());
+    EXPECT_THROW(embeddedPositions(e, simulation.faces, two, out), InputError);
+    const std::span<const Face> fewer(simulation.faces.data(), simulation.faces.size() - 1);
+    EXPECT_THROW(embeddedPositions(e, fewer, simulation.vertices, out), InputError);
+    embeddedPositions(e, simulation.faces, simulation.vertices, out);
+    EXPECT_EQ(out, e.mesh.vertices);
+}

@@ -399,3 +399,18 @@ TEST(World, SettingsWithAnEnumValueThatIsNoneOrASubnormalStepAreRefused) {
     rule.technique = static_cast<SnapTechnique>(12);
     refused([&] { world.addAssembly(rule); }, "technique 12");
 }
+
+TEST(World, SubstepsAndContactIterationsHaveTheScenesBounds) {
+    // 2^31 contact iterations a sub-step never ended; the API now has the scene file's bounds.
+    for (const auto& [substeps, iterations] : {std::pair{0, 8}, std::pair{kMostSubsteps + 1, 8}, std::pair{16, 0}, std::pair{16, 2147483647}}) {
+        WorldSettings s;
+        s.maxSubsteps = substeps;
+        s.contactIterations = iterations;
+        EXPECT_THROW(World w(s), InputError) << substeps << " " << iterations;
+    }
+    WorldSettings most;
+    most.maxSubsteps = kMostSubsteps;
+    most.contactIterations = kMostContactIterations;
+    World accepted(most);
+    EXPECT_EQ(accepted.bodyCount(), 0u);
+}
