@@ -43,6 +43,8 @@ Vec3 anchorOf(std::span<const Vec3> x, const Face& f, const Vec3& w, double offs
 
 SurfaceEmbedding embedSurface(TriMesh drawn, const TriMesh& simulation, const std::string& source) {
     if (drawn.faces.empty()) throw InputError(source, 0, "the drawn mesh has no faces");
+    for (std::size_t v = 0; v < drawn.vertices.size(); ++v)
+        if (!drawn.vertices[v].allFinite()) throw InputError(source, 0, "drawn vertex " + std::to_string(v) + " is not finite");
     if (simulation.faces.empty()) throw InputError(source, 0, "the simulation mesh has no faces");
     std::vector<Aabb> boxes(simulation.faces.size());
     for (std::size_t f = 0; f < boxes.size(); ++f) boxes[f] = faceBox(simulation.vertices, simulation.faces[f]);

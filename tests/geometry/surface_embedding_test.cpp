@@ -113,3 +113,9 @@ TEST(SurfaceEmbedding, PositionsOrFacesOfAnotherMeshAreAnError) {
     embeddedPositions(e, simulation.faces, simulation.vertices, out);
     EXPECT_EQ(out, e.mesh.vertices);
 }
+
+TEST(SurfaceEmbedding, ADrawnVertexThatIsNotFiniteIsAnError) {
+    TriMesh drawn = makeIcoSphere(1.05, 1);
+    drawn.vertices[3].y() = std::nan("");
+    EXPECT_THROW((void)embedSurface(drawn, makeIcoSphere(1.0, 1), "test"), InputError);
+}
