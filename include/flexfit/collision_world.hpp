@@ -205,6 +205,7 @@ private:
     // `items` (cleared first).
     void overlappingLeaves(const Bvh<Sphere>& tree, const Sphere& sphere, std::vector<Index>& items);
     std::vector<Index> leafItems_;  // scratch of overlappingLeaves' callers
+    void buildTree(Bvh<Sphere>& tree, std::span<const BodyId> bodies);  // over those bodies' spheres
     void buildFixedTree();
     std::vector<std::pair<BodyId, BodyId>> pairs_;
     std::vector<Contact> contacts_;

@@ -9,8 +9,10 @@
 #include "flexfit/core.hpp"
 
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace flexfit {
@@ -87,6 +89,8 @@ struct FileVertices {
 TriMesh inFileOrder(const TriMesh& mesh, const FileVertices& file);
 // For each mesh vertex, the first file vertex that became it (kNoVertex: none did).
 VertexMap firstFileVertices(const FileVertices& file, std::size_t meshVertexCount);
+// The first face corner naming a vertex beyond `vertexCount`, as (face, index), or nullopt.
+std::optional<std::pair<std::size_t, Index>> firstIndexBeyond(std::span<const Face> faces, std::size_t vertexCount);
 // InputError unless `file` fits a mesh of that many vertices: a position for each file vertex,
 // each finite, each going to a vertex of the mesh or removed. inFileOrder and
 // firstFileVertices check it.

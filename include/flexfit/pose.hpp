@@ -31,10 +31,10 @@ struct Pose {
     Pose then(const Pose& after) const;
 };
 
-// Throws InputError (source `what`) unless the pose is one: a finite translation and a
+// Throws InputError (`source`, "`what`: ...") unless the pose is one: a finite translation and a
 // rotation quaternion of finite, non-zero squared norm (it is normalised where it is set; a
 // quaternion of coefficients 1e200 would normalise to zeros, one of 1e-200 to NaN).
-void checkPose(const Pose& pose, std::string_view what);
+void checkPose(const Pose& pose, std::string_view source, std::string_view what);
 
 // The same pose bit for bit (coefficient by coefficient; a NaN never is): what the rigid motion
 // and the collision world's kept answers test before reusing what was found at a pose.

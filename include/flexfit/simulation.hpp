@@ -112,6 +112,9 @@ struct SimulationSettings {
 
 // Throws InputError (source "simulation settings") for non-finite or out-of-range values.
 void validateSettings(const SimulationSettings& settings);
+// What is wrong with a time step (not finite and positive, or subnormal: h/m and 1/h would
+// overflow), or nullopt: the parts' and the world's settings checks share it.
+std::optional<std::string> timeStepProblem(double timeStep);
 
 // What one step takes from whoever drives it. A part stepped alone takes the time step and
 // gravity of its settings; a world gives every stage its own (world.hpp).

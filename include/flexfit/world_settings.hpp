@@ -4,9 +4,9 @@
 #pragma once
 
 #include "flexfit/collision_world.hpp"
+#include "flexfit/simulation.hpp"
 
 #include <cmath>
-#include <limits>
 #include <string>
 
 namespace flexfit {
@@ -36,9 +36,7 @@ inline constexpr int kMostSubsteps = 1 << 20, kMostContactIterations = 1000;
 // non-finite contact damping, or a collision enum holding none of its values.
 inline void validateSettings(const WorldSettings& settings) {
     const std::string source = "world";
-    if (!std::isfinite(settings.timeStep) || settings.timeStep <= 0.0) throw InputError(source, 0, "time step must be finite and > 0");
-    if (!(settings.timeStep >= std::numeric_limits<double>::min()))  // h/m and 1/h would overflow
-        throw InputError(source, 0, "time step " + std::to_string(settings.timeStep) + " is below the smallest normal double");
+    if (const std::optional<std::string> problem = timeStepProblem(settings.timeStep)) throw InputError(source, 0, *problem);
     if (!settings.gravity.allFinite()) throw InputError(source, 0, "gravity must be finite");
     requireNamedValue<InputError>(settings.collision.exactTest, source, "exact test");
     requireNamedValue<InputError>(settings.collision.broadPhase, source, "broad-phase update");

@@ -39,10 +39,14 @@ void CollisionWorld::overlappingLeaves(const Bvh<Sphere>& tree, const Sphere& sp
     }
 }
 
-void CollisionWorld::buildFixedTree() {
+void CollisionWorld::buildTree(Bvh<Sphere>& tree, std::span<const BodyId> bodies) {
     treeSpheres_.clear();
-    for (const BodyId f : fixedIds_) treeSpheres_.push_back(partSpheres_[f]);
-    fixedTree_.build(treeSpheres_);
+    for (const BodyId b : bodies) treeSpheres_.push_back(partSpheres_[b]);
+    tree.build(treeSpheres_);
+}
+
+void CollisionWorld::buildFixedTree() {
+    buildTree(fixedTree_, fixedIds_);
     fixedTreeBuilt_ = true;
 }
 
@@ -50,9 +54,7 @@ void CollisionWorld::updatePairs() {
     updateBounds();
     if (!fixedTreeBuilt_) buildFixedTree();
     if (settings_.broadPhase == BroadPhaseUpdate::Rebuild || !broadPhaseBuilt_) {
-        treeSpheres_.clear();
-        for (const BodyId i : movingIds_) treeSpheres_.push_back(partSpheres_[i]);
-        broadPhase_.build(treeSpheres_);
+        buildTree(broadPhase_, movingIds_);
         broadPhaseBuilt_ = true;
     } else {
         broadPhase_.refitAll([&](Index k) { return partSpheres_[movingIds_[k]]; });

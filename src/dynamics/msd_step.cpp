@@ -13,11 +13,15 @@
 
 namespace flexfit {
 
+std::optional<std::string> timeStepProblem(double timeStep) {
+    if (!std::isfinite(timeStep) || timeStep <= 0.0) return "time step must be finite and > 0";
+    if (!(timeStep >= std::numeric_limits<double>::min())) return "time step " + std::to_string(timeStep) + " is below the smallest normal double";
+    return std::nullopt;
+}
+
 void validateSettings(const SimulationSettings& s) {
     const std::string source = "simulation settings";
-    if (!std::isfinite(s.timeStep) || s.timeStep <= 0.0) throw InputError(source, 0, "time step must be finite and > 0");
-    if (!(s.timeStep >= std::numeric_limits<double>::min()))  // its inverse (h/m, c/h) would overflow
-        throw InputError(source, 0, "time step " + std::to_string(s.timeStep) + " is below the smallest normal double");
+    if (const std::optional<std::string> problem = timeStepProblem(s.timeStep)) throw InputError(source, 0, *problem);
     if (!s.gravity.allFinite()) throw InputError(source, 0, "gravity must be finite");
     requireNamedValue<InputError>(s.integrator, source, "integrator");
     requireNamedValue<InputError>(s.restoration.method, source, "restoration method");

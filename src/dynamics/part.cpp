@@ -116,7 +116,7 @@ void Part::setSettings(const PartSettings& settings) {
 // --- Pose ---
 
 void Part::setPose(const Pose& pose) {
-    checkPose(pose, "part: setPose");
+    checkPose(pose, kPartSource, "setPose");
     detail::setPoseUnchecked(*this, pose);
 }
 
@@ -370,7 +370,7 @@ bool Part::advance(const StepContext& context, StepCounters* counters) {
     s.gravity = pose_.rotateInverse(context.gravity);  // world gravity seen in the part frame
     bool checked = true;  // the full model's step checks every mass itself (and throws)
     if (region_.coversEveryMass() && settings_.zones.fullSweepWhenComplete)
-        stepFullModel(*model_, s, {}, state_, counters);
+        detail::stepAllMasses(*model_, s, {}, nullptr, state_, counters);  // stepFullModel without its entry checks: the part checked its settings
     // The implicit solve holds a region's edge fixed; the full step would solve for it too.
     else if (settings_.zones.fullStepWhenCheaper && s.integrator != Integrator::ImplicitEuler &&
              fullStepCostsLess(*model_, RegionWork::of(region_)))

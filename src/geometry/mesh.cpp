@@ -46,13 +46,12 @@ void requireWellFormed(const TriMesh& mesh, const std::string& source, const Mes
         if (!mesh.vertices[v].allFinite())
             throw InputError(source, lineOf(lines.vertexLine, v), "vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
     requireWorkableScale(mesh, source, lines);
-    const std::size_t n = mesh.vertices.size();
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
-        for (Index idx : mesh.faces[f])
-            if (idx >= n)
-                throw InputError(source, lineOf(lines.faceLine, f),
-                                 faceText(f, mesh.faces[f]) + ": index " + std::to_string(idx) + " out of range (the mesh has " +
-                                     std::to_string(n) + " vertices)");
+    if (const auto beyond = firstIndexBeyond(mesh.faces, mesh.vertices.size())) {
+        const auto [f, idx] = *beyond;
+        throw InputError(source, lineOf(lines.faceLine, f),
+                         faceText(f, mesh.faces[f]) + ": index " + std::to_string(idx) + " out of range (the mesh has " +
+                             std::to_string(mesh.vertices.size()) + " vertices)");
+    }
 }
 
 double areaScale(const TriMesh& mesh) {
@@ -250,6 +249,13 @@ void composeVertexMap(VertexMap& map, const VertexMap& then) {
         if (v != kNoVertex) v = then[v];
 }
 
+std::optional<std::pair<std::size_t, Index>> firstIndexBeyond(std::span<const Face> faces, std::size_t vertexCount) {
+    for (std::size_t f = 0; f < faces.size(); ++f)
+        for (const Index v : faces[f])
+            if (v >= vertexCount) return std::pair{f, v};
+    return std::nullopt;
+}
+
 void checkFileVertices(const FileVertices& file, std::size_t meshVertexCount) {
     const auto fail = [](const std::string& problem) { throw InputError("file vertices", 0, problem); };
     if (file.positions.size() != file.count())
@@ -284,11 +290,10 @@ TriMesh inFileOrder(const TriMesh& mesh, const FileVertices& file) {
 std::size_t weldVertices(TriMesh& mesh, double tolerance, VertexMap* moved) {
     if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
         throw InputError(mesh.name.empty() ? std::string("weld") : mesh.name, 0, "the weld tolerance must be finite and >= 0");
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
-        for (const Index v : mesh.faces[f])
-            if (v >= mesh.vertices.size())
-                throw InputError(mesh.name.empty() ? std::string("weld") : mesh.name, 0,
-                                 "face " + std::to_string(f) + " names vertex " + std::to_string(v) + " of " + std::to_string(mesh.vertices.size()));
+    if (const auto beyond = firstIndexBeyond(mesh.faces, mesh.vertices.size()))
+        throw InputError(mesh.name.empty() ? std::string("weld") : mesh.name, 0,
+                         "face " + std::to_string(beyond->first) + " names vertex " + std::to_string(beyond->second) + " of " +
+                             std::to_string(mesh.vertices.size()));
     const std::vector<Index> target = weldTargets(mesh.vertices, tolerance);
     // Kept vertices in input order; every vertex maps to its target's new index.
     std::vector<Index> remap(mesh.vertices.size());

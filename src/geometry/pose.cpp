@@ -29,10 +29,10 @@ Pose Pose::fromMatrix(const Eigen::Matrix4d& m) {
     return pose;
 }
 
-void checkPose(const Pose& pose, std::string_view what) {
+void checkPose(const Pose& pose, std::string_view source, std::string_view what) {
     const double norm2 = pose.rotation.squaredNorm();
     if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite() || !(norm2 > 0.0) || !std::isfinite(norm2))
-        throw InputError(std::string(what), 0, "the pose must be finite, with a rotation quaternion of finite non-zero norm");
+        throw InputError(std::string(source), 0, std::string(what) + ": the pose must be finite, with a rotation quaternion of finite non-zero norm");
 }
 
 Pose Pose::then(const Pose& after) const {

@@ -1,4 +1,5 @@
 #include "flexfit/topology.hpp"
+#include "flexfit/mesh.hpp"
 
 #include <algorithm>
 #include <string>
@@ -100,11 +101,9 @@ void buildFaceNeighbours(std::vector<std::uint64_t>& pairs, Topology& topo) {
 }  // namespace
 
 Topology buildTopology(std::span<const Face> faces, std::size_t vertexCount) {
-    for (std::size_t f = 0; f < faces.size(); ++f)
-        for (const Index v : faces[f])
-            if (v >= vertexCount)
-                throw InputError("topology", 0, "face " + std::to_string(f) + " names vertex " + std::to_string(v) + " of " +
-                                                    std::to_string(vertexCount));
+    if (const auto beyond = firstIndexBeyond(faces, vertexCount))
+        throw InputError("topology", 0, "face " + std::to_string(beyond->first) + " names vertex " + std::to_string(beyond->second) + " of " +
+                                            std::to_string(vertexCount));
     Topology topo;
     topo.vertexCount = vertexCount;
     topo.faceCount = faces.size();

@@ -92,9 +92,9 @@ std::size_t addRule(const AssemblyRule& rule, std::size_t bodyCount, AssemblySta
     for (const AssemblyVector* v : {&rule.primaryVector, &rule.secondaryVector})
         if (!v->origin.allFinite() || !v->end.allFinite() || v->origin == v->end)
             throw InputError("world", 0, "assembly rule '" + rule.name + "': a vector's origin and end must be finite and differ (zero length has no direction)");
-    const std::string what = "world: assembly rule '" + rule.name + "'";
-    checkPose(rule.finalRelativePose, what + ": final relative pose");
-    checkPose(rule.area.frame, what + ": area frame");
+    const std::string what = "assembly rule '" + rule.name + "'";
+    checkPose(rule.finalRelativePose, "world", what + ": final relative pose");
+    checkPose(rule.area.frame, "world", what + ": area frame");
     for (const double tolerance : {rule.distanceTolerance, rule.angleTolerance, rule.vectorTolerance})
         if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
             throw InputError("world", 0, "assembly rule '" + rule.name + "': its distance, angle and vector tolerances must be finite and >= 0");

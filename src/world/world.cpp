@@ -18,13 +18,6 @@ namespace {
 
 const std::string kSource = "world";
 
-void checkPose(const Pose& pose, const char* what) {
-    try {
-        flexfit::checkPose(pose, what);
-    } catch (const InputError& e) {
-        throw InputError(kSource, 0, std::string(what) + ": " + e.problem());
-    }
-}
 
 // World::warnings(): a deforming part's restoration constraint left at its per-step default
 // fraction (no rate) at a world time step other than 1 ms.
@@ -56,7 +49,7 @@ BodyId World::add(std::shared_ptr<const PartModel> model, const PartSettings& pa
                   const Pose& pose) {
     detail::WorldData& d = *data_;
     if (model == nullptr) throw InputError(kSource, 0, "add: no part model");
-    checkPose(pose, "add");
+    checkPose(pose, kSource, "add");
     // Everything that can fail comes first; then the body is registered everywhere at once.
     const RigidBody body = makeRigidBody(*model, settings);
     auto part = std::make_unique<Part>(std::move(model), partSettings);
@@ -138,7 +131,7 @@ void World::setVelocity(BodyId id, const Vec3& linear, const Vec3& angular) {
 
 void World::setKinematicTarget(BodyId id, const Pose& target) {
     checkBody(id, "kinematic target");
-    checkPose(target, "kinematic target");
+    checkPose(target, kSource, "kinematic target");
     if (data_->bodies.rigid[id].motion == MotionType::Kinematic) data_->bodies.kinematicTargets[id] = target;
 }
 
@@ -146,7 +139,7 @@ void World::setKinematicTarget(BodyId id, const Pose& target) {
 
 void World::grab(BodyId id, const GrabSettings& settings) { detail::grab(id, settings, data_->settings.timeStep, data_->bodies, data_->op); }
 void World::setGrabTarget(const Pose& target) {
-    checkPose(target, "grab target");
+    checkPose(target, kSource, "grab target");
     data_->op.target = target;
 }
 void World::release() { detail::release(data_->op); }

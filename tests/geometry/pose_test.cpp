@@ -66,8 +66,8 @@ TEST(Pose, MillionRigidUpdatesStayOrthonormal) {
 
 TEST(Pose, CheckPoseRefusesWhatIsNoPose) {
     // A finite translation and a quaternion that normalises: accepted, whatever its length.
-    checkPose(Pose{}, "test");
-    checkPose(Pose{Eigen::Quaterniond(3.0, 0.0, 4.0, 0.0), Vec3(1e10, -2.0, 0.5)}, "test");
+    checkPose(Pose{}, "test", "pose");
+    checkPose(Pose{Eigen::Quaterniond(3.0, 0.0, 4.0, 0.0), Vec3(1e10, -2.0, 0.5)}, "test", "pose");
     const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
     const Pose bad[] = {
         {Eigen::Quaterniond(0, 0, 0, 0), Vec3::Zero()},       // no rotation
@@ -79,7 +79,7 @@ TEST(Pose, CheckPoseRefusesWhatIsNoPose) {
     };
     for (const Pose& p : bad) {
         try {
-            checkPose(p, "the test's pose");
+            checkPose(p, "test", "the test's pose");
             ADD_FAILURE() << p.rotation.coeffs().transpose() << " / " << p.translation.transpose() << " accepted";
         } catch (const InputError& e) {
             EXPECT_NE(std::string(e.what()).find("the test's pose"), std::string::npos) << e.what();
